@@ -1,0 +1,56 @@
+# The two commands of the README: `make run` and `make test`. Each installs what it needs the
+# first time (a venv with every package pinned by constraints.txt, the CMake path fix of
+# ROS_WHEELS.md, a colcon build) and skips what is already done.
+SHELL := /bin/bash
+.DEFAULT_GOAL := help
+
+PYTHON ?= python3
+VENV := .venv
+WS := tools/ws
+DEPS_STAMP := $(VENV)/.deps-stamp
+BUILD_STAMP := install/.build-stamp
+SOURCES := $(shell find src -type f -not -path '*/__pycache__/*' -not -name '*.pyc' 2>/dev/null)
+PYTEST_ARGS ?=
+
+.PHONY: help run test lint bench deps build lock clean
+
+help:
+	@echo 'make run    - drop parts into a bin and onto a vibrating tray, print a summary'
+	@echo 'make test   - lint and run every test (installs and builds on first use)'
+	@echo 'make bench  - world benchmarks (480-part bin, 50-part tray, node vs core)'
+	@echo 'make clean  - remove build/, install/, log/ (keeps the venv)'
+
+$(DEPS_STAMP): requirements.txt constraints.txt tools/fix_cmake_paths.py
+	test -x $(VENV)/bin/python || $(PYTHON) -m venv $(VENV)
+	$(VENV)/bin/python -m pip install --quiet --disable-pip-version-check pip==26.3
+	$(VENV)/bin/python -m pip install --quiet -r requirements.txt -c constraints.txt
+	$(VENV)/bin/python tools/fix_cmake_paths.py
+	touch $@
+
+deps: $(DEPS_STAMP)
+
+$(BUILD_STAMP): $(DEPS_STAMP) $(SOURCES) colcon.meta
+	$(WS) colcon build --event-handlers console_cohesion- summary+ status- \
+	    --cmake-args -DBUILD_TESTING=OFF -Wno-dev
+	touch $@
+
+build: $(BUILD_STAMP)
+
+run: $(BUILD_STAMP)
+	$(WS) pick_world_demo
+
+lint: $(DEPS_STAMP)
+	$(WS) ruff check src tests bench tools
+
+test: $(BUILD_STAMP) lint
+	$(WS) python -m pytest $(PYTEST_ARGS)
+
+bench: $(BUILD_STAMP)
+	$(WS) python bench/bench_world.py
+
+lock: $(DEPS_STAMP)
+	$(VENV)/bin/python -m pip freeze --exclude-editable | sort > constraints.txt.new
+	@echo 'review constraints.txt.new, then move it over constraints.txt'
+
+clean:
+	rm -rf build install log
