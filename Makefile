@@ -37,7 +37,7 @@ $(BUILD_STAMP): $(DEPS_STAMP) $(SOURCES) colcon.meta
 build: $(BUILD_STAMP)
 
 run: $(BUILD_STAMP)
-	$(WS) pick_world_demo
+	$(WS) install/pick_sim_world/lib/pick_sim_world/pick_world_demo
 
 lint: $(DEPS_STAMP)
 	$(WS) ruff check src tests bench tools

@@ -1,0 +1,94 @@
+"""Containers: a rectangular bin or the vibrating-table tray, in the instance frame.
+
+The instance frame has its origin at the centre of the inner floor, +Z up. The inner box spans
+[-x/2, x/2] x [-y/2, y/2] x [0, z]; walls and floor lie outside it. Units: metres.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import check_number, check_vector, InvalidArgument
+
+BIN = 'bin'
+TRAY = 'tray'
+KINDS = (BIN, TRAY)
+MIN_INNER, MAX_INNER = 0.005, 2.0     # m, per dimension
+MAX_WALL, MAX_FLOOR = 0.1, 0.2        # m
+TRAY_DEFAULT_SIZE = (0.195, 0.150, 0.027)
+
+
+@dataclass(frozen=True)
+class ContainerSpec:
+    """A rectangular container.
+
+    inner_size: inner length x, width y, wall height z, m.
+    wall_thickness, floor_thickness: m. The floor is thick so that fast parts cannot tunnel.
+    feeder_zone_center, feeder_zone_size: the tray's feeder drop zone on its floor (x, y), m.
+    """
+
+    kind: str = BIN
+    inner_size: tuple[float, float, float] = (0.3, 0.3, 0.026)
+    wall_thickness: float = 0.003
+    floor_thickness: float = 0.01
+    feeder_zone_center: tuple[float, float] = (0.0, 0.0)
+    feeder_zone_size: tuple[float, float] = (0.0, 0.0)
+
+    @staticmethod
+    def tray(inner_size: tuple[float, float, float] = TRAY_DEFAULT_SIZE) -> 'ContainerSpec':
+        """The vibrating-table tray with its feeder zone at the -X end (a quarter of its length)."""
+        x, y, _ = inner_size
+        return ContainerSpec(kind=TRAY, inner_size=tuple(inner_size), wall_thickness=0.003,
+                             floor_thickness=0.01, feeder_zone_center=(-3 * x / 8, 0.0),
+                             feeder_zone_size=(x / 4, 0.8 * y))
+
+
+def check_container(spec: ContainerSpec) -> ContainerSpec:
+    """Check every field; raise InvalidArgument naming the first that is wrong."""
+    if spec.kind not in KINDS:
+        raise InvalidArgument('container.kind', spec.kind, f'must be one of {", ".join(KINDS)}')
+    check_vector('container.inner_size', spec.inner_size, 3, low=MIN_INNER, high=MAX_INNER)
+    check_number('container.wall_thickness', spec.wall_thickness, low=0.0005, high=MAX_WALL)
+    check_number('container.floor_thickness', spec.floor_thickness, low=0.001, high=MAX_FLOOR)
+    if spec.kind == TRAY:
+        cx, cy = check_vector('container.feeder_zone_center', spec.feeder_zone_center, 2)
+        sx, sy = check_vector('container.feeder_zone_size', spec.feeder_zone_size, 2,
+                              low=0.0, low_open=True)
+        x, y, _ = spec.inner_size
+        if abs(cx) + sx / 2 > x / 2 + 1e-9 or abs(cy) + sy / 2 > y / 2 + 1e-9:
+            raise InvalidArgument('container.feeder_zone_size', (sx, sy),
+                                  f'at {cx:g}, {cy:g} reaches outside the inner floor '
+                                  f'{x:g} x {y:g}')
+    return spec
+
+
+def wall_boxes(spec: ContainerSpec) -> list[tuple[tuple[float, float, float],
+                                                  tuple[float, float, float]]]:
+    """Floor and four walls as (half extents, centre) boxes in the instance frame, m."""
+    x, y, z = spec.inner_size
+    t, f = spec.wall_thickness, spec.floor_thickness
+    ox, oy = x / 2 + t, y / 2 + t
+    boxes = [((ox, oy, f / 2), (0.0, 0.0, -f / 2))]
+    for s in (-1.0, 1.0):
+        boxes.append(((t / 2, oy, z / 2), (s * (x / 2 + t / 2), 0.0, z / 2)))
+        boxes.append(((x / 2, t / 2, z / 2), (0.0, s * (y / 2 + t / 2), z / 2)))
+    return boxes
+
+
+def outer_size(spec: ContainerSpec) -> tuple[float, float, float]:
+    """Outer length, width and height including walls and floor, m."""
+    x, y, z = spec.inner_size
+    t = spec.wall_thickness
+    return (x + 2 * t, y + 2 * t, z + spec.floor_thickness)
+
+
+def inside(spec: ContainerSpec, points: np.ndarray, tolerance: float = 0.001) -> np.ndarray:
+    """Which points (N, 3) in the instance frame lie within the inner box, (N,) bool.
+
+    The box is open upwards up to twice the wall height: a part resting on a pile that rises
+    above the walls is still in the container; tolerance (m) absorbs contact penetration.
+    """
+    x, y, z = spec.inner_size
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    return ((np.abs(p[:, 0]) <= x / 2 + tolerance) & (np.abs(p[:, 1]) <= y / 2 + tolerance)
+            & (p[:, 2] >= -tolerance) & (p[:, 2] <= 2 * z + tolerance))

@@ -1,0 +1,323 @@
+"""Part models: built-in parametric through-hole parts and user meshes.
+
+A part model becomes a `PartGeometry`: a compound of collision primitives and convex hulls in the
+part frame (what the physics and the validity checks collide) plus a detailed visual mesh.
+Moving bodies never use a raw triangle mesh: a user mesh becomes the convex hulls of its
+connected components.
+
+Units: metres, kilograms. Quaternions are (x, y, z, w).
+"""
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+import os
+
+import numpy as np
+import trimesh
+
+from .errors import check_int, check_number, InvalidArgument, MeshError, UnknownPart
+
+# Largest part accepted: a sanity limit well above small parts, in metres.
+MAX_PART_SIZE = 0.5
+MIN_PART_SIZE = 1e-4
+MAX_MESH_HULLS = 32
+MAX_MESH_FACES = 500_000
+IDENTITY = (0.0, 0.0, 0.0, 1.0)
+
+
+@dataclass(frozen=True)
+class PartSpec:
+    """What a user says about a part: a model name or a mesh, its size and material.
+
+    dimensions: overrides of the built-in model's defaults, metres (see `BUILTIN_MODELS`).
+    mass: kg; None takes the model's default. Friction: lateral is a Coulomb coefficient;
+    rolling and spinning are resistance arms in metres (torque = arm * normal force).
+    """
+
+    model: str = 'radial_capacitor'
+    dimensions: Mapping[str, float] = field(default_factory=dict)
+    mass: float | None = None
+    lateral_friction: float = 0.5
+    rolling_friction: float = 0.001
+    spinning_friction: float = 0.001
+    restitution: float = 0.0
+    mesh_path: str = ''
+    scale: float = 1.0
+
+
+@dataclass(frozen=True, eq=False)
+class Primitive:
+    """One collision shape of a part, in the part frame.
+
+    kind: 'box' (size = half extents x, y, z), 'cylinder' (size = radius, length; axis along
+    its local z) or 'hull' (vertices (K, 3) float64 in its local frame; size unused).
+    """
+
+    kind: str
+    size: tuple[float, ...]
+    position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    orientation: tuple[float, float, float, float] = IDENTITY
+    vertices: np.ndarray | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class PartGeometry:
+    """A part model ready for simulation and collision checks.
+
+    primitives: the collision compound in the part frame.
+    visual: the detailed mesh in the part frame, for display and volume.
+    dimensions: the model parameters used, metres (built-ins) or empty (meshes).
+    center: centre of the collision compound's bounding box in the part frame, (3,) m.
+    radius: radius of a sphere about `center` that encloses the compound, m.
+    thinnest: half the smallest feature thickness, m (the swept-sphere radius for CCD).
+    volume: volume of the visual mesh (or of the hulls when it is not watertight), m^3.
+    """
+
+    spec: PartSpec
+    dimensions: Mapping[str, float]
+    mass: float
+    primitives: tuple[Primitive, ...]
+    visual: trimesh.Trimesh
+    center: np.ndarray
+    radius: float
+    thinnest: float
+    volume: float
+
+
+# name -> (default dimensions in metres, default mass in kg, description)
+BUILTIN_MODELS: dict[str, tuple[dict[str, float], float, str]] = {
+    'radial_capacitor': ({
+        'body_diameter': 0.005,
+        'body_length': 0.011,
+        'lead_diameter': 0.0005,
+        'lead_length': 0.015,
+        'lead_pitch': 0.002,
+    }, 0.0004, 'cylindrical body along +Z, two leads along -Z spaced along X'),
+    'to220': ({
+        'body_width': 0.010,
+        'body_thickness': 0.0045,
+        'body_height': 0.009,
+        'tab_height': 0.0065,
+        'tab_thickness': 0.0013,
+        'lead_width': 0.0008,
+        'lead_thickness': 0.0005,
+        'lead_length': 0.013,
+        'lead_pitch': 0.00254,
+    }, 0.002, 'body box, metal tab above it (+Z) at the back (-Y), three leads along -Z'),
+    'dip': ({
+        'body_length': 0.0094,
+        'body_width': 0.00635,
+        'body_height': 0.0033,
+        'pins_per_row': 4.0,
+        'pin_pitch': 0.00254,
+        'row_spacing': 0.00762,
+        'pin_length': 0.0035,
+        'pin_width': 0.0005,
+        'pin_thickness': 0.00025,
+    }, 0.0005, 'body box, two rows of pins along -Z, rows spaced along Y, pins along X'),
+}
+
+
+def _box(half: tuple[float, float, float], position=(0.0, 0.0, 0.0)) -> Primitive:
+    return Primitive('box', tuple(float(h) for h in half), tuple(float(p) for p in position))
+
+
+def _cylinder(radius: float, length: float, position=(0.0, 0.0, 0.0)) -> Primitive:
+    return Primitive('cylinder', (float(radius), float(length)),
+                     tuple(float(p) for p in position))
+
+
+def _primitive_mesh(p: Primitive) -> trimesh.Trimesh:
+    """The triangle mesh of a primitive, in the part frame."""
+    if p.kind == 'box':
+        mesh = trimesh.creation.box(extents=2.0 * np.asarray(p.size))
+    elif p.kind == 'cylinder':
+        mesh = trimesh.creation.cylinder(radius=p.size[0], height=p.size[1], sections=24)
+    else:
+        mesh = trimesh.Trimesh(p.vertices, trimesh.convex.convex_hull(p.vertices).faces)
+    transform = trimesh.transformations.quaternion_matrix(
+        [p.orientation[3], *p.orientation[:3]])
+    transform[:3, 3] = p.position
+    mesh.apply_transform(transform)
+    return mesh
+
+
+def _radial_capacitor(d: Mapping[str, float]):
+    body_r, body_l = d['body_diameter'] / 2, d['body_length']
+    lead_r, lead_l, pitch = d['lead_diameter'] / 2, d['lead_length'], d['lead_pitch']
+    if pitch / 2 + lead_r > body_r:
+        raise InvalidArgument('part.dimensions.lead_pitch', pitch,
+                              f'puts the leads outside the body (max {2 * (body_r - lead_r):g})')
+    lead_z = -(body_l + lead_l) / 2
+    visual = [_cylinder(body_r, body_l),
+              _cylinder(lead_r, lead_l, (pitch / 2, 0, lead_z)),
+              _cylinder(lead_r, lead_l, (-pitch / 2, 0, lead_z))]
+    # The two leads collide as their convex hull (a thin plate): one shape instead of two,
+    # and no thin gap for another part's lead to jitter in.
+    collision = [visual[0], _box((pitch / 2 + lead_r, lead_r, lead_l / 2), (0, 0, lead_z))]
+    return collision, visual, lead_r
+
+
+def _to220(d: Mapping[str, float]):
+    w, t, h = d['body_width'], d['body_thickness'], d['body_height']
+    tab_h, tab_t = d['tab_height'], d['tab_thickness']
+    lw, lt, ll, pitch = d['lead_width'], d['lead_thickness'], d['lead_length'], d['lead_pitch']
+    if tab_t > t:
+        raise InvalidArgument('part.dimensions.tab_thickness', tab_t,
+                              f'must be <= body_thickness {t:g}')
+    if 2 * pitch + lw > w:
+        raise InvalidArgument('part.dimensions.lead_pitch', pitch,
+                              f'puts the leads outside the body (max {(w - lw) / 2:g})')
+    body = _box((w / 2, t / 2, h / 2))
+    tab = _box((w / 2, tab_t / 2, tab_h / 2), (0, -(t - tab_t) / 2, (h + tab_h) / 2))
+    lead_z = -(h + ll) / 2
+    leads = [_box((lw / 2, lt / 2, ll / 2), (k * pitch, 0, lead_z)) for k in (-1, 0, 1)]
+    collision = [body, tab, _box((pitch + lw / 2, lt / 2, ll / 2), (0, 0, lead_z))]
+    return collision, [body, tab, *leads], min(lt, tab_t) / 2
+
+
+def _dip(d: Mapping[str, float]):
+    n = check_int('part.dimensions.pins_per_row', d['pins_per_row'], low=1, high=64)
+    bl, bw, bh = d['body_length'], d['body_width'], d['body_height']
+    pitch, rows, pl = d['pin_pitch'], d['row_spacing'], d['pin_length']
+    pw, pt = d['pin_width'], d['pin_thickness']
+    span = (n - 1) * pitch + pw
+    if span > bl:
+        raise InvalidArgument('part.dimensions.pin_pitch', pitch,
+                              f'with {n} pins per row needs body_length >= {span:g}')
+    if not pt < rows <= 3 * bw:
+        raise InvalidArgument('part.dimensions.row_spacing', rows,
+                              f'must be within ({pt:g}, {3 * bw:g}]: above pin_thickness, '
+                              'at most 3 * body_width')
+    body = _box((bl / 2, bw / 2, bh / 2))
+    pin_z = -(bh + pl) / 2
+    pins = [_box((pw / 2, pt / 2, pl / 2), (-(n - 1) * pitch / 2 + k * pitch, s * rows / 2, pin_z))
+            for s in (-1, 1) for k in range(n)]
+    collision = [body] + [_box((span / 2, pt / 2, pl / 2), (0, s * rows / 2, pin_z))
+                          for s in (-1, 1)]
+    return collision, [body, *pins], pt / 2
+
+
+_BUILDERS = {'radial_capacitor': _radial_capacitor, 'to220': _to220, 'dip': _dip}
+
+
+def _check_material(spec: PartSpec, default_mass: float) -> float:
+    check_number('part.lateral_friction', spec.lateral_friction, low=0.0, high=10.0)
+    check_number('part.rolling_friction', spec.rolling_friction, low=0.0, high=0.1)
+    check_number('part.spinning_friction', spec.spinning_friction, low=0.0, high=0.1)
+    check_number('part.restitution', spec.restitution, low=0.0, high=1.0)
+    if spec.mass is None:
+        return default_mass
+    return check_number('part.mass', spec.mass, low=0.0, high=10.0, low_open=True)
+
+
+def _finish(spec: PartSpec, dims: Mapping[str, float], mass: float,
+            collision: list[Primitive], visual: trimesh.Trimesh, thinnest: float,
+            volume: float) -> PartGeometry:
+    corners = np.vstack([_primitive_mesh(p).bounds for p in collision])
+    low, high = corners.min(axis=0), corners.max(axis=0)
+    center = (low + high) / 2
+    points = np.vstack([_primitive_mesh(p).vertices for p in collision])
+    radius = float(np.linalg.norm(points - center, axis=1).max())
+    return PartGeometry(spec=spec, dimensions=dict(dims), mass=mass,
+                        primitives=tuple(collision), visual=visual, center=center,
+                        radius=radius, thinnest=float(thinnest), volume=float(volume))
+
+
+def _builtin(spec: PartSpec) -> PartGeometry:
+    defaults, default_mass, _ = BUILTIN_MODELS[spec.model]
+    unknown = sorted(set(spec.dimensions) - set(defaults))
+    if unknown:
+        raise InvalidArgument(f'part.dimensions.{unknown[0]}', spec.dimensions[unknown[0]],
+                              f'is not a dimension of {spec.model} '
+                              f'(known: {", ".join(sorted(defaults))})')
+    dims = {}
+    for name, default in defaults.items():
+        value = spec.dimensions.get(name, default)
+        if name == 'pins_per_row':
+            dims[name] = float(check_int(f'part.dimensions.{name}', value, low=1, high=64))
+        else:
+            dims[name] = check_number(f'part.dimensions.{name}', value, low=MIN_PART_SIZE,
+                                      high=MAX_PART_SIZE)
+    mass = _check_material(spec, default_mass)
+    collision, visual_parts, thinnest = _BUILDERS[spec.model](dims)
+    visual = trimesh.util.concatenate([_primitive_mesh(p) for p in visual_parts])
+    volume = float(sum(_primitive_mesh(p).volume for p in visual_parts))
+    return _finish(spec, dims, mass, collision, visual, thinnest, volume)
+
+
+def load_mesh(path: str, scale: float) -> trimesh.Trimesh:
+    """Read a mesh file (STL, OBJ, PLY) and check it; scale applies to the file's units.
+
+    Raises MeshError for a missing file, an unreadable or empty mesh, out-of-range face indices,
+    non-finite vertices or a mesh with no volume.
+    """
+    scale = check_number('part.scale', scale, low=0.0, high=1e3, low_open=True)
+    if not path:
+        raise MeshError('part.mesh_path', path, 'is empty: a mesh part needs a file')
+    if not os.path.isfile(path):
+        raise MeshError('part.mesh_path', path, 'does not exist or is not a file')
+    try:
+        loaded = trimesh.load(path, force='mesh', process=False)
+    except Exception as exc:  # trimesh raises many types for a bad file
+        raise MeshError('part.mesh_path', path, f'could not be read as a mesh: {exc}') from None
+    if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
+        raise MeshError('part.mesh_path', path, 'holds no triangles')
+    vertices = np.asarray(loaded.vertices, dtype=np.float64)
+    faces = np.asarray(loaded.faces)
+    if len(faces) > MAX_MESH_FACES:
+        raise MeshError('part.mesh_path', path,
+                        f'has {len(faces)} faces (limit {MAX_MESH_FACES}): simplify it')
+    if not np.isfinite(vertices).all():
+        raise MeshError('part.mesh_path', path, 'has non-finite vertex coordinates')
+    if faces.min() < 0 or faces.max() >= len(vertices):
+        raise MeshError('part.mesh_path', path,
+                        f'has face indices outside [0, {len(vertices) - 1}]')
+    mesh = trimesh.Trimesh(vertices * scale, faces, process=True)
+    extent = float(mesh.extents.max()) if len(mesh.vertices) else 0.0
+    if not MIN_PART_SIZE <= extent <= MAX_PART_SIZE:
+        raise MeshError('part.mesh_path', path,
+                        f'is {extent:g} m across after scale {scale:g}; must be within '
+                        f'[{MIN_PART_SIZE:g}, {MAX_PART_SIZE:g}] m (check part.scale: STL files '
+                        'are often in mm, scale 0.001)')
+    return mesh
+
+
+def _hull(points: np.ndarray) -> trimesh.Trimesh | None:
+    try:
+        hull = trimesh.convex.convex_hull(points)
+    except Exception:  # qhull fails on flat or collinear input
+        return None
+    return hull if hull.volume > 0 else None
+
+
+def _mesh_part(spec: PartSpec) -> PartGeometry:
+    mesh = load_mesh(spec.mesh_path, spec.scale)
+    if spec.mass is None:
+        raise InvalidArgument('part.mass', None, 'is required for a mesh part, kg')
+    mass = _check_material(spec, 0.0)
+    components = mesh.split(only_watertight=False)
+    if len(components) > MAX_MESH_HULLS:
+        components = [mesh]
+    hulls = [h for h in (_hull(c.vertices) for c in components) if h is not None]
+    if not hulls:
+        hull = _hull(mesh.vertices)
+        if hull is None:
+            raise MeshError('part.mesh_path', spec.mesh_path, 'has zero volume (flat or a line)')
+        hulls = [hull]
+    collision = [Primitive('hull', (), vertices=np.asarray(h.vertices, dtype=np.float64))
+                 for h in hulls]
+    volume = mesh.volume if mesh.is_watertight else sum(h.volume for h in hulls)
+    # Half the smallest extent of any hull: the CCD swept-sphere radius.
+    thinnest = min(float(h.extents.min()) for h in hulls) / 2
+    return _finish(spec, {}, mass, collision, mesh, thinnest, volume)
+
+
+def build_part(spec: PartSpec) -> PartGeometry:
+    """Check a part spec and build its geometry. Raises InvalidArgument or UnknownPart."""
+    if spec.model == 'mesh':
+        return _mesh_part(spec)
+    if spec.model not in BUILTIN_MODELS:
+        raise UnknownPart(f'part.model: {spec.model!r} is not a part model '
+                          f'(known: {", ".join(sorted(BUILTIN_MODELS))}, mesh)')
+    return _builtin(spec)
