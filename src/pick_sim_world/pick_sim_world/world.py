@@ -19,6 +19,7 @@ import time
 
 import numpy as np
 import pybullet as pb
+import trimesh
 
 from . import containers
 from .config import (
@@ -224,8 +225,7 @@ class World:
                 # pybullet takes convex hull vertices only from a file, one hull per file.
                 kind = pb.GEOM_MESH
                 path = os.path.join(self._tmp, f'hull_{i}.obj')
-                with open(path, 'w') as f:
-                    f.writelines(f'v {x!r} {y!r} {z!r}\n' for x, y, z in p.vertices)
+                trimesh.convex.convex_hull(p.vertices).export(path)
             kinds.append(kind)
             radii.append(radius)
             lengths.append(length)

@@ -1,0 +1,240 @@
+"""Pure-core tests of the world: real PyBullet, no ROS."""
+
+import math
+
+import numpy as np
+from pick_sim_world import containers
+from pick_sim_world.config import PhysicsConfig, SceneSpec, Vibration
+from pick_sim_world.containers import ContainerSpec
+from pick_sim_world.errors import InvalidArgument, PhysicsFault, UnknownInstance, UnknownPart
+from pick_sim_world.parts import BUILTIN_MODELS, PartSpec
+from pick_sim_world.world import quaternion_angles, World
+import pybullet as pb
+import pytest
+
+SMALL_BIN = ContainerSpec(inner_size=(0.12, 0.10, 0.03))
+
+
+def _world(container=SMALL_BIN, model='radial_capacitor', instances=1, seed=3, **physics):
+    return World(SceneSpec(container, PartSpec(model=model), instances, seed),
+                 PhysicsConfig(**physics))
+
+
+@pytest.mark.parametrize('model', sorted(BUILTIN_MODELS))
+@pytest.mark.parametrize('container', [SMALL_BIN, ContainerSpec.tray()], ids=['bin', 'tray'])
+def test_settled_parts_are_inside_their_container(model, container):
+    with _world(container, model) as world:
+        ids, report = world.drop(40)
+        state = world.snapshot()
+    assert report.settled, f'{len(report.unsettled_ids)} parts still moving'
+    assert report.escaped_ids == []
+    assert len(ids) == 40 and sorted(state.ids.tolist()) == sorted(ids)
+    assert state.inside.all()
+    # Resting on the floor or on other parts: below the wall top plus one part.
+    x, y, z = container.inner_size
+    assert (np.abs(state.poses[:, 0]) < x / 2).all() and (np.abs(state.poses[:, 1]) < y / 2).all()
+    assert (state.poses[:, 2] > 0).all() and (state.poses[:, 2] < z + 0.03).all()
+    assert np.allclose(np.linalg.norm(state.poses[:, 3:], axis=1), 1.0)
+
+
+def test_same_scene_and_seed_give_the_same_poses():
+    runs = []
+    for _ in range(2):
+        with _world(seed=11) as world:
+            world.drop(30)
+            world.remove([0, 1, 2])
+            runs.append(world.snapshot().poses)
+    assert np.array_equal(runs[0], runs[1])
+    with _world(seed=12) as world:
+        world.drop(30)
+        world.remove([0, 1, 2])
+        other = world.snapshot().poses
+    assert not np.allclose(runs[0], other)
+
+
+def test_spawn_poses_do_not_overlap_and_respect_the_region():
+    with _world(ContainerSpec.tray()) as world:
+        part = world.part
+        for zone in ('container', 'feeder'):
+            poses = world.spawn_poses(0, 60, zone)
+            centres = poses[:, :3] + np.array([
+                pb.multiplyTransforms([0, 0, 0], q, part.center.tolist(), [0, 0, 0, 1])[0]
+                for q in poses[:, 3:]])
+            gaps = np.linalg.norm(centres[:, None] - centres[None], axis=2)
+            np.fill_diagonal(gaps, np.inf)
+            assert gaps.min() >= 2 * part.radius - 1e-9
+            cx, cy, hx, hy = world.drop_region(0, zone)
+            assert (np.abs(centres[:, 0] - cx) <= hx - part.radius + 1e-9).all()
+            assert (np.abs(centres[:, 1] - cy) <= hy - part.radius + 1e-9).all()
+
+
+def test_480_capacitors_settle_in_the_paper_bin_without_escapes():
+    with _world(ContainerSpec(inner_size=(0.3, 0.3, 0.026)), seed=0) as world:
+        _, report = world.drop(480)
+    assert report.settled and report.escaped_ids == []
+
+
+def test_vibration_scatters_and_turns_parts_and_the_tray_returns_home():
+    with _world(ContainerSpec.tray()) as world:
+        world.drop(50)
+        before = world.snapshot()
+        report = world.vibrate(Vibration(amplitude=(0.001, 0.0005, 0.001), frequency=30.0,
+                                         duration=1.0))
+        after = world.snapshot()
+        tray = world.instances[0]
+        home, _ = pb.getBasePositionAndOrientation(tray.body, physicsClientId=world._client)
+    moved = np.linalg.norm(after.poses[:, :3] - before.poses[:, :3], axis=1)
+    turned = quaternion_angles(after.poses[:, 3:], before.poses[:, 3:])
+    assert report.settled and report.escaped_ids == []
+    assert np.median(moved) > 0.005, 'a vibration must move most parts by millimetres'
+    assert (turned > math.radians(90)).sum() >= 1, 'some parts must turn over'
+    assert np.allclose(home, tray.origin, atol=1e-4)
+
+
+def test_vibrating_a_bin_is_refused():
+    with _world() as world:
+        with pytest.raises(InvalidArgument, match='only trays vibrate'):
+            world.vibrate(Vibration())
+
+
+def test_feed_drops_into_the_feeder_zone_on_top_of_the_parts_there():
+    with _world(ContainerSpec.tray()) as world:
+        world.drop(20)
+        new, report = world.drop(15, zone='feeder')
+        state = world.snapshot()
+    assert report.settled and report.escaped_ids == []
+    assert len(state.ids) == 35 and set(new) <= set(state.ids.tolist())
+
+
+def test_remove_parts_then_resettle_and_ids_are_not_reused():
+    with _world() as world:
+        ids, _ = world.drop(30)
+        removed, report = world.remove(ids[:10])
+        assert removed == ids[:10]
+        assert report.settled
+        state = world.snapshot()
+        assert sorted(state.ids.tolist()) == ids[10:]
+        new, _ = world.drop(5)
+        assert min(new) == max(ids) + 1
+        with pytest.raises(UnknownPart, match='part_ids: 3 is not a part'):
+            world.remove([3])
+
+
+def test_instances_are_independent_with_their_own_frames_and_seeds():
+    with _world(instances=3) as world:
+        world.drop(20)
+        state = world.snapshot()
+        seeds = [inst.seed for inst in world.instances]
+        assert len(set(seeds)) == 3
+        for k in range(3):
+            mine = state.select([k])
+            assert len(mine.ids) == 20 and mine.inside.all()
+        # Same seed sequence, so instance 0 of another world with one instance would differ
+        # only through instances' shared physics; the frames, though, do not overlap.
+        origins = np.array([inst.origin for inst in world.instances])
+        assert np.all(np.diff(origins[:, 0]) > containers.outer_size(SMALL_BIN)[0])
+        with pytest.raises(UnknownInstance, match='instances: 3 does not exist'):
+            world.drop(1, [3])
+
+
+def test_time_cap_is_reported_when_hit():
+    with _world(max_settle_time=10.0) as world:
+        _, report = world.drop(60, max_settle_time=0.25)
+    assert not report.settled
+    assert report.unsettled_ids and math.isclose(report.sim_time, 0.25, abs_tol=0.01)
+
+
+def test_cancel_from_the_progress_callback_stops_the_operation():
+    calls = []
+    with _world() as world:
+        _, report = world.drop(40, progress=lambda p: calls.append(p) or len(calls) < 3)
+        assert report.canceled and not report.settled and len(calls) == 3
+        assert len(world.snapshot().ids) == 40
+
+
+def test_nan_state_is_detected_and_the_scene_reset():
+    with _world() as world:
+        ids, _ = world.drop(5)
+        body = world._bodies[ids[0]]
+        pb.resetBaseVelocity(body, [math.nan, 0, 0], [0, 0, 0], physicsClientId=world._client)
+        with pytest.raises(PhysicsFault, match=r'parts \[0\] got non-finite poses'):
+            world.settle()
+        assert len(world.snapshot().ids) == 0
+        world.drop(5)
+        assert np.isfinite(world.snapshot().poses).all()
+
+
+@pytest.mark.parametrize(('change', 'field'), [
+    (dict(container=ContainerSpec(inner_size=(0.0, 0.1, 0.02))), r'container.inner_size\[0\]'),
+    (dict(container=ContainerSpec(inner_size=(0.1, -0.1, 0.02))), r'container.inner_size\[1\]'),
+    (dict(container=ContainerSpec(inner_size=(0.1, math.nan, 0.02))),
+     r'container.inner_size\[1\]: nan must be finite'),
+    (dict(container=ContainerSpec(wall_thickness=math.inf)), 'container.wall_thickness'),
+    (dict(container=ContainerSpec(kind='box')), 'container.kind'),
+    (dict(part=PartSpec(dimensions={'body_diameter': -0.005})),
+     'part.dimensions.body_diameter'),
+    (dict(part=PartSpec(dimensions={'body_diamter': 0.005})),
+     'part.dimensions.body_diamter: 0.005 is not a dimension of radial_capacitor'),
+    (dict(part=PartSpec(mass=math.nan)), 'part.mass: nan must be finite'),
+    (dict(part=PartSpec(lateral_friction=-1.0)), 'part.lateral_friction'),
+    (dict(instance_count=0), 'instance_count: 0 must be within'),
+    (dict(seed=-1), 'seed'),
+])
+def test_bad_scene_is_refused_naming_the_field_and_the_world_is_unchanged(change, field):
+    with _world() as world:
+        world.drop(5)
+        base = world.scene
+        scene = SceneSpec(**{**dict(container=base.container, part=base.part,
+                                    instance_count=1, seed=0), **change})
+        with pytest.raises(InvalidArgument, match=field):
+            world.reset(scene)
+        assert world.scene is base and len(world.snapshot().ids) == 5
+
+
+def test_unknown_part_model_is_refused_listing_the_known_ones():
+    with pytest.raises(UnknownPart, match="part.model: 'resistor' is not a part model.*dip"):
+        _world(model='resistor')
+
+
+@pytest.mark.parametrize(('count', 'rule'), [
+    (0, r'count: 0 must be within \[1, 5000\]'),
+    (10**9, r'count: 1000000000 must be within \[1, 5000\]'),
+    (2.5, 'count: 2.5 is not an integer'),
+    (math.nan, 'count: nan is not an integer'),
+])
+def test_bad_counts_are_refused(count, rule):
+    with _world() as world, pytest.raises(InvalidArgument, match=rule):
+        world.drop(count)
+
+
+def test_a_bin_too_small_for_the_parts_is_refused_before_any_physics():
+    tiny = ContainerSpec(inner_size=(0.02, 0.02, 0.01))
+    with _world(tiny) as world:
+        with pytest.raises(InvalidArgument, match='container.inner_size.*smaller than the part'):
+            world.drop(1)
+    with _world(ContainerSpec(inner_size=(0.05, 0.05, 0.01))) as world:
+        with pytest.raises(InvalidArgument, match=r'count: 500 does not fit.*at most \d+ parts'):
+            world.drop(500)
+        assert len(world.snapshot().ids) == 0
+
+
+@pytest.mark.parametrize(('vibration', 'rule'), [
+    (Vibration(amplitude=(0.0, 0.0, 0.0)), 'is zero on every axis'),
+    (Vibration(amplitude=(math.nan, 0.0, 0.001)), r'vibration.amplitude\[0\]: nan must be finite'),
+    (Vibration(frequency=-3.0), 'vibration.frequency: -3.0 must be >= 0.1'),
+    (Vibration(duration=math.inf), 'vibration.duration: inf must be finite'),
+    (Vibration(amplitude=(0.01, 0.0, 0.01), frequency=100.0), 'peak acceleration'),
+])
+def test_bad_vibrations_are_refused(vibration, rule):
+    with _world(ContainerSpec.tray()) as world, pytest.raises(InvalidArgument, match=rule):
+        world.vibrate(vibration)
+
+
+def test_feeding_a_bin_is_refused():
+    with _world() as world, pytest.raises(InvalidArgument, match='zone.*has no feeder'):
+        world.drop(1, zone='feeder')
+
+
+def test_bad_settle_time_is_refused():
+    with _world() as world, pytest.raises(InvalidArgument, match='max_settle_time: nan'):
+        world.drop(1, max_settle_time=math.nan)
