@@ -330,7 +330,11 @@ class WorldNode(Node):
 
 
 def main(args=None) -> None:
-    rclpy.init(args=args)
+    try:
+        rclpy.init(args=args)
+    except Exception as exc:  # rcl's RCLError (bad --ros-args, unreadable params file)
+        print(f'world: could not start: {exc}', file=sys.stderr)
+        sys.exit(2)
     try:
         node = WorldNode()
     except (WorldError, ParameterException) as exc:

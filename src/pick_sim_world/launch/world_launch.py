@@ -1,0 +1,26 @@
+"""Start one `world` node, optionally under a namespace (a worker) with a parameter file.
+
+ros2 launch pick_sim_world world_launch.py namespace:=worker_1 params_file:=tray.yaml
+"""
+
+import os
+
+from ament_index_python.packages import get_package_share_directory
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node
+
+
+def generate_launch_description() -> LaunchDescription:
+    default_params = os.path.join(get_package_share_directory('pick_sim_world'), 'config',
+                                  'world.yaml')
+    return LaunchDescription([
+        DeclareLaunchArgument('namespace', default_value='',
+                              description='namespace of the node, e.g. worker_1'),
+        DeclareLaunchArgument('params_file', default_value=default_params,
+                              description='parameter file of the world node'),
+        Node(package='pick_sim_world', executable='world', name='world',
+             namespace=LaunchConfiguration('namespace'),
+             parameters=[LaunchConfiguration('params_file')], output='screen'),
+    ])

@@ -1,0 +1,42 @@
+"""Fixtures for graph tests: a private ROS domain, node processes, a client node."""
+
+from collections.abc import Callable, Iterator
+import os
+
+from graph import Client, NodeProcess
+import pytest
+
+
+@pytest.fixture(scope='session', autouse=True)
+def private_ros_domain() -> Iterator[int]:
+    """A ROS domain of this test run only, on loopback: parallel runs do not see each other."""
+    domain = 10 + os.getpid() % 90
+    saved = {k: os.environ.get(k) for k in ('ROS_DOMAIN_ID', 'ROS_AUTOMATIC_DISCOVERY_RANGE')}
+    os.environ['ROS_DOMAIN_ID'] = str(domain)
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    yield domain
+    for key, value in saved.items():
+        if value is None:
+            os.environ.pop(key, None)
+        else:
+            os.environ[key] = value
+
+
+@pytest.fixture
+def start_node() -> Iterator[Callable[..., NodeProcess]]:
+    started: list[NodeProcess] = []
+
+    def start(package: str, name: str, *args: str) -> NodeProcess:
+        started.append(NodeProcess(package, name, list(args)))
+        return started[-1]
+
+    yield start
+    for proc in started:
+        proc.stop()
+
+
+@pytest.fixture
+def client() -> Iterator[Client]:
+    c = Client()
+    yield c
+    c.close()

@@ -1,0 +1,80 @@
+"""Helpers for graph tests: node processes, a client node, a steady-clock wait.
+
+Nodes run as real processes started from their installed executables (the path `ros2 run`
+uses) and talk to the test's client node over DDS on loopback.
+"""
+
+from collections.abc import Callable
+import os
+import signal
+import subprocess
+import time
+
+from ament_index_python.packages import get_package_prefix
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+
+
+def wait_for(predicate: Callable[[], bool], timeout: float, spin: Callable[[], None]) -> bool:
+    """Spin until predicate() holds or timeout (s, steady clock) passes; no fixed sleeps."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return True
+        spin()
+    return predicate()
+
+
+def executable(package: str, name: str) -> str:
+    """The installed executable, where `ros2 run package name` finds it."""
+    return os.path.join(get_package_prefix(package), 'lib', package, name)
+
+
+class NodeProcess:
+    """A node started as a process; stop() sends SIGINT and returns its exit code."""
+
+    def __init__(self, package: str, name: str, args: list[str]) -> None:
+        self.command = [executable(package, name), '--ros-args', *args]
+        self.process = subprocess.Popen(self.command, stdout=subprocess.PIPE,
+                                        stderr=subprocess.STDOUT, text=True)
+
+    def stop(self, timeout: float = 20.0) -> int:
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGINT)
+            try:
+                self.process.wait(timeout)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait()
+        return self.process.returncode
+
+    def output(self) -> str:
+        return self.process.stdout.read() if self.process.stdout else ''
+
+
+class Client:
+    """A client node in its own context with a single-threaded executor."""
+
+    def __init__(self) -> None:
+        self.context = Context()
+        rclpy.init(context=self.context)
+        self.node = Node('test_client', context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+
+    def spin_once(self) -> None:
+        self.executor.spin_once(timeout_sec=0.05)
+
+    def wait(self, predicate: Callable[[], bool], timeout: float = 30.0) -> bool:
+        return wait_for(predicate, timeout, self.spin_once)
+
+    def result(self, future, timeout: float = 60.0):
+        assert self.wait(future.done, timeout), f'no answer within {timeout} s'
+        return future.result()
+
+    def close(self) -> None:
+        self.executor.shutdown()
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)

@@ -1,0 +1,228 @@
+"""The real `world` executable, driven over DDS from a client node."""
+
+import math
+import os
+
+from ament_index_python.packages import get_package_share_directory
+from geometry_msgs.msg import Vector3
+from graph import NodeProcess
+import numpy as np
+from pick_msgs.action import DropParts, RemoveParts, Vibrate
+from pick_msgs.msg import ContainerGeometry, PartArray, Scene
+from pick_msgs.srv import GetParts, ResetScene
+import pytest
+from rclpy.action import ActionClient
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
+pytestmark = pytest.mark.graph
+NS = '/cell_a'
+LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL,
+                     reliability=ReliabilityPolicy.RELIABLE)
+OK = GetParts.Response.NONE
+
+
+@pytest.fixture(scope='module')
+def world(private_ros_domain):
+    proc = NodeProcess('pick_sim_world', 'world', [
+        '-r', f'__ns:={NS}', '-p', 'container.kind:=tray', '-p', 'seed:=5',
+        '-p', 'publish_markers:=true'])
+    yield proc
+    code = proc.stop()
+    assert code == 0, f'world exited with {code} on SIGINT:\n{proc.output()}'
+
+
+class Cell:
+    """Typed access to the world's endpoints under NS."""
+
+    def __init__(self, client) -> None:
+        self.c = client
+        node = client.node
+        self.get_parts_srv = node.create_client(GetParts, f'{NS}/get_parts')
+        self.reset_srv = node.create_client(ResetScene, f'{NS}/reset_scene')
+        self.actions = {t: ActionClient(node, t, f'{NS}/{name}') for t, name in (
+            (DropParts, 'drop_parts'), (Vibrate, 'vibrate'), (RemoveParts, 'remove_parts'))}
+        assert client.wait(lambda: self.get_parts_srv.service_is_ready()
+                           and self.reset_srv.service_is_ready()
+                           and all(a.server_is_ready() for a in self.actions.values()), 60.0), \
+            'the world node did not come up'
+
+    def call(self, client, request):
+        return self.c.result(client.call_async(request))
+
+    def get_parts(self, instances=()):
+        return self.call(self.get_parts_srv, GetParts.Request(instances=list(instances)))
+
+    def reset(self, **fields):
+        return self.call(self.reset_srv, ResetScene.Request(**fields))
+
+    def send(self, action_type, goal, feedback=None):
+        handle = self.c.result(self.actions[action_type].send_goal_async(
+            goal, feedback_callback=feedback))
+        assert handle.accepted
+        return handle
+
+    def run(self, action_type, goal, feedback=None):
+        handle = self.send(action_type, goal, feedback)
+        return self.c.result(handle.get_result_async(), 120.0).result
+
+
+@pytest.fixture
+def cell(world, client):
+    cell = Cell(client)
+    assert cell.reset(keep_scene=True, seed=5).error_code == OK
+    return cell
+
+
+def _poses(parts: PartArray) -> np.ndarray:
+    return np.array([[p.pose.pose.position.x, p.pose.pose.position.y, p.pose.pose.position.z]
+                     for p in parts.parts])
+
+
+def test_scene_is_latched_and_describes_the_tray(cell, client):
+    scenes = []
+    client.node.create_subscription(Scene, f'{NS}/scene', scenes.append, LATCHED)
+    assert client.wait(lambda: scenes, 30.0), 'no latched scene'
+    scene = scenes[-1]
+    assert scene.header.frame_id == 'world'
+    assert [i.frame_id for i in scene.instances] == ['cell_a/instance_0']
+    container = scene.instances[0].container
+    assert container.type == ContainerGeometry.TYPE_TRAY
+    assert math.isclose(container.inner_size.x, 0.195) and math.isclose(
+        container.inner_size.y, 0.150)
+    assert scene.part_model.name == 'radial_capacitor' and len(scene.part_model.primitives) == 2
+
+
+def test_drop_50_parts_then_read_them_vibrate_and_remove(cell, client):
+    published = []
+    client.node.create_subscription(PartArray, f'{NS}/parts', published.append, 10)
+    feedback = []
+    drop = cell.run(DropParts, DropParts.Goal(count=50), feedback.append)
+    assert drop.error_code == OK, drop.error_msg
+    assert len(drop.part_ids) == 50 and drop.settle.settled and not drop.settle.escaped_ids
+    assert feedback, 'feedback once per settle check'
+    assert client.wait(lambda: any(len(m.parts) == 50 for m in published), 30.0)
+    parts = cell.get_parts()
+    assert parts.error_code == OK and len(parts.parts.parts) == 50
+    assert all(p.inside and p.pose.header.frame_id == 'cell_a/instance_0'
+               for p in parts.parts.parts)
+    assert np.allclose(_poses(parts.parts), _poses(drop.parts))
+
+    vibrate = cell.run(Vibrate, Vibrate.Goal())   # zeros: the node's default vibration
+    assert vibrate.error_code == OK, vibrate.error_msg
+    moved = np.linalg.norm(_poses(vibrate.parts) - _poses(drop.parts), axis=1)
+    assert np.median(moved) > 0.005
+
+    remove = cell.run(RemoveParts, RemoveParts.Goal(part_ids=list(drop.part_ids[:5])))
+    assert remove.error_code == OK and list(remove.removed_ids) == list(drop.part_ids[:5])
+    left = cell.get_parts().parts.parts
+    assert len(left) == 45 and not {p.id for p in left} & set(drop.part_ids[:5])
+
+
+def test_feed_drops_into_the_feeder_zone(cell):
+    result = cell.run(DropParts, DropParts.Goal(count=12, zone=DropParts.Goal.ZONE_FEEDER))
+    assert result.error_code == OK and len(result.parts.parts) == 12
+
+
+@pytest.mark.parametrize(('action_type', 'goal', 'code', 'text'), [
+    (DropParts, DropParts.Goal(count=0), DropParts.Result.INVALID_ARGUMENT, 'count: 0'),
+    (DropParts, DropParts.Goal(count=10**6), DropParts.Result.INVALID_ARGUMENT, 'count'),
+    (DropParts, DropParts.Goal(count=3, max_settle_time=math.nan),
+     DropParts.Result.INVALID_ARGUMENT, 'max_settle_time: nan must be finite'),
+    (DropParts, DropParts.Goal(count=3, instances=[7]), DropParts.Result.UNKNOWN_INSTANCE,
+     'instances: 7 does not exist'),
+    (DropParts, DropParts.Goal(count=3, zone=9), DropParts.Result.INVALID_ARGUMENT, 'zone: 9'),
+    (Vibrate, Vibrate.Goal(amplitude=Vector3(x=math.inf)), Vibrate.Result.INVALID_ARGUMENT,
+     r'vibration.amplitude[0]: inf must be finite'),
+    (Vibrate, Vibrate.Goal(frequency=-1.0), Vibrate.Result.INVALID_ARGUMENT,
+     'vibration.frequency: -1.0'),
+    (RemoveParts, RemoveParts.Goal(part_ids=[123456]), RemoveParts.Result.UNKNOWN_PART,
+     'part_ids: 123456 is not a part'),
+    (RemoveParts, RemoveParts.Goal(), RemoveParts.Result.INVALID_ARGUMENT, 'part_ids: [] is'),
+])
+def test_bad_goals_get_an_error_and_the_node_keeps_serving(cell, action_type, goal, code, text):
+    result = cell.run(action_type, goal)
+    assert result.error_code == code and text in result.error_msg, result.error_msg
+    again = cell.run(DropParts, DropParts.Goal(count=2))
+    assert again.error_code == OK
+
+
+def test_bad_service_requests_get_an_error(cell):
+    missing = cell.get_parts([4])
+    assert missing.error_code == GetParts.Response.UNKNOWN_INSTANCE
+    bad = ResetScene.Request(instance_count=1)
+    bad.container.inner_size = Vector3(x=0.1, y=math.nan, z=0.02)
+    bad.container.wall_thickness, bad.container.floor_thickness = 0.003, 0.01
+    bad.part_model.name = 'radial_capacitor'
+    answer = cell.reset(container=bad.container, part_model=bad.part_model, instance_count=1)
+    assert answer.error_code == ResetScene.Response.INVALID_ARGUMENT
+    assert 'container.inner_size[1]: nan must be finite' in answer.error_msg
+    bad.part_model.name = 'resistor'
+    bad.container.inner_size.y = 0.1
+    answer = cell.reset(container=bad.container, part_model=bad.part_model, instance_count=1)
+    assert answer.error_code == ResetScene.Response.UNKNOWN_PART and 'resistor' in answer.error_msg
+    assert cell.get_parts().error_code == OK
+
+
+def test_reset_builds_a_new_scene_with_instances(cell, client):
+    request = ResetScene.Request(instance_count=2, seed=9)
+    request.container.type = ContainerGeometry.TYPE_BIN
+    request.container.inner_size = Vector3(x=0.1, y=0.08, z=0.02)
+    request.container.wall_thickness, request.container.floor_thickness = 0.002, 0.005
+    request.part_model.name = 'dip'
+    answer = cell.reset(**{k: getattr(request, k) for k in (
+        'container', 'part_model', 'instance_count', 'seed')})
+    assert answer.error_code == OK, answer.error_msg
+    assert [i.frame_id for i in answer.scene.instances] == ['cell_a/instance_0',
+                                                            'cell_a/instance_1']
+    result = cell.run(DropParts, DropParts.Goal(count=10))
+    assert result.error_code == OK and len(result.parts.parts) == 20
+    assert len(cell.get_parts([1]).parts.parts) == 10
+    # Back to the module's tray for the other tests.
+    request.container = ContainerGeometry(type=ContainerGeometry.TYPE_TRAY)
+    request.container.inner_size = Vector3(x=0.195, y=0.150, z=0.027)
+    request.container.wall_thickness, request.container.floor_thickness = 0.003, 0.01
+    request.container.feeder_zone_center.x = -0.073125
+    request.container.feeder_zone_size = Vector3(x=0.04875, y=0.12)
+    request.part_model.name = 'radial_capacitor'
+    assert cell.reset(container=request.container, part_model=request.part_model,
+                      instance_count=1, seed=5).error_code == OK
+
+
+def test_a_second_goal_while_one_runs_is_busy_and_cancel_stops_the_first(cell, client):
+    feedback = []
+    first = cell.send(DropParts, DropParts.Goal(count=300, max_settle_time=60.0),
+                      feedback.append)
+    assert client.wait(lambda: feedback, 60.0), 'no feedback from the running drop'
+    second = cell.run(DropParts, DropParts.Goal(count=1))
+    assert second.error_code == DropParts.Result.BUSY and 'not queued' in second.error_msg
+    assert cell.get_parts().error_code == OK, 'get_parts answers while physics runs'
+    client.result(first.cancel_goal_async())
+    result = client.result(first.get_result_async(), 60.0).result
+    assert result.error_code == DropParts.Result.CANCELED
+    assert len(result.parts.parts) == 300
+
+
+@pytest.mark.parametrize(('args', 'text'), [
+    (['-p', 'instances:=0'], 'instances out of range. Min: 1, Max: 64'),
+    (['-p', 'part.model:=resistor'], "part.model: 'resistor' is not a part model"),
+    (['-p', 'container.inner_size:=[0.1, 0.0, 0.02]'], 'container.inner_size[1]: 0.0 must be'),
+    (['-p', 'part.model:=mesh', '-p', 'part.mesh_path:=/no/such.stl', '-p', 'part.mass:=0.001'],
+     "part.mesh_path: '/no/such.stl' does not exist"),
+    (['--params-file', '/no/such.yaml'], "Couldn't parse params file"),
+])
+def test_bad_parameters_stop_the_node_with_a_clear_message(private_ros_domain, args, text):
+    proc = NodeProcess('pick_sim_world', 'world', args)
+    proc.process.wait(60)
+    output = proc.output()
+    assert proc.process.returncode == 2, output
+    assert text in output and 'Traceback' not in output, output
+
+
+def test_parameter_file_configures_the_scene(private_ros_domain, client, start_node):
+    params = os.path.join(get_package_share_directory('pick_sim_world'), 'config', 'tray.yaml')
+    start_node('pick_sim_world', 'world', '-r', '__ns:=/cell_b', '--params-file', params)
+    scenes = []
+    client.node.create_subscription(Scene, '/cell_b/scene', scenes.append, LATCHED)
+    assert client.wait(lambda: scenes, 60.0), 'no latched scene from the parameter file node'
+    assert scenes[-1].part_model.name == 'to220'
+    assert scenes[-1].instances[0].container.type == ContainerGeometry.TYPE_TRAY
