@@ -28,7 +28,7 @@ class PhysicsConfig:
     """
 
     time_step: float = 1.0 / 240.0
-    solver_iterations: int = 10
+    solver_iterations: int = 30
     contact_breaking_threshold: float = 0.001
     settle_check_period: float = 0.05
     settle_window: float = 0.2

@@ -1,14 +1,13 @@
 """Part models: built-in geometry and user meshes, good and degenerate."""
 
 import numpy as np
+from pick_sim_world.config import SceneSpec
 from pick_sim_world.containers import ContainerSpec
 from pick_sim_world.errors import InvalidArgument, MeshError
 from pick_sim_world.parts import build_part, BUILTIN_MODELS, PartSpec
 from pick_sim_world.world import World
 import pytest
 import trimesh
-
-from pick_sim_world.config import SceneSpec
 
 
 @pytest.mark.parametrize('model', sorted(BUILTIN_MODELS))

@@ -3,15 +3,14 @@
 import math
 
 import numpy as np
+from pick_sim_world import containers
+from pick_sim_world.config import PhysicsConfig, SceneSpec, Vibration
 from pick_sim_world.containers import ContainerSpec
 from pick_sim_world.errors import InvalidArgument, PhysicsFault, UnknownInstance, UnknownPart
 from pick_sim_world.parts import BUILTIN_MODELS, PartSpec
 from pick_sim_world.world import quaternion_angles, World
 import pybullet as pb
 import pytest
-
-from pick_sim_world import containers
-from pick_sim_world.config import PhysicsConfig, SceneSpec, Vibration
 
 SMALL_BIN = ContainerSpec(inner_size=(0.12, 0.10, 0.03))
 
