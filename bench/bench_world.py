@@ -57,10 +57,10 @@ def row(label: str, runs: list[dict]) -> None:
           f'escaped {sum(r["escaped"] for r in runs)}')
 
 
-def bench_bin(seeds: list[int]) -> None:
+def bench_bin(seeds: list[int], iterations: int) -> None:
     print('\n== 480 radial capacitors into a 300 x 300 x 26 mm bin')
-    ours = [drop(BIN, 480, s, PhysicsConfig()) for s in seeds]
-    row('tuned (30 iterations, 1 mm threshold)', ours)
+    ours = [drop(BIN, 480, s, PhysicsConfig(solver_iterations=iterations)) for s in seeds]
+    row(f'tuned ({iterations} iterations, 1 mm threshold)', ours)
     cap = max(r['sim'] for r in ours)
     base = [drop(BIN, 480, s, PhysicsConfig(max_settle_time=cap, **BULLET_DEFAULTS))
             for s in seeds]
@@ -130,12 +130,14 @@ def bench_node(count: int, seed: int) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--seeds', type=int, default=3, help='drops per figure')
+    parser.add_argument('--iterations', type=int, default=PhysicsConfig().solver_iterations,
+                        help='solver iterations of the tuned bin drop')
     parser.add_argument('--skip-node', action='store_true')
     args = parser.parse_args()
     os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
     seeds = list(range(args.seeds))
     print(f'pinned to core {sorted(os.sched_getaffinity(0))}; numpy {np.__version__}')
-    bench_bin(seeds)
+    bench_bin(seeds, args.iterations)
     bench_tray(seeds)
     if not args.skip_node:
         bench_node(480, 0)
