@@ -13,6 +13,7 @@ from pick_msgs.srv import GetParts, ResetScene
 import pytest
 from rclpy.action import ActionClient
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from visualization_msgs.msg import Marker, MarkerArray
 
 pytestmark = pytest.mark.graph
 NS = '/cell_a'
@@ -106,6 +107,12 @@ def test_drop_50_parts_then_read_them_vibrate_and_remove(cell, client):
     assert all(p.inside and p.pose.header.frame_id == 'cell_a/instance_0'
                for p in parts.parts.parts)
     assert np.allclose(_poses(parts.parts), _poses(drop.parts))
+    markers = []
+    client.node.create_subscription(MarkerArray, f'{NS}/markers', markers.append, LATCHED)
+    assert client.wait(lambda: markers, 30.0), 'no latched markers'
+    kinds = [m.ns.split('_')[0] for m in markers[-1].markers[1:]]
+    assert markers[-1].markers[0].action == Marker.DELETEALL
+    assert kinds.count('container') == 5 and kinds.count('part') == 50 * 2  # body + leads
 
     vibrate = cell.run(Vibrate, Vibrate.Goal())   # zeros: the node's default vibration
     assert vibrate.error_code == OK, vibrate.error_msg
