@@ -1,0 +1,134 @@
+"""Frozen definitions of the gripper, the grasp poses, the placement and the check settings,
+and their validation in one place (shared by the node, the services and the tests).
+
+Units: metres and radians. Axes are in the part frame.
+"""
+
+from dataclasses import dataclass, field
+import math
+
+import numpy as np
+from pick_sim_world.errors import check_number, check_vector, InvalidArgument
+
+MAX_GRASPS = 32
+MAX_TILTS = 361
+PARALLEL_LIMIT = math.radians(5.0)   # closing and up axes closer than this are "parallel"
+
+
+@dataclass(frozen=True)
+class Gripper:
+    """The simplified parallel-jaw gripper (paper figure 8).
+
+    body_diameter D and body_length of the body cylinder; jaw_height V and jaw_depth W of the
+    jaws' workspace cuboid (its width U is the grasp's jaw opening). m.
+    """
+
+    body_diameter: float = 0.020
+    body_length: float = 0.060
+    jaw_height: float = 0.015
+    jaw_depth: float = 0.006
+
+
+@dataclass(frozen=True)
+class GraspPose:
+    """A user-defined grasp pose (paper figure 4), in the part frame.
+
+    up_axis must point along world +Z; closing_axis lies along the jaws' closing direction;
+    jaw_opening is U, m; grasp_point is where the jaw tips' centre goes, m.
+    """
+
+    name: str
+    up_axis: tuple[float, float, float]
+    closing_axis: tuple[float, float, float]
+    jaw_opening: float
+    grasp_point: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class PlaceSpec:
+    """How the part is placed: place_axis (part frame) points down into the placing surface;
+    the surface is the plane through seat_offset * place_axis, perpendicular to it, m (the
+    part's seating plane, e.g. the bottom of a capacitor's body)."""
+
+    place_axis: tuple[float, float, float] = (0.0, 0.0, -1.0)
+    seat_offset: float = 0.0055
+
+
+@dataclass(frozen=True)
+class CheckConfig:
+    """tolerance: largest angle between a grasp's up axis and world +Z, rad. The wrist tilts
+    about the closing axis from tilt_min to tilt_max in steps of tilt_step, rad."""
+
+    tolerance: float = math.radians(45.0)
+    tilt_min: float = math.radians(-45.0)
+    tilt_max: float = math.radians(45.0)
+    tilt_step: float = math.radians(5.0)
+
+
+@dataclass(frozen=True)
+class Grasp:
+    """A checked grasp pose: unit up axis, unit closing axis orthogonal to it."""
+
+    name: str
+    up: np.ndarray = field(repr=False)
+    closing: np.ndarray = field(repr=False)
+    jaw_opening: float
+    point: np.ndarray = field(repr=False)
+
+
+def _unit(field_name: str, values) -> np.ndarray:
+    v = np.array(check_vector(field_name, values, 3))
+    norm = float(np.linalg.norm(v))
+    if norm < 1e-9:
+        raise InvalidArgument(field_name, tuple(values), 'is a zero vector')
+    return v / norm
+
+
+def check_gripper(gripper: Gripper) -> Gripper:
+    check_number('gripper.body_diameter', gripper.body_diameter, low=0.0, high=1.0, low_open=True)
+    check_number('gripper.body_length', gripper.body_length, low=0.0, high=2.0, low_open=True)
+    check_number('gripper.jaw_height', gripper.jaw_height, low=0.0, high=1.0, low_open=True)
+    check_number('gripper.jaw_depth', gripper.jaw_depth, low=0.0, high=1.0, low_open=True)
+    return gripper
+
+
+def check_grasps(grasps: list[GraspPose] | tuple[GraspPose, ...]) -> tuple[Grasp, ...]:
+    """Check every grasp pose; orthogonalise the closing axis against the up axis."""
+    if not 1 <= len(grasps) <= MAX_GRASPS:
+        raise InvalidArgument('grasps', len(grasps), f'must hold 1..{MAX_GRASPS} grasp poses')
+    out = []
+    for i, g in enumerate(grasps):
+        up = _unit(f'grasps[{i}].up_axis', g.up_axis)
+        closing = _unit(f'grasps[{i}].closing_axis', g.closing_axis)
+        angle = math.acos(min(1.0, abs(float(up @ closing))))
+        if angle < PARALLEL_LIMIT:
+            raise InvalidArgument(f'grasps[{i}].closing_axis', g.closing_axis,
+                                  f'is parallel to up_axis {g.up_axis} (within '
+                                  f'{math.degrees(PARALLEL_LIMIT):g} deg)')
+        closing = closing - (closing @ up) * up
+        closing /= np.linalg.norm(closing)
+        opening = check_number(f'grasps[{i}].jaw_opening', g.jaw_opening, low=0.0, high=1.0,
+                               low_open=True)
+        point = np.array(check_vector(f'grasps[{i}].grasp_point', g.grasp_point, 3,
+                                      low=-1.0, high=1.0))
+        out.append(Grasp(g.name or f'grasp_{i}', up, closing, opening, point))
+    return tuple(out)
+
+
+def check_place(place: PlaceSpec) -> tuple[np.ndarray, float]:
+    axis = _unit('place.place_axis', place.place_axis)
+    return axis, check_number('place.seat_offset', place.seat_offset, low=-1.0, high=1.0)
+
+
+def tilts(cfg: CheckConfig) -> np.ndarray:
+    """The tilt angles to try, rad, from tilt_min to tilt_max inclusive."""
+    check_number('check.tolerance', cfg.tolerance, low=0.0, high=math.pi / 2, low_open=True)
+    low = check_number('check.tilt_min', cfg.tilt_min, low=-math.pi / 2, high=math.pi / 2)
+    high = check_number('check.tilt_max', cfg.tilt_max, low=low, high=math.pi / 2)
+    step = check_number('check.tilt_step', cfg.tilt_step, low=math.radians(0.1),
+                        high=math.pi)
+    count = int(math.floor((high - low) / step + 1e-9)) + 1
+    if count > MAX_TILTS:
+        raise InvalidArgument('check.tilt_step', step, f'gives {count} tilts from tilt_min to '
+                              f'tilt_max (limit {MAX_TILTS})')
+    return low + step * np.arange(count)

@@ -1,0 +1,160 @@
+"""Shapes for the checks: part primitives and the simplified gripper, their exact bounds, and
+their FCL collision objects.
+
+A `Shape` is a box, a cylinder (axis along its local z) or a convex hull, placed in a parent
+frame. Its FCL geometry is built once and shared; a query sets the object's transform.
+Rotations are (..., 3, 3) float64 arrays whose columns are the child axes; quaternions xyzw.
+"""
+
+from dataclasses import dataclass
+
+import fcl
+import numpy as np
+from pick_sim_world.parts import PartGeometry
+import trimesh
+
+from .config import Gripper
+
+BOX, CYLINDER, HULL = 'box', 'cylinder', 'hull'
+
+
+@dataclass(frozen=True, eq=False)
+class Shape:
+    """kind; half: box half extents (3,) or cylinder (radius, half length); vertices: hull
+    (M, 3) in the shape frame; rotation (3, 3) and center (3,) in the parent frame, m."""
+
+    kind: str
+    half: np.ndarray
+    vertices: np.ndarray | None
+    rotation: np.ndarray
+    center: np.ndarray
+    geometry: fcl.CollisionGeometry
+
+    def fcl_object(self) -> fcl.CollisionObject:
+        """A new collision object on the shared geometry (one per query site, reused)."""
+        return fcl.CollisionObject(self.geometry, fcl.Transform())
+
+
+def quaternions_to_matrices(q: np.ndarray) -> np.ndarray:
+    """(N, 4) xyzw unit quaternions to (N, 3, 3) rotation matrices."""
+    x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    m = np.empty((len(q), 3, 3))
+    m[:, 0, 0] = 1 - 2 * (y * y + z * z)
+    m[:, 0, 1] = 2 * (x * y - z * w)
+    m[:, 0, 2] = 2 * (x * z + y * w)
+    m[:, 1, 0] = 2 * (x * y + z * w)
+    m[:, 1, 1] = 1 - 2 * (x * x + z * z)
+    m[:, 1, 2] = 2 * (y * z - x * w)
+    m[:, 2, 0] = 2 * (x * z - y * w)
+    m[:, 2, 1] = 2 * (y * z + x * w)
+    m[:, 2, 2] = 1 - 2 * (x * x + y * y)
+    return m
+
+
+def matrix_to_quaternion(m: np.ndarray) -> np.ndarray:
+    """(3, 3) rotation matrix to an xyzw quaternion."""
+    wxyz = trimesh.transformations.quaternion_from_matrix(m)
+    return np.array([wxyz[1], wxyz[2], wxyz[3], wxyz[0]])
+
+
+def rotations_about_x(angles: np.ndarray) -> np.ndarray:
+    """(K,) angles, rad, to (K, 3, 3) rotations about x."""
+    c, s = np.cos(angles), np.sin(angles)
+    m = np.zeros((len(angles), 3, 3))
+    m[:, 0, 0] = 1.0
+    m[:, 1, 1], m[:, 1, 2] = c, -s
+    m[:, 2, 1], m[:, 2, 2] = s, c
+    return m
+
+
+def _convex(vertices: np.ndarray) -> tuple[np.ndarray, fcl.Convex]:
+    hull = trimesh.convex.convex_hull(vertices)
+    faces = np.hstack([np.full((len(hull.faces), 1), 3), hull.faces]).ravel()
+    return (np.asarray(hull.vertices, dtype=np.float64),
+            fcl.Convex(np.asarray(hull.vertices, dtype=np.float64), len(hull.faces), faces))
+
+
+def part_shapes(part: PartGeometry) -> tuple[Shape, ...]:
+    """The part's collision primitives as shapes in the part frame."""
+    shapes = []
+    for p in part.primitives:
+        rotation = quaternions_to_matrices(np.array([p.orientation]))[0]
+        center = np.array(p.position, dtype=np.float64)
+        if p.kind == 'box':
+            half = np.array(p.size, dtype=np.float64)
+            shapes.append(Shape(BOX, half, None, rotation, center, fcl.Box(*(2 * half))))
+        elif p.kind == 'cylinder':
+            radius, length = p.size
+            shapes.append(Shape(CYLINDER, np.array([radius, length / 2]), None, rotation, center,
+                                fcl.Cylinder(radius, length)))
+        else:
+            vertices, geometry = _convex(p.vertices)
+            shapes.append(Shape(HULL, np.zeros(3), vertices, rotation, center, geometry))
+    return tuple(shapes)
+
+
+def gripper_shapes(gripper: Gripper, opening: float) -> tuple[Shape, Shape]:
+    """The jaws' workspace cuboid (U x W x V, z from 0 to V) and the body cylinder (diameter D,
+    z from V to V + body_length), in the gripper frame: origin at the jaw tips' centre, x along
+    the closing direction, z up the gripper."""
+    v, length = gripper.jaw_height, gripper.body_length
+    jaws = Shape(BOX, np.array([opening / 2, gripper.jaw_depth / 2, v / 2]), None, np.eye(3),
+                 np.array([0.0, 0.0, v / 2]), fcl.Box(opening, gripper.jaw_depth, v))
+    body = Shape(CYLINDER, np.array([gripper.body_diameter / 2, length / 2]), None, np.eye(3),
+                 np.array([0.0, 0.0, v + length / 2]),
+                 fcl.Cylinder(gripper.body_diameter / 2, length))
+    return jaws, body
+
+
+def place(shape: Shape, rotation: np.ndarray, translation: np.ndarray) -> tuple[np.ndarray,
+                                                                               np.ndarray]:
+    """The shape's rotation (N, 3, 3) and center (N, 3) in a frame where its parent frame has
+    rotation (N, 3, 3) and translation (N, 3)."""
+    return rotation @ shape.rotation, translation + rotation @ shape.center
+
+
+def half_extents(shape: Shape, rotation: np.ndarray) -> np.ndarray:
+    """Exact half extents (N, 3) of the shape's axis-aligned bounds for rotations (N, 3, 3);
+    hulls return the offset of the bound's centre too, see `bounds`."""
+    if shape.kind == BOX:
+        return np.abs(rotation) @ shape.half
+    radius, half_length = shape.half[0], shape.half[1]
+    w = rotation[:, :, 2]
+    return np.abs(w) * half_length + radius * np.sqrt(np.clip(1.0 - w * w, 0.0, 1.0))
+
+
+def bounds(shape: Shape, rotation: np.ndarray, center: np.ndarray) -> tuple[np.ndarray,
+                                                                           np.ndarray]:
+    """Exact axis-aligned bounds (low (N, 3), high (N, 3)) of the shape at rotation and center
+    (its own pose, as from `place`)."""
+    if shape.kind == HULL:
+        points = np.einsum('nij,mj->nmi', rotation, shape.vertices) + center[:, None, :]
+        return points.min(axis=1), points.max(axis=1)
+    half = half_extents(shape, rotation)
+    return center - half, center + half
+
+
+def support(shape: Shape, rotation: np.ndarray, center: np.ndarray,
+            direction: np.ndarray) -> np.ndarray:
+    """max over the shape of direction . x, (N,), for unit direction (3,)."""
+    local = np.einsum('nji,j->ni', rotation, direction)   # direction in the shape frame
+    if shape.kind == HULL:
+        return (shape.vertices @ local.T).max(axis=0) + center @ direction
+    if shape.kind == BOX:
+        return center @ direction + np.abs(local) @ shape.half
+    radius, half_length = shape.half[0], shape.half[1]
+    along = local[:, 2]
+    return (center @ direction + np.abs(along) * half_length
+            + radius * np.sqrt(np.clip(1.0 - along * along, 0.0, 1.0)))
+
+
+def transform(rotation: np.ndarray, translation: np.ndarray) -> fcl.Transform:
+    return fcl.Transform(rotation, translation)
+
+
+_REQUEST = fcl.CollisionRequest()   # yes/no only: one contact, no contact details
+
+
+def collide(a: fcl.CollisionObject, b: fcl.CollisionObject) -> bool:
+    """One FCL narrowphase query: do the two objects, at their transforms, intersect?"""
+    return fcl.collide(a, b, _REQUEST, fcl.CollisionResult()) > 0
