@@ -65,6 +65,18 @@ class CheckConfig:
     tilt_step: float = math.radians(5.0)
 
 
+# The default grasp poses, for a radial capacitor (body along part +Z, leads along -Z) lying on
+# its side (a radial axis up: four poses cover every roll within 45 deg) or standing. Jaws 11 mm
+# wide: the 5 mm body + 2 x (1 mm clearance + 2 mm finger).
+CAPACITOR_GRASPS = (
+    GraspPose('side_px', (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), 0.011),
+    GraspPose('side_nx', (-1.0, 0.0, 0.0), (0.0, 1.0, 0.0), 0.011),
+    GraspPose('side_py', (0.0, 1.0, 0.0), (1.0, 0.0, 0.0), 0.011),
+    GraspPose('side_ny', (0.0, -1.0, 0.0), (1.0, 0.0, 0.0), 0.011),
+    GraspPose('upright', (0.0, 0.0, 1.0), (1.0, 0.0, 0.0), 0.011),
+)
+
+
 @dataclass(frozen=True)
 class Grasp:
     """A checked grasp pose: unit up axis, unit closing axis orthogonal to it."""
@@ -98,18 +110,20 @@ def check_grasps(grasps: list[GraspPose] | tuple[GraspPose, ...]) -> tuple[Grasp
         raise InvalidArgument('grasps', len(grasps), f'must hold 1..{MAX_GRASPS} grasp poses')
     out = []
     for i, g in enumerate(grasps):
-        up = _unit(f'grasps[{i}].up_axis', g.up_axis)
-        closing = _unit(f'grasps[{i}].closing_axis', g.closing_axis)
+        # Named as the node's parameters are (grasps.<name>.up_axis) when the grasp has a name.
+        where = f'grasps.{g.name}' if g.name else f'grasps[{i}]'
+        up = _unit(f'{where}.up_axis', g.up_axis)
+        closing = _unit(f'{where}.closing_axis', g.closing_axis)
         angle = math.acos(min(1.0, abs(float(up @ closing))))
         if angle < PARALLEL_LIMIT:
-            raise InvalidArgument(f'grasps[{i}].closing_axis', g.closing_axis,
+            raise InvalidArgument(f'{where}.closing_axis', g.closing_axis,
                                   f'is parallel to up_axis {g.up_axis} (within '
                                   f'{math.degrees(PARALLEL_LIMIT):g} deg)')
         closing = closing - (closing @ up) * up
         closing /= np.linalg.norm(closing)
-        opening = check_number(f'grasps[{i}].jaw_opening', g.jaw_opening, low=0.0, high=1.0,
+        opening = check_number(f'{where}.jaw_opening', g.jaw_opening, low=0.0, high=1.0,
                                low_open=True)
-        point = np.array(check_vector(f'grasps[{i}].grasp_point', g.grasp_point, 3,
+        point = np.array(check_vector(f'{where}.grasp_point', g.grasp_point, 3,
                                       low=-1.0, high=1.0))
         out.append(Grasp(g.name or f'grasp_{i}', up, closing, opening, point))
     return tuple(out)

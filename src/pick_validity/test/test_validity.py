@@ -196,14 +196,19 @@ def test_empty_duplicate_and_unknown_ids_are_refused():
 
 
 @pytest.mark.parametrize(('grasp', 'rule'), [
-    (GraspPose('z', (0, 0, 0), (1, 0, 0), 0.01), r'grasps\[0\].up_axis: .* is a zero vector'),
-    (GraspPose('p', (1, 0, 0), (1, 0.01, 0), 0.01), r'grasps\[0\].closing_axis: .* is parallel'),
-    (GraspPose('n', (1, 0, 0), (0, 1, 0), math.nan), r'grasps\[0\].jaw_opening: nan'),
-    (GraspPose('o', (1, 0, 0), (0, 1, 0), 0.0), r'grasps\[0\].jaw_opening: 0.0 must be > 0'),
+    (GraspPose('z', (0, 0, 0), (1, 0, 0), 0.01), r'grasps.z.up_axis: .* is a zero vector'),
+    (GraspPose('p', (1, 0, 0), (1, 0.01, 0), 0.01), r'grasps.p.closing_axis: .* is parallel'),
+    (GraspPose('n', (1, 0, 0), (0, 1, 0), math.nan), r'grasps.n.jaw_opening: nan'),
+    (GraspPose('o', (1, 0, 0), (0, 1, 0), 0.0), r'grasps.o.jaw_opening: 0.0 must be > 0'),
 ])
 def test_bad_grasps_are_refused(grasp, rule):
     with pytest.raises(InvalidArgument, match=rule):
         _validator(grasps=(grasp,))
+
+
+def test_an_unnamed_bad_grasp_is_named_by_its_index():
+    with pytest.raises(InvalidArgument, match=r'grasps\[1\].up_axis'):
+        _validator(grasps=(SIDE, GraspPose('', (0, 0, 0), (1, 0, 0), 0.01)))
 
 
 @pytest.mark.parametrize(('config', 'rule'), [
