@@ -17,7 +17,7 @@ PYTEST_ARGS ?=
 help:
 	@echo 'make run    - drop parts into a bin and onto a vibrating tray, print a summary'
 	@echo 'make test   - lint and run every test (installs and builds on first use)'
-	@echo 'make bench  - world benchmarks (480-part bin, 50-part tray, node vs core)'
+	@echo 'make bench  - world and validity benchmarks (figures in the READMEs)'
 	@echo 'make clean  - remove build/, install/, log/ (keeps the venv)'
 
 $(DEPS_STAMP): requirements.txt constraints.txt tools/fix_cmake_paths.py
@@ -47,6 +47,7 @@ test: $(BUILD_STAMP) lint
 
 bench: $(BUILD_STAMP)
 	$(WS) python bench/bench_world.py
+	$(WS) python bench/bench_validity.py
 
 lock: $(DEPS_STAMP)
 	$(VENV)/bin/python -m pip freeze --exclude-editable | sort > constraints.txt.new
