@@ -114,8 +114,8 @@ def place(shape: Shape, rotation: np.ndarray, translation: np.ndarray) -> tuple[
 
 
 def half_extents(shape: Shape, rotation: np.ndarray) -> np.ndarray:
-    """Exact half extents (N, 3) of the shape's axis-aligned bounds for rotations (N, 3, 3);
-    hulls return the offset of the bound's centre too, see `bounds`."""
+    """Exact half extents (N, 3) of a box's or cylinder's axis-aligned bounds about its center,
+    for rotations (N, 3, 3). Hulls: see `bounds`."""
     if shape.kind == BOX:
         return np.abs(rotation) @ shape.half
     radius, half_length = shape.half[0], shape.half[1]
@@ -146,10 +146,6 @@ def support(shape: Shape, rotation: np.ndarray, center: np.ndarray,
     along = local[:, 2]
     return (center @ direction + np.abs(along) * half_length
             + radius * np.sqrt(np.clip(1.0 - along * along, 0.0, 1.0)))
-
-
-def transform(rotation: np.ndarray, translation: np.ndarray) -> fcl.Transform:
-    return fcl.Transform(rotation, translation)
 
 
 _REQUEST = fcl.CollisionRequest()   # yes/no only: one contact, no contact details

@@ -37,6 +37,7 @@ from .config import (
     check_gripper,
     check_place,
     CheckConfig,
+    Grasp,
     GraspPose,
     Gripper,
     PlaceSpec,
@@ -172,17 +173,12 @@ class Validator:
         self.gripper_shapes = [gripper_shapes(self.gripper, g.jaw_opening) for g in self.grasps]
         self.frames = [self._frames(g) for g in self.grasps]
         self.placeable = [self._placeable(k) for k in range(len(self.grasps))]
-        # Radius about the grasp point that holds the gripper at every tilt.
-        self.reach = [max(np.linalg.norm(s.center) + _radius(s) for s in shapes)
-                      for shapes in self.gripper_shapes]
-        self._part_objects = [s.fcl_object() for s in self.part_shapes]
         self._gripper_objects = [[s.fcl_object() for s in shapes]
                                  for shapes in self.gripper_shapes]
 
-    def _frames(self, grasp) -> np.ndarray:
+    def _frames(self, grasp: Grasp) -> np.ndarray:
         """Gripper rotations in the part frame, (T, 3, 3), one per tilt."""
-        base = np.column_stack([grasp.closing, np.cross(grasp.up, grasp.closing), grasp.up])
-        return base @ rotations_about_x(self.tilts)
+        return grasp_basis(grasp) @ rotations_about_x(self.tilts)
 
     def _placeable(self, k: int) -> np.ndarray:
         """(T,) bool: the gripper stays on its side of the seating plane at each tilt."""
@@ -393,6 +389,12 @@ class _Pairs:
         return queries
 
 
+def grasp_basis(grasp: Grasp) -> np.ndarray:
+    """The gripper's rotation in the part frame at tilt 0: x along the closing axis, z along
+    the up axis, (3, 3)."""
+    return np.column_stack([grasp.closing, np.cross(grasp.up, grasp.closing), grasp.up])
+
+
 def _radius(shape: Shape) -> float:
     """Radius of a sphere about the shape's center that encloses it, m."""
     if shape.kind == 'hull':
@@ -433,8 +435,7 @@ def naive_check(validator: Validator, container: ContainerSpec, ids: Sequence[in
             continue
         shapes = gripper_shapes(v.gripper, v.grasps[g].jaw_opening)
         objects = [s.fcl_object() for s in shapes]
-        base = np.column_stack([v.grasps[g].closing, np.cross(v.grasps[g].up,
-                                                              v.grasps[g].closing), v.grasps[g].up])
+        base = grasp_basis(v.grasps[g])
         kept = []
         for k, tilt in enumerate(v.tilts):
             frame = base @ rotations_about_x(np.array([tilt]))[0]
