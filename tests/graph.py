@@ -53,6 +53,9 @@ class NodeProcess:
     def output(self) -> str:
         return self.process.stdout.read() if self.process.stdout else ''
 
+    def running(self) -> bool:
+        return self.process.poll() is None
+
 
 class Client:
     """A client node in its own context with a single-threaded executor."""
@@ -67,8 +70,17 @@ class Client:
     def spin_once(self) -> None:
         self.executor.spin_once(timeout_sec=0.05)
 
-    def wait(self, predicate: Callable[[], bool], timeout: float = 30.0) -> bool:
-        return wait_for(predicate, timeout, self.spin_once)
+    def wait(self, predicate: Callable[[], bool], timeout: float = 30.0,
+             nodes: tuple[NodeProcess, ...] = ()) -> bool:
+        """Spin until predicate() holds; fail at once, with its output, if a node process
+        in `nodes` has exited (instead of waiting out the timeout on a dead node)."""
+        def done() -> bool:
+            for proc in nodes:
+                if not proc.running():
+                    raise AssertionError(f'{proc.command[0]} exited with '
+                                         f'{proc.process.returncode}:\n{proc.output()}')
+            return predicate()
+        return wait_for(done, timeout, self.spin_once)
 
     def result(self, future, timeout: float = 60.0):
         assert self.wait(future.done, timeout), f'no answer within {timeout} s'

@@ -9,17 +9,15 @@ from pick_msgs.action import DropParts
 from pick_msgs.msg import Scene, ValidityReport
 from pick_msgs.srv import CheckParts, GetParts
 from pick_sim_world.conversions import container_from_msg, part_spec_from_msg, parts_to_arrays
+from pick_sim_world.node_runner import LATCHED
 from pick_sim_world.parts import build_part
 from pick_validity.config import CAPACITOR_GRASPS, CheckConfig, Gripper, PlaceSpec
 from pick_validity.validity import Validator
 import pytest
 from rclpy.action import ActionClient
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 pytestmark = pytest.mark.graph
 NS = '/cell_v'
-LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL,
-                     reliability=ReliabilityPolicy.RELIABLE)
 OK = CheckParts.Response.NONE
 
 
@@ -41,7 +39,7 @@ def settled(nodes):
     client = Client()
     try:
         drop = ActionClient(client.node, DropParts, f'{NS}/drop_parts')
-        assert client.wait(drop.server_is_ready, 60.0)
+        assert client.wait(drop.server_is_ready, 60.0, nodes)
         handle = client.result(drop.send_goal_async(DropParts.Goal(count=120)))
         result = client.result(handle.get_result_async(), 120.0).result
         assert result.error_code == 0, result.error_msg
@@ -61,18 +59,20 @@ def _request(scene, parts, **fields) -> CheckParts.Request:
                               parts=copy.deepcopy(list(parts)), **fields)
 
 
-def _call(client, request) -> CheckParts.Response:
+@pytest.fixture
+def check(client, nodes):
+    """Call check_parts: request -> response."""
     service = client.node.create_client(CheckParts, f'{NS}/check_parts')
-    assert client.wait(service.service_is_ready, 60.0), 'validity did not come up'
-    return client.result(service.call_async(request))
+    assert client.wait(service.service_is_ready, 60.0, nodes), 'validity did not come up'
+    return lambda request: client.result(service.call_async(request))
 
 
 @pytest.mark.parametrize('neighbours', [False, True])
-def test_service_agrees_with_the_core_on_a_settled_bin(client, settled, neighbours):
+def test_service_agrees_with_the_core_on_a_settled_bin(client, check, settled, neighbours):
     scene, parts = settled
     reports = []
     client.node.create_subscription(ValidityReport, f'{NS}/results', reports.append, LATCHED)
-    response = _call(client, _request(scene, parts, check_neighbours=neighbours))
+    response = check(_request(scene, parts, check_neighbours=neighbours))
     assert response.error_code == OK, response.error_msg
     ids, _, poses = parts_to_arrays(parts)
     core = Validator(build_part(part_spec_from_msg(scene.part_model)), Gripper(),
@@ -93,39 +93,39 @@ def test_service_agrees_with_the_core_on_a_settled_bin(client, settled, neighbou
                for r in valid)
 
 
-def test_targets_only_are_checked(client, settled):
+def test_targets_only_are_checked(check, settled):
     scene, parts = settled
-    response = _call(client, _request(scene, parts, target_ids=[parts[3].id, parts[7].id]))
+    response = check(_request(scene, parts, target_ids=[parts[3].id, parts[7].id]))
     assert response.error_code == OK
     assert [r.part_id for r in response.report.results] == [parts[3].id, parts[7].id]
 
 
-def test_bad_requests_get_an_error_and_it_keeps_serving(client, settled):
+def test_bad_requests_get_an_error_and_it_keeps_serving(check, settled):
     scene, parts = settled
     bad = _request(scene, parts)
     bad.parts[5].pose.pose.position.x = math.nan
-    answer = _call(client, bad)
+    answer = check(bad)
     assert answer.error_code == CheckParts.Response.INVALID_ARGUMENT
     assert f'parts[5] (id {parts[5].id}).pose' in answer.error_msg and 'finite' in answer.error_msg
 
     bad = _request(scene, parts)
     bad.parts[2].pose.pose.orientation.w += 0.5
-    answer = _call(client, bad)
+    answer = check(bad)
     assert answer.error_code == CheckParts.Response.INVALID_ARGUMENT
     assert 'must be a unit quaternion' in answer.error_msg
 
-    answer = _call(client, _request(scene, []))
+    answer = check(_request(scene, []))
     assert answer.error_code == CheckParts.Response.INVALID_ARGUMENT and 'empty' in answer.error_msg
 
-    answer = _call(client, _request(scene, parts, target_ids=[99999]))
+    answer = check(_request(scene, parts, target_ids=[99999]))
     assert answer.error_code == CheckParts.Response.UNKNOWN_PART
 
     unknown = _request(scene, parts)
     unknown.part_model.name = 'resistor'
-    answer = _call(client, unknown)
+    answer = check(unknown)
     assert answer.error_code == CheckParts.Response.UNKNOWN_PART and 'resistor' in answer.error_msg
 
-    answer = _call(client, _request(scene, parts))
+    answer = check(_request(scene, parts))
     assert answer.error_code == OK and answer.report.checked == 120
 
 

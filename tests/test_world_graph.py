@@ -10,15 +10,13 @@ import numpy as np
 from pick_msgs.action import DropParts, RemoveParts, Vibrate
 from pick_msgs.msg import ContainerGeometry, PartArray, Scene
 from pick_msgs.srv import GetParts, ResetScene
+from pick_sim_world.node_runner import LATCHED
 import pytest
 from rclpy.action import ActionClient
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from visualization_msgs.msg import Marker, MarkerArray
 
 pytestmark = pytest.mark.graph
 NS = '/cell_a'
-LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL,
-                     reliability=ReliabilityPolicy.RELIABLE)
 OK = GetParts.Response.NONE
 
 
@@ -35,7 +33,7 @@ def world(private_ros_domain):
 class Cell:
     """Typed access to the world's endpoints under NS."""
 
-    def __init__(self, client) -> None:
+    def __init__(self, client, world: NodeProcess) -> None:
         self.c = client
         node = client.node
         self.get_parts_srv = node.create_client(GetParts, f'{NS}/get_parts')
@@ -44,8 +42,8 @@ class Cell:
             (DropParts, 'drop_parts'), (Vibrate, 'vibrate'), (RemoveParts, 'remove_parts'))}
         assert client.wait(lambda: self.get_parts_srv.service_is_ready()
                            and self.reset_srv.service_is_ready()
-                           and all(a.server_is_ready() for a in self.actions.values()), 60.0), \
-            'the world node did not come up'
+                           and all(a.server_is_ready() for a in self.actions.values()), 60.0,
+                           (world,)), 'the world node did not come up'
 
     def call(self, client, request):
         return self.c.result(client.call_async(request))
@@ -69,7 +67,7 @@ class Cell:
 
 @pytest.fixture
 def cell(world, client):
-    cell = Cell(client)
+    cell = Cell(client, world)
     assert cell.reset(keep_scene=True, seed=5).error_code == OK
     return cell
 

@@ -10,7 +10,6 @@ never waits for physics.
 """
 
 from collections.abc import Callable
-import sys
 import threading
 import traceback
 
@@ -18,13 +17,10 @@ from pick_msgs.action import DropParts, RemoveParts, Vibrate
 from pick_msgs.msg import PartArray, Scene
 from pick_msgs.srv import GetParts, ResetScene
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
-import rclpy
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
-from rclpy.exceptions import ParameterException
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.qos_overriding_options import QoSOverridingOptions
 from visualization_msgs.msg import MarkerArray
 
@@ -32,11 +28,10 @@ from . import conversions as conv
 from .config import PhysicsConfig, SceneSpec, Vibration
 from .containers import BIN, ContainerSpec, TRAY
 from .errors import InvalidArgument, WorldError
+from .node_runner import LATCHED, run
 from .parts import BUILTIN_MODELS, PartSpec
 from .world import Progress, SettleReport, World
 
-LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL,
-                     reliability=ReliabilityPolicy.RELIABLE)
 ZONES = {DropParts.Goal.ZONE_CONTAINER: 'container', DropParts.Goal.ZONE_FEEDER: 'feeder'}
 
 
@@ -330,23 +325,4 @@ class WorldNode(Node):
 
 
 def main(args=None) -> None:
-    try:
-        rclpy.init(args=args)
-    except Exception as exc:  # rcl's RCLError (bad --ros-args, unreadable params file)
-        print(f'world: could not start: {exc}', file=sys.stderr)
-        sys.exit(2)
-    try:
-        node = WorldNode()
-    except (WorldError, ParameterException) as exc:
-        print(f'world: bad configuration: {exc}', file=sys.stderr)
-        rclpy.try_shutdown()
-        sys.exit(2)
-    executor = MultiThreadedExecutor(num_threads=3)
-    try:
-        rclpy.spin(node, executor=executor)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
-
+    run('world', WorldNode, lambda: MultiThreadedExecutor(num_threads=3), args)

@@ -6,27 +6,21 @@ grasp poses, the placement and the check settings are parameters.
 """
 
 import math
-import sys
 import traceback
 
 from pick_msgs.msg import PartModel, ValidityReport
 from pick_msgs.srv import CheckParts
 from pick_sim_world import conversions as world_conversions
 from pick_sim_world.errors import WorldError
+from pick_sim_world.node_runner import LATCHED, run
 from pick_sim_world.parts import build_part
 from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor
-import rclpy
-from rclpy.exceptions import ParameterException
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from . import conversions as conv
 from .config import CAPACITOR_GRASPS, CheckConfig, GraspPose, Gripper, PlaceSpec
 from .validity import Validator
 
-LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL,
-                     reliability=ReliabilityPolicy.RELIABLE)
 CACHE_SIZE = 8   # part models whose geometry and placeability are kept
 
 def _describe(text: str, low: float | None = None, high: float | None = None):
@@ -127,21 +121,4 @@ class ValidityNode(Node):
 
 
 def main(args=None) -> None:
-    try:
-        rclpy.init(args=args)
-    except Exception as exc:  # rcl's RCLError (bad --ros-args, unreadable params file)
-        print(f'validity: could not start: {exc}', file=sys.stderr)
-        sys.exit(2)
-    try:
-        node = ValidityNode()
-    except (WorldError, ParameterException) as exc:
-        print(f'validity: bad configuration: {exc}', file=sys.stderr)
-        rclpy.try_shutdown()
-        sys.exit(2)
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    run('validity', ValidityNode, args=args)

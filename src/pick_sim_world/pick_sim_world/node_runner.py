@@ -1,0 +1,43 @@
+"""What every node of the workspace shares: the latched QoS profile, and a main() that starts
+rclpy, turns a bad configuration into one line and exit code 2 (never a traceback), spins, and
+shuts down cleanly on Ctrl-C or SIGINT (the Jazzy way: ros2/demos `qos_overrides_talker.py`)."""
+
+from collections.abc import Callable
+import sys
+
+import rclpy
+from rclpy.exceptions import ParameterException
+from rclpy.executors import Executor, ExternalShutdownException
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
+from .errors import WorldError
+
+# Latched: a late subscriber gets the last message (scene, markers, last report).
+LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL,
+                     reliability=ReliabilityPolicy.RELIABLE)
+
+
+def run(name: str, make_node: Callable[[], Node],
+        make_executor: Callable[[], Executor] | None = None,
+        args: list[str] | None = None) -> None:
+    """Run one node until shutdown; exit 2 with a message when it cannot start. Executors
+    need an initialised context, so they are made here, after rclpy.init."""
+    try:
+        rclpy.init(args=args)
+    except Exception as exc:  # rcl's RCLError: bad --ros-args, unreadable params file
+        print(f'{name}: could not start: {exc}', file=sys.stderr)
+        sys.exit(2)
+    try:
+        node = make_node()
+    except (WorldError, ParameterException) as exc:
+        print(f'{name}: bad configuration: {exc}', file=sys.stderr)
+        rclpy.try_shutdown()
+        sys.exit(2)
+    try:
+        rclpy.spin(node, executor=make_executor() if make_executor else None)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
