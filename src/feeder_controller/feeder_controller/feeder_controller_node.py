@@ -1,0 +1,154 @@
+"""The `feeder_controller` node: applies the optimal-range policy and commands the world.
+
+Action `feed_cycle` (one policy step per goal); topic `feeder/state` (latched). It calls the
+world's `drop_parts` (feeder zone) and `vibrate` actions by relative names, so in a worker's
+namespace it commands that worker's world. One goal at a time: another is answered BUSY.
+"""
+
+import threading
+
+from pick_msgs.action import DropParts, FeedCycle, Vibrate
+from pick_msgs.msg import FeederState as FeederStateMsg
+from pick_sim_world import conversions as world_conversions
+from pick_sim_world.errors import WorldError
+from pick_sim_world.node_runner import LATCHED, run
+from rcl_interfaces.msg import IntegerRange, ParameterDescriptor
+from rclpy.action import ActionClient, ActionServer
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import MultiThreadedExecutor
+from rclpy.node import Node
+from std_msgs.msg import Header
+
+from .policy import (
+    FEED_AND_VIBRATE,
+    FeederConfig,
+    FeederPolicy,
+    NAMES,
+    PICK,
+    STOP_EMPTY,
+    STOP_VIBRATION_LIMIT,
+    VIBRATE,
+)
+
+STATES = {-1: FeederStateMsg.STATE_IDLE, PICK: FeederStateMsg.STATE_PICKING,
+          VIBRATE: FeederStateMsg.STATE_VIBRATING, FEED_AND_VIBRATE: FeederStateMsg.STATE_FEEDING,
+          STOP_EMPTY: FeederStateMsg.STATE_DONE_EMPTY,
+          STOP_VIBRATION_LIMIT: FeederStateMsg.STATE_DONE_VIBRATION_LIMIT}
+SERVER_WAIT = 5.0   # s to wait for the world's action server before answering an error
+
+
+class WorldCommandError(Exception):
+    """The world did not do what the policy asked; carries the error code to report."""
+
+    def __init__(self, code: int, message: str) -> None:
+        self.code = code
+        super().__init__(message)
+
+
+class FeederControllerNode(Node):
+    """Translates feed_cycle goals into policy steps and world actions."""
+
+    def __init__(self) -> None:
+        super().__init__('feeder_controller')
+        d = FeederConfig()
+
+        def get(name, default, text, high):
+            return self.declare_parameter(name, default, ParameterDescriptor(
+                description=text, read_only=True,
+                integer_range=[IntegerRange(from_value=1, to_value=high)])).value
+
+        self._defaults = FeederConfig(
+            feeder_parts=get('feeder.parts', d.feeder_parts, 'parts loaded per run', 100_000),
+            min_count=get('feeder.min_count', d.min_count, 'min* of the optimal range', 5000),
+            max_count=get('feeder.max_count', d.max_count, 'max* of the optimal range', 5000),
+            max_vibrations=get('feeder.max_vibrations', d.max_vibrations,
+                               'vibrations before a run stops', 1_000_000))
+        self._policy = FeederPolicy(self._defaults)
+        self._lock = threading.Lock()
+        group = ReentrantCallbackGroup()
+        self._state_pub = self.create_publisher(FeederStateMsg, 'feeder/state', LATCHED)
+        self._drop = ActionClient(self, DropParts, 'drop_parts', callback_group=group)
+        self._vibrate = ActionClient(self, Vibrate, 'vibrate', callback_group=group)
+        ActionServer(self, FeedCycle, 'feed_cycle', execute_callback=self._feed_cycle,
+                     callback_group=group)
+        self._publish_state()
+
+    def _state_msg(self) -> FeederStateMsg:
+        s, cfg = self._policy.state, self._policy.config
+        return FeederStateMsg(
+            header=Header(stamp=self.get_clock().now().to_msg()), state=STATES[s.last],
+            parts_in_feeder=s.in_feeder, parts_on_table=s.on_table, parts_picked=s.picked,
+            vibrations=s.vibrations, feeds=s.feeds, min_count=cfg.min_count,
+            max_count=cfg.max_count, max_vibrations=cfg.max_vibrations)
+
+    def _publish_state(self) -> None:
+        self._state_pub.publish(self._state_msg())
+
+    async def _world(self, client: ActionClient, goal, name: str):
+        """Send a goal to the world's action `name` and await its result. Raises
+        WorldCommandError with the world's own error code, or INTERNAL when it is not there."""
+        if not client.wait_for_server(timeout_sec=SERVER_WAIT):
+            raise WorldCommandError(FeedCycle.Result.INTERNAL, (
+                f'the world action {name!r} in namespace {self.get_namespace()!r} did not '
+                f'answer within {SERVER_WAIT:g} s: is the world node running there?'))
+        handle = await client.send_goal_async(goal)
+        if not handle.accepted:
+            raise WorldCommandError(FeedCycle.Result.INTERNAL, f'the world rejected {name}')
+        result = (await handle.get_result_async()).result
+        if result.error_code != world_conversions.ERROR_NONE:
+            raise WorldCommandError(result.error_code, f'world {name}: {result.error_msg}')
+        return result
+
+    async def _feed_cycle(self, goal_handle) -> FeedCycle.Result:
+        goal = goal_handle.request
+        result = FeedCycle.Result()
+        if not self._lock.acquire(blocking=False):
+            result.error_code = FeedCycle.Result.BUSY
+            result.error_msg = 'another feed_cycle is running; goals are not queued'
+            goal_handle.abort()
+            return result
+        try:
+            if goal.restart:
+                d = self._defaults
+                self._policy = FeederPolicy(FeederConfig(
+                    feeder_parts=goal.feeder_parts or d.feeder_parts,
+                    min_count=goal.min_count or d.min_count,
+                    max_count=goal.max_count or d.max_count,
+                    max_vibrations=goal.max_vibrations or d.max_vibrations))
+            step = self._policy.decide(goal.valid_parts, goal.parts_on_table)
+            result.decision = step.decision
+            if step.feed:
+                goal_handle.publish_feedback(FeedCycle.Feedback(
+                    state=self._state_msg(), phase=f'feeding {step.feed} parts'))
+                await self._world(self._drop, DropParts.Goal(
+                    instances=[goal.instance], count=step.feed,
+                    zone=DropParts.Goal.ZONE_FEEDER), 'drop_parts')
+                self._policy.fed(step.feed)
+                result.parts_fed = step.feed
+            if step.vibrates:
+                goal_handle.publish_feedback(FeedCycle.Feedback(
+                    state=self._state_msg(), phase='vibrating'))
+                await self._world(self._vibrate, Vibrate.Goal(instances=[goal.instance]),
+                                  'vibrate')
+                self._policy.vibrated()
+            goal_handle.succeed()
+            self.get_logger().debug(f'feed_cycle: {NAMES[step.decision]}')
+        except WorldError as exc:
+            result.error_code = world_conversions.error_code(exc)
+            result.error_msg = str(exc)
+            goal_handle.abort()
+        except WorldCommandError as exc:
+            result.error_code = exc.code
+            result.error_msg = str(exc)
+            self.get_logger().error(result.error_msg)
+            goal_handle.abort()
+        finally:
+            result.state = self._state_msg()
+            self._publish_state()
+            self._lock.release()
+        return result
+
+
+def main(args=None) -> None:
+    run('feeder_controller', FeederControllerNode, lambda: MultiThreadedExecutor(num_threads=3),
+        args)

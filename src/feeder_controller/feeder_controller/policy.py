@@ -1,0 +1,110 @@
+"""The optimal-range policy of the feeder and vibrating table (paper section 4.3.2).
+
+After each validity check of the table: if a part is valid, pick it; if none is and the count is
+within [min*, max*], vibrate; if the count is below min*, feed up to max* (or until the feeder is
+empty), then vibrate; stop when the feeder and the table are empty, or at the vibration limit.
+
+Deciding and applying are separate: `decide` changes nothing but the table count it is told;
+`fed` and `vibrated` record what the world actually did, so a failed world command leaves the
+state true.
+"""
+
+from dataclasses import dataclass
+
+from pick_sim_world.errors import check_int, InvalidArgument
+
+PICK, VIBRATE, FEED_AND_VIBRATE, STOP_EMPTY, STOP_VIBRATION_LIMIT = range(5)
+NAMES = ('pick', 'vibrate', 'feed and vibrate', 'stop: empty', 'stop: vibration limit')
+MAX_FEEDER_PARTS = 100_000
+MAX_TABLE_PARTS = 5000
+MAX_VIBRATIONS = 1_000_000
+
+
+@dataclass(frozen=True)
+class FeederConfig:
+    """feeder_parts: parts loaded into the feeder at the start of a run. min_count, max_count:
+    the optimal range [min*, max*] of parts on the table. max_vibrations: the limit."""
+
+    feeder_parts: int = 100
+    min_count: int = 20
+    max_count: int = 30
+    max_vibrations: int = 200
+
+
+def check_feeder(cfg: FeederConfig) -> FeederConfig:
+    """Check every field; raise InvalidArgument naming the first that is wrong."""
+    check_int('feeder_parts', cfg.feeder_parts, low=1, high=MAX_FEEDER_PARTS)
+    high = check_int('max_count', cfg.max_count, low=1, high=MAX_TABLE_PARTS)
+    check_int('min_count', cfg.min_count, low=1, high=high)
+    check_int('max_vibrations', cfg.max_vibrations, low=1, high=MAX_VIBRATIONS)
+    return cfg
+
+
+@dataclass
+class FeederState:
+    """Counts of a run. picked is derived: what left the feeder and is no longer on the table."""
+
+    loaded: int
+    in_feeder: int
+    on_table: int = 0
+    vibrations: int = 0
+    feeds: int = 0
+    last: int = -1          # the last decision, -1 before the first
+
+    @property
+    def picked(self) -> int:
+        return self.loaded - self.in_feeder - self.on_table
+
+
+@dataclass(frozen=True)
+class Step:
+    """A decision and how many parts to feed before vibrating (0 unless FEED_AND_VIBRATE)."""
+
+    decision: int
+    feed: int = 0
+
+    @property
+    def vibrates(self) -> bool:
+        return self.decision in (VIBRATE, FEED_AND_VIBRATE)
+
+
+class FeederPolicy:
+    """One run of the feeder: starts loaded with `feeder_parts`, the table empty."""
+
+    def __init__(self, config: FeederConfig) -> None:
+        self.config = check_feeder(config)
+        self.state = FeederState(loaded=config.feeder_parts, in_feeder=config.feeder_parts)
+
+    def decide(self, valid_parts: int, parts_on_table: int) -> Step:
+        """The next step, given the last check's valid parts and the parts on the table now.
+
+        Parts leave the table only by picks, so the count cannot exceed the last one.
+        """
+        s, cfg = self.state, self.config
+        on_table = check_int('parts_on_table', parts_on_table, low=0, high=s.on_table)
+        valid = check_int('valid_parts', valid_parts, low=0, high=on_table)
+        s.on_table = on_table
+        if s.in_feeder == 0 and on_table == 0:
+            step = Step(STOP_EMPTY)
+        elif valid > 0:
+            step = Step(PICK)
+        elif s.vibrations >= cfg.max_vibrations:
+            step = Step(STOP_VIBRATION_LIMIT)
+        elif on_table < cfg.min_count and s.in_feeder > 0:
+            step = Step(FEED_AND_VIBRATE, min(cfg.max_count - on_table, s.in_feeder))
+        else:
+            step = Step(VIBRATE)
+        s.last = step.decision
+        return step
+
+    def fed(self, count: int) -> None:
+        """Record that `count` parts went from the feeder onto the table."""
+        if not 0 < count <= self.state.in_feeder:
+            raise InvalidArgument('fed', count, f'must be within [1, {self.state.in_feeder}]')
+        self.state.in_feeder -= count
+        self.state.on_table += count
+        self.state.feeds += 1
+
+    def vibrated(self) -> None:
+        """Record one vibration of the table."""
+        self.state.vibrations += 1

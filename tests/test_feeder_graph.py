@@ -1,0 +1,91 @@
+"""The real `feeder_controller` commanding the real `world` (a tray) over DDS."""
+
+from graph import NodeProcess
+from pick_msgs.action import FeedCycle, RemoveParts
+from pick_msgs.msg import FeederState
+from pick_msgs.srv import GetParts
+from pick_sim_world.node_runner import LATCHED
+import pytest
+from rclpy.action import ActionClient
+
+pytestmark = pytest.mark.graph
+NS = '/cell_f'
+OK = FeedCycle.Result.NONE
+
+
+@pytest.fixture(scope='module')
+def nodes(private_ros_domain):
+    world = NodeProcess('pick_sim_world', 'world', [
+        '-r', f'__ns:={NS}', '-p', 'container.kind:=tray', '-p', 'publish_markers:=false'])
+    feeder = NodeProcess('feeder_controller', 'feeder_controller', ['-r', f'__ns:={NS}'])
+    yield world, feeder
+    for proc in (world, feeder):
+        assert proc.stop() == 0, proc.output()
+
+
+class Feeder:
+    def __init__(self, client, nodes) -> None:
+        self.c = client
+        self.cycle_client = ActionClient(client.node, FeedCycle, f'{NS}/feed_cycle')
+        self.remove_client = ActionClient(client.node, RemoveParts, f'{NS}/remove_parts')
+        self.parts_client = client.node.create_client(GetParts, f'{NS}/get_parts')
+        self.states = []
+        client.node.create_subscription(FeederState, f'{NS}/feeder/state', self.states.append,
+                                        LATCHED)
+        assert client.wait(lambda: self.cycle_client.server_is_ready()
+                           and self.remove_client.server_is_ready()
+                           and self.parts_client.service_is_ready(), 60.0, nodes)
+
+    def _run(self, client, goal):
+        handle = self.c.result(client.send_goal_async(goal))
+        return self.c.result(handle.get_result_async(), 120.0).result
+
+    def cycle(self, **fields) -> FeedCycle.Result:
+        return self._run(self.cycle_client, FeedCycle.Goal(**fields))
+
+    def parts(self) -> list[int]:
+        return [p.id for p in self.c.result(self.parts_client.call_async(
+            GetParts.Request())).parts.parts]
+
+    def pick(self, part_id: int) -> None:
+        assert self._run(self.remove_client, RemoveParts.Goal(part_ids=[part_id])).error_code == 0
+
+
+def test_a_run_feeds_vibrates_picks_and_stops_at_the_limit(client, nodes):
+    feeder = Feeder(client, nodes)
+    first = feeder.cycle(restart=True, feeder_parts=30, min_count=5, max_count=10,
+                         max_vibrations=3, valid_parts=0, parts_on_table=0)
+    assert first.error_code == OK, first.error_msg
+    assert first.decision == FeedCycle.Result.DECISION_FEED_AND_VIBRATE and first.parts_fed == 10
+    on_table = feeder.parts()
+    assert len(on_table) == 10, 'the world has the fed parts'
+    assert (first.state.parts_in_feeder, first.state.parts_on_table,
+            first.state.vibrations, first.state.feeds) == (20, 10, 1, 1)
+
+    pick = feeder.cycle(valid_parts=2, parts_on_table=10)
+    assert pick.decision == FeedCycle.Result.DECISION_PICK
+    feeder.pick(on_table[0])
+    vibrate = feeder.cycle(valid_parts=0, parts_on_table=9)
+    assert vibrate.decision == FeedCycle.Result.DECISION_VIBRATE
+    assert vibrate.state.parts_picked == 1 and vibrate.state.vibrations == 2
+    feeder.cycle(valid_parts=0, parts_on_table=9)
+    stop = feeder.cycle(valid_parts=0, parts_on_table=9)
+    assert stop.decision == FeedCycle.Result.DECISION_STOP_VIBRATION_LIMIT
+    assert stop.state.state == FeederState.STATE_DONE_VIBRATION_LIMIT
+    assert client.wait(lambda: feeder.states and feeder.states[-1].vibrations == 3, 30.0)
+
+
+def test_impossible_counts_and_bad_ranges_are_refused(client, nodes):
+    feeder = Feeder(client, nodes)
+    bad = feeder.cycle(restart=True, min_count=40, max_count=30)
+    assert bad.error_code == FeedCycle.Result.INVALID_ARGUMENT
+    assert 'min_count: 40 must be within [1, 30]' in bad.error_msg
+    good = feeder.cycle(restart=True, feeder_parts=5, min_count=2, max_count=3,
+                        parts_on_table=0)
+    assert good.error_code == OK and good.parts_fed == 3
+    more = feeder.cycle(valid_parts=0, parts_on_table=7)
+    assert more.error_code == FeedCycle.Result.INVALID_ARGUMENT
+    assert 'parts_on_table: 7 must be within [0, 3]' in more.error_msg
+    world_error = feeder.cycle(restart=True, parts_on_table=0, instance=5)
+    assert world_error.error_code == FeedCycle.Result.UNKNOWN_INSTANCE
+    assert 'world drop_parts: instances: 5 does not exist' in world_error.error_msg
