@@ -167,16 +167,18 @@ class WorldNode(Node):
         return scene, physics, vibration
 
     # ----------------------------------------------------------------------------- publish
-    def _publish(self, scene_changed: bool = False) -> None:
+    def _publish(self, scene_changed: bool = False) -> PartArray:
+        """Publish the current snapshot (and the scene when it changed); return the parts."""
         stamp = self.get_clock().now().to_msg()
         if scene_changed:
             self._scene_pub.publish(conv.scene_to_msg(self._world, stamp, self._frame_id,
                                                       self._prefix))
-        self._parts_pub.publish(conv.states_to_msg(self._states, stamp, self._frame_id,
-                                                   self._prefix))
+        parts = conv.states_to_msg(self._states, stamp, self._frame_id, self._prefix)
+        self._parts_pub.publish(parts)
         if self._publish_markers:
             self._markers_pub.publish(conv.markers_msg(self._world, self._states, stamp,
                                                        self._prefix))
+        return parts
 
     def _parts_msg(self, instances) -> PartArray:
         states = self._states if instances is None else self._states.select(instances)
@@ -259,8 +261,8 @@ class WorldNode(Node):
             report = settle[0]
             result.settle = conv.settle_to_msg(report)
             self._states = self._world.snapshot()
-            self._publish()
-            result.parts = self._parts_msg(instances)
+            published = self._publish()
+            result.parts = published if instances is None else self._parts_msg(instances)
             if report.canceled:
                 result.error_code = conv.ERROR_CANCELED
                 result.error_msg = 'canceled: parts are where they stopped'
