@@ -88,19 +88,20 @@ def bench_node(count: int, seed: int) -> None:
     """Same drop through the node (goal to result, over DDS) and in the core."""
     # The node-process and client helpers of the graph tests.
     sys.path.insert(0, os.path.join(os.path.dirname(__file__), '..', 'tests'))
-    from graph import Client, NodeProcess
+    from graph import Client, NodeProcess, unique_namespace
 
     print(f'\n== the world node against the pure core: {count} capacitors into the bin, '
           f'seed {seed}')
     os.environ.setdefault('ROS_DOMAIN_ID', str(150 + os.getpid() % 50))
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     core = drop(BIN, count, seed, PhysicsConfig())
+    ns = unique_namespace('bench')
     proc = NodeProcess('pick_sim_world', 'world', ['-p', f'seed:={seed}',
-                                                   '-r', '__ns:=/bench'])
+                                                   '-r', f'__ns:={ns}'])
     client = Client()
     try:
-        action = ActionClient(client.node, DropParts, '/bench/drop_parts')
-        reset = client.node.create_client(ResetScene, '/bench/reset_scene')
+        action = ActionClient(client.node, DropParts, f'{ns}/drop_parts')
+        reset = client.node.create_client(ResetScene, f'{ns}/reset_scene')
         assert client.wait(lambda: action.server_is_ready() and reset.service_is_ready(), 60)
         walls = {}
         for markers in (True, False):
@@ -109,8 +110,8 @@ def bench_node(count: int, seed: int) -> None:
                 # the same drop without the marker message, to show what it costs
                 proc.stop()
                 proc = NodeProcess('pick_sim_world', 'world', [
-                    '-p', f'seed:={seed}', '-p', 'publish_markers:=false', '-r', '__ns:=/bench'])
-                action = ActionClient(client.node, DropParts, '/bench/drop_parts')
+                    '-p', f'seed:={seed}', '-p', 'publish_markers:=false', '-r', f'__ns:={ns}'])
+                action = ActionClient(client.node, DropParts, f'{ns}/drop_parts')
                 assert client.wait(action.server_is_ready, 60)
             start = time.perf_counter()
             handle = client.result(action.send_goal_async(DropParts.Goal(count=count)))

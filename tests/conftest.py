@@ -10,7 +10,7 @@ import pytest
 @pytest.fixture(scope='session', autouse=True)
 def private_ros_domain() -> Iterator[int]:
     """A ROS domain of this test run only, on loopback: parallel runs do not see each other."""
-    domain = 10 + os.getpid() % 90
+    domain = int(os.environ.get('PICK_TEST_DOMAIN', 10 + os.getpid() % 90))
     saved = {k: os.environ.get(k) for k in ('ROS_DOMAIN_ID', 'ROS_AUTOMATIC_DISCOVERY_RANGE')}
     os.environ['ROS_DOMAIN_ID'] = str(domain)
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'

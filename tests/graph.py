@@ -27,6 +27,12 @@ def wait_for(predicate: Callable[[], bool], timeout: float, spin: Callable[[], N
     return predicate()
 
 
+def unique_namespace(base: str) -> str:
+    """A namespace of this process only: two test runs on one ROS domain (their domain ids can
+    collide) then never drive each other's nodes."""
+    return f'/{base}_{os.getpid()}'
+
+
 def executable(package: str, name: str) -> str:
     """The installed executable, where `ros2 run package name` finds it."""
     return os.path.join(get_package_prefix(package), 'lib', package, name)

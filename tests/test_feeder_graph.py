@@ -1,6 +1,6 @@
 """The real `feeder_controller` commanding the real `world` (a tray) over DDS."""
 
-from graph import NodeProcess
+from graph import NodeProcess, unique_namespace
 from pick_msgs.action import FeedCycle, RemoveParts
 from pick_msgs.msg import FeederState
 from pick_msgs.srv import GetParts
@@ -9,7 +9,7 @@ import pytest
 from rclpy.action import ActionClient
 
 pytestmark = pytest.mark.graph
-NS = '/cell_f'
+NS = unique_namespace('cell_f')
 OK = FeedCycle.Result.NONE
 
 

@@ -4,7 +4,7 @@ agrees part by part with the pure core; bad requests get an error and it keeps s
 import copy
 import math
 
-from graph import NodeProcess
+from graph import NodeProcess, unique_namespace
 from pick_msgs.action import DropParts
 from pick_msgs.msg import Scene, ValidityReport
 from pick_msgs.srv import CheckParts, GetParts
@@ -17,7 +17,7 @@ import pytest
 from rclpy.action import ActionClient
 
 pytestmark = pytest.mark.graph
-NS = '/cell_v'
+NS = unique_namespace('cell_v')
 OK = CheckParts.Response.NONE
 
 
@@ -85,7 +85,7 @@ def test_service_agrees_with_the_core_on_a_settled_bin(client, check, settled, n
     report = response.report
     assert report.checked == 120 and report.valid == core.counts['valid']
     assert report.candidates >= report.placeable >= report.container_free >= report.valid
-    assert report.header.frame_id == 'cell_v/instance_0'
+    assert report.header.frame_id == f'{NS[1:]}/instance_0'
     assert client.wait(lambda: reports and reports[-1].checked == 120, 30.0), 'no results'
     valid = [r for r in report.results if r.valid]
     assert valid, 'a settled bin has valid parts'

@@ -5,7 +5,7 @@ import os
 
 from ament_index_python.packages import get_package_share_directory
 from geometry_msgs.msg import Vector3
-from graph import NodeProcess
+from graph import NodeProcess, unique_namespace
 import numpy as np
 from pick_msgs.action import DropParts, RemoveParts, Vibrate
 from pick_msgs.msg import ContainerGeometry, PartArray, Scene
@@ -16,7 +16,8 @@ from rclpy.action import ActionClient
 from visualization_msgs.msg import Marker, MarkerArray
 
 pytestmark = pytest.mark.graph
-NS = '/cell_a'
+NS = unique_namespace('cell_a')
+FRAME = f'{NS[1:]}/instance_'   # instance k's frame is FRAME + str(k)
 OK = GetParts.Response.NONE
 
 
@@ -83,7 +84,7 @@ def test_scene_is_latched_and_describes_the_tray(cell, client):
     assert client.wait(lambda: scenes, 30.0), 'no latched scene'
     scene = scenes[-1]
     assert scene.header.frame_id == 'world'
-    assert [i.frame_id for i in scene.instances] == ['cell_a/instance_0']
+    assert [i.frame_id for i in scene.instances] == [FRAME + '0']
     container = scene.instances[0].container
     assert container.type == ContainerGeometry.TYPE_TRAY
     assert math.isclose(container.inner_size.x, 0.195) and math.isclose(
@@ -102,7 +103,7 @@ def test_drop_50_parts_then_read_them_vibrate_and_remove(cell, client):
     assert client.wait(lambda: any(len(m.parts) == 50 for m in published), 30.0)
     parts = cell.get_parts()
     assert parts.error_code == OK and len(parts.parts.parts) == 50
-    assert all(p.inside and p.pose.header.frame_id == 'cell_a/instance_0'
+    assert all(p.inside and p.pose.header.frame_id == FRAME + '0'
                for p in parts.parts.parts)
     assert np.allclose(_poses(parts.parts), _poses(drop.parts))
     markers = []
@@ -177,8 +178,8 @@ def test_reset_builds_a_new_scene_with_instances(cell, client):
     answer = cell.reset(**{k: getattr(request, k) for k in (
         'container', 'part_model', 'instance_count', 'seed')})
     assert answer.error_code == OK, answer.error_msg
-    assert [i.frame_id for i in answer.scene.instances] == ['cell_a/instance_0',
-                                                            'cell_a/instance_1']
+    assert [i.frame_id for i in answer.scene.instances] == [FRAME + '0',
+                                                            FRAME + '1']
     result = cell.run(DropParts, DropParts.Goal(count=10))
     assert result.error_code == OK and len(result.parts.parts) == 20
     assert len(cell.get_parts([1]).parts.parts) == 10
@@ -225,9 +226,10 @@ def test_bad_parameters_stop_the_node_with_a_clear_message(private_ros_domain, a
 
 def test_parameter_file_configures_the_scene(private_ros_domain, client, start_node):
     params = os.path.join(get_package_share_directory('pick_sim_world'), 'config', 'tray.yaml')
-    start_node('pick_sim_world', 'world', '-r', '__ns:=/cell_b', '--params-file', params)
+    namespace = unique_namespace('cell_b')
+    start_node('pick_sim_world', 'world', '-r', f'__ns:={namespace}', '--params-file', params)
     scenes = []
-    client.node.create_subscription(Scene, '/cell_b/scene', scenes.append, LATCHED)
+    client.node.create_subscription(Scene, f'{namespace}/scene', scenes.append, LATCHED)
     assert client.wait(lambda: scenes, 60.0), 'no latched scene from the parameter file node'
     assert scenes[-1].part_model.name == 'to220'
     assert scenes[-1].instances[0].container.type == ContainerGeometry.TYPE_TRAY
