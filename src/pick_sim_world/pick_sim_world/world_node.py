@@ -171,8 +171,9 @@ class WorldNode(Node):
         """Publish the current snapshot (and the scene when it changed); return the parts."""
         stamp = self.get_clock().now().to_msg()
         if scene_changed:
-            self._scene_pub.publish(conv.scene_to_msg(self._world, stamp, self._frame_id,
-                                                      self._prefix))
+            self._scene_msg = conv.scene_to_msg(self._world, stamp, self._frame_id,
+                                                self._prefix)
+            self._scene_pub.publish(self._scene_msg)
         parts = conv.states_to_msg(self._states, stamp, self._frame_id, self._prefix)
         self._parts_pub.publish(parts)
         if self._publish_markers:
@@ -213,8 +214,7 @@ class WorldNode(Node):
         if self._guarded(reset, response):
             self._states = self._world.snapshot()
             self._publish(scene_changed=True)
-            response.scene = conv.scene_to_msg(self._world, self.get_clock().now().to_msg(),
-                                               self._frame_id, self._prefix)
+            response.scene = self._scene_msg
         return response
 
     def _guarded(self, operation: Callable[[], object], response) -> bool:
