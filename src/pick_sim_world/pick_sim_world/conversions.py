@@ -14,7 +14,6 @@ from pick_msgs.msg import SettleReport as SettleReportMsg
 from pick_msgs.srv import GetParts
 from shape_msgs.msg import Mesh, MeshTriangle, SolidPrimitive
 from std_msgs.msg import ColorRGBA, Header
-import trimesh
 from visualization_msgs.msg import Marker, MarkerArray
 
 from . import containers
@@ -149,8 +148,7 @@ def part_model_to_msg(part: PartGeometry) -> PartModel:
                                                  dimensions=[length, radius]))
             msg.primitive_poses.append(_pose(p.position, p.orientation))
         else:
-            hull = trimesh.convex.convex_hull(p.vertices)
-            msg.hulls.append(_mesh_msg(hull.vertices, hull.faces))
+            msg.hulls.append(_mesh_msg(p.vertices, p.faces))
     msg.visual = _mesh_msg(part.visual.vertices, part.visual.faces)
     return msg
 
@@ -271,9 +269,8 @@ def markers_msg(world: World, states: PartStates, stamp: Time, prefix: str) -> M
                 m.type = Marker.TRIANGLE_LIST
                 m.scale = Vector3(x=1.0, y=1.0, z=1.0)
                 if k not in hulls:
-                    hull = trimesh.convex.convex_hull(p.vertices)
                     hulls[k] = [Point(x=float(x), y=float(y), z=float(z))
-                                for x, y, z in hull.vertices[hull.faces.reshape(-1)]]
+                                for x, y, z in p.vertices[p.faces.reshape(-1)]]
                 m.points = hulls[k]
             out.markers.append(m)
     return out

@@ -50,7 +50,8 @@ class Primitive:
     """One collision shape of a part, in the part frame.
 
     kind: 'box' (size = half extents x, y, z), 'cylinder' (size = radius, length; axis along
-    its local z) or 'hull' (vertices (K, 3) float64 in its local frame; size unused).
+    its local z) or 'hull' (vertices (K, 3) float64 and triangles faces (F, 3) int64 of the
+    convex hull, in its local frame, computed once; size unused).
     """
 
     kind: str
@@ -58,6 +59,7 @@ class Primitive:
     position: tuple[float, float, float] = (0.0, 0.0, 0.0)
     orientation: tuple[float, float, float, float] = IDENTITY
     vertices: np.ndarray | None = None
+    faces: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -134,7 +136,7 @@ def _primitive_mesh(p: Primitive) -> trimesh.Trimesh:
     elif p.kind == 'cylinder':
         mesh = trimesh.creation.cylinder(radius=p.size[0], height=p.size[1], sections=24)
     else:
-        mesh = trimesh.Trimesh(p.vertices, trimesh.convex.convex_hull(p.vertices).faces)
+        mesh = trimesh.Trimesh(p.vertices, p.faces, process=False)
     transform = trimesh.transformations.quaternion_matrix(
         [p.orientation[3], *p.orientation[:3]])
     transform[:3, 3] = p.position
@@ -305,8 +307,8 @@ def _mesh_part(spec: PartSpec) -> PartGeometry:
         if hull is None:
             raise MeshError('part.mesh_path', spec.mesh_path, 'has zero volume (flat or a line)')
         hulls = [hull]
-    collision = [Primitive('hull', (), vertices=np.asarray(h.vertices, dtype=np.float64))
-                 for h in hulls]
+    collision = [Primitive('hull', (), vertices=np.asarray(h.vertices, dtype=np.float64),
+                           faces=np.asarray(h.faces, dtype=np.int64)) for h in hulls]
     volume = mesh.volume if mesh.is_watertight else sum(h.volume for h in hulls)
     # Half the smallest extent of any hull: the CCD swept-sphere radius.
     thinnest = min(float(h.extents.min()) for h in hulls) / 2

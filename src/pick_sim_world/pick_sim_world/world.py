@@ -225,7 +225,7 @@ class World:
                 # pybullet takes convex hull vertices only from a file, one hull per file.
                 kind = pb.GEOM_MESH
                 path = os.path.join(self._tmp, f'hull_{i}.obj')
-                trimesh.convex.convex_hull(p.vertices).export(path)
+                trimesh.Trimesh(p.vertices, p.faces, process=False).export(path)
             kinds.append(kind)
             radii.append(radius)
             lengths.append(length)

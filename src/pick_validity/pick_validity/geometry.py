@@ -67,11 +67,10 @@ def rotations_about_x(angles: np.ndarray) -> np.ndarray:
     return m
 
 
-def _convex(vertices: np.ndarray) -> tuple[np.ndarray, fcl.Convex]:
-    hull = trimesh.convex.convex_hull(vertices)
-    faces = np.hstack([np.full((len(hull.faces), 1), 3), hull.faces]).ravel()
-    return (np.asarray(hull.vertices, dtype=np.float64),
-            fcl.Convex(np.asarray(hull.vertices, dtype=np.float64), len(hull.faces), faces))
+def _convex(vertices: np.ndarray, faces: np.ndarray) -> fcl.Convex:
+    """FCL's convex shape from a hull's vertices (M, 3) and triangles (F, 3)."""
+    polygons = np.hstack([np.full((len(faces), 1), 3), faces]).ravel()
+    return fcl.Convex(vertices, len(faces), polygons)
 
 
 def part_shapes(part: PartGeometry) -> tuple[Shape, ...]:
@@ -88,8 +87,8 @@ def part_shapes(part: PartGeometry) -> tuple[Shape, ...]:
             shapes.append(Shape(CYLINDER, np.array([radius, length / 2]), None, rotation, center,
                                 fcl.Cylinder(radius, length)))
         else:
-            vertices, geometry = _convex(p.vertices)
-            shapes.append(Shape(HULL, np.zeros(3), vertices, rotation, center, geometry))
+            shapes.append(Shape(HULL, np.zeros(3), p.vertices, rotation, center,
+                                _convex(p.vertices, p.faces)))
     return tuple(shapes)
 
 
