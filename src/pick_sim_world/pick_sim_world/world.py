@@ -47,7 +47,6 @@ SPAWN_GAP = 0.0005              # m of clearance between spawn spheres
 PACKING_LIMIT = 0.4             # largest fraction of a container's inner volume parts may fill
 TRAY_MASS = 3.0                 # kg; the tray is a dynamic body held by a driven constraint
 TRAY_MAX_FORCE = 5000.0         # N the constraint may apply to hold the tray on its trajectory
-MAX_PEAK_ACCELERATION = 200.0   # m/s^2 of tray motion, about 20 g
 
 ProgressCallback = Callable[['Progress'], bool]
 
@@ -434,11 +433,6 @@ class World:
         check_vibration(vibration)
         amplitude = np.array(vibration.amplitude, dtype=np.float64)
         omega = 2.0 * math.pi * vibration.frequency
-        peak = float(np.linalg.norm(amplitude)) * omega ** 2
-        if peak > MAX_PEAK_ACCELERATION:
-            raise InvalidArgument('vibration.amplitude', tuple(amplitude),
-                                  f'at {vibration.frequency:g} Hz gives a peak acceleration of '
-                                  f'{peak:.4g} m/s^2 (limit {MAX_PEAK_ACCELERATION:g})')
         for k in targets:
             if self._instances[k].constraint is None:
                 raise InvalidArgument('instances', k, f'is a {self._scene.container.kind}: '

@@ -33,6 +33,7 @@ from .parts import BUILTIN_MODELS, PartSpec
 from .world import Progress, SettleReport, World
 
 ZONES = {DropParts.Goal.ZONE_CONTAINER: 'container', DropParts.Goal.ZONE_FEEDER: 'feeder'}
+SHUTDOWN_WAIT = 10.0   # s a shutdown waits for a running physics operation
 
 
 def _describe(text: str, low: float | None = None, high: float | None = None,
@@ -322,8 +323,13 @@ class WorldNode(Node):
         return self._execute(RemoveParts, goal_handle, result, remove, None)
 
     def destroy_node(self) -> None:
-        self._world.close()
+        """Stop serving first, then close PyBullet once no operation holds it: a disconnect
+        under a running step is a native crash."""
         super().destroy_node()
+        locked = self._lock.acquire(timeout=SHUTDOWN_WAIT)
+        self._world.close()
+        if locked:
+            self._lock.release()
 
 
 def main(args=None) -> None:

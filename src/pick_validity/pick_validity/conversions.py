@@ -1,17 +1,33 @@
 """The one place that maps check_parts requests and ValidityReport messages to and from the
 validity core. Container, part-model and part conversions are pick_sim_world's, reused."""
 
+from dataclasses import dataclass
+
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Point, Pose, Quaternion, Vector3
+import numpy as np
+from pick_msgs.msg import CheckSettings, PartValidity, ValidityReport
 from pick_msgs.msg import GraspPose as GraspPoseMsg
-from pick_msgs.msg import PartValidity, ValidityReport
+from pick_msgs.msg import Gripper as GripperMsg
+from pick_msgs.msg import PlaceSpec as PlaceSpecMsg
 from pick_msgs.srv import CheckParts
 from pick_sim_world import conversions as world_conversions
 from pick_sim_world.containers import ContainerSpec
 from pick_sim_world.parts import PartSpec
 from std_msgs.msg import Header
 
-from .validity import Report, Validator
+from .config import CheckConfig, GraspPose, Gripper, PlaceSpec
+from .validity import PartResult, Report, Validator
+
+
+@dataclass(frozen=True)
+class Setup:
+    """The gripper, grasp poses, placement and settings a check runs with."""
+
+    gripper: Gripper
+    grasps: tuple[GraspPose, ...]
+    place: PlaceSpec
+    config: CheckConfig
 
 
 def request_to_core(request: CheckParts.Request) -> tuple[ContainerSpec, PartSpec, list[int],
@@ -22,6 +38,54 @@ def request_to_core(request: CheckParts.Request) -> tuple[ContainerSpec, PartSpe
     return (world_conversions.container_from_msg(request.container),
             world_conversions.part_spec_from_msg(request.part_model), ids.tolist(), poses,
             targets)
+
+
+def _xyz(v) -> tuple[float, float, float]:
+    return float(v.x), float(v.y), float(v.z)
+
+
+def setup_from_request(request: CheckParts.Request, defaults: Setup) -> Setup:
+    """The request's gripper, grasps, placement and settings; each left empty (all 0 or an
+    empty list) takes the node's default. Checked by the core."""
+    g = request.gripper
+    gripper = defaults.gripper
+    if any((g.body_diameter, g.body_length, g.jaw_height, g.jaw_depth)):
+        gripper = Gripper(g.body_diameter, g.body_length, g.jaw_height, g.jaw_depth)
+    grasps = tuple(GraspPose(m.name, _xyz(m.up_axis), _xyz(m.closing_axis), m.jaw_opening,
+                             _xyz(m.grasp_point)) for m in request.grasps) or defaults.grasps
+    place = defaults.place
+    if any(_xyz(request.place.place_axis)):
+        place = PlaceSpec(_xyz(request.place.place_axis), request.place.seat_offset)
+    s = request.settings
+    config = defaults.config
+    if s.tilt_step != 0.0:
+        config = CheckConfig(s.tolerance, s.tilt_min, s.tilt_max, s.tilt_step)
+    return Setup(gripper, grasps, place, config)
+
+
+def setup_to_request(setup: Setup, request: CheckParts.Request) -> CheckParts.Request:
+    """Fill a request's gripper, grasps, placement and settings from a Setup."""
+    g, p, c = setup.gripper, setup.place, setup.config
+    request.gripper = GripperMsg(body_diameter=g.body_diameter, body_length=g.body_length,
+                                 jaw_height=g.jaw_height, jaw_depth=g.jaw_depth)
+    request.grasps = [_grasp_msg(x.name, x.up_axis, x.closing_axis, x.jaw_opening,
+                                 x.grasp_point) for x in setup.grasps]
+    request.place = PlaceSpecMsg(place_axis=Vector3(x=p.place_axis[0], y=p.place_axis[1],
+                                                    z=p.place_axis[2]),
+                                 seat_offset=p.seat_offset)
+    request.settings = CheckSettings(tolerance=c.tolerance, tilt_min=c.tilt_min,
+                                     tilt_max=c.tilt_max, tilt_step=c.tilt_step)
+    return request
+
+
+def _grasp_msg(name, up, closing, opening, point) -> GraspPoseMsg:
+    return GraspPoseMsg(name=name, up_axis=Vector3(x=float(up[0]), y=float(up[1]),
+                                                   z=float(up[2])),
+                        closing_axis=Vector3(x=float(closing[0]), y=float(closing[1]),
+                                             z=float(closing[2])),
+                        jaw_opening=float(opening),
+                        grasp_point=Point(x=float(point[0]), y=float(point[1]),
+                                          z=float(point[2])))
 
 
 def geometry_key(spec: PartSpec) -> tuple:
@@ -51,12 +115,22 @@ def report_to_msg(report: Report, validator: Validator, stamp: Time, frame_id: s
                             jaw_opening=float(r.jaw_opening), valid_tilts=list(r.valid_tilts))
         if r.grasp_index >= 0:
             g = validator.grasps[r.grasp_index]
-            item.grasp = GraspPoseMsg(
-                name=g.name, up_axis=Vector3(x=g.up[0], y=g.up[1], z=g.up[2]),
-                closing_axis=Vector3(x=g.closing[0], y=g.closing[1], z=g.closing[2]),
-                jaw_opening=g.jaw_opening, grasp_point=Point(x=g.point[0], y=g.point[1],
-                                                             z=g.point[2]))
+            item.grasp = _grasp_msg(g.name, g.up, g.closing, g.jaw_opening, g.point)
         if r.gripper_pose is not None:
             item.gripper_pose = _pose(r.gripper_pose)
         msg.results.append(item)
     return msg
+
+
+def report_from_msg(msg: ValidityReport) -> Report:
+    """A core Report from a ValidityReport (counts recomputed from the stages)."""
+    results = []
+    for r in msg.results:
+        pose = None
+        if r.valid:
+            p, q = r.gripper_pose.position, r.gripper_pose.orientation
+            pose = np.array([p.x, p.y, p.z, q.x, q.y, q.z, q.w])
+        results.append(PartResult(r.part_id, r.stage_reached, r.reason, r.grasp_index,
+                                  r.candidacy_angle, pose, r.jaw_opening,
+                                  tuple(r.valid_tilts)))
+    return Report(results, msg.neighbour_check, wall_time=msg.wall_time)

@@ -35,15 +35,16 @@ class ValidityNode(Node):
 
     def __init__(self) -> None:
         super().__init__('validity')
-        self._gripper, self._grasps, self._place, self._config = self._declare_parameters()
+        self._defaults = conv.Setup(*self._declare_parameters())
         self._cache: dict[tuple, Validator] = {}
         # Fail at start, not at the first request, on a bad gripper, grasp or setting.
         self._validator_for(world_conversions.part_spec_from_msg(
-            PartModel(name='radial_capacitor')))
+            PartModel(name='radial_capacitor')), self._defaults)
         self._results = self.create_publisher(ValidityReport, 'results', LATCHED)
         self.create_service(CheckParts, 'check_parts', self._check_parts)
-        self.get_logger().info(f'{len(self._grasps)} grasp pose(s): '
-                               f'{", ".join(g.name for g in self._grasps)}')
+        grasps = self._defaults.grasps
+        self.get_logger().info(f'{len(grasps)} grasp pose(s): '
+                               f'{", ".join(g.name for g in grasps)}')
 
     def _declare_parameters(self):
         def get(name, default, text, low=None, high=None):
@@ -84,14 +85,16 @@ class ValidityNode(Node):
             tilt_min=get('check.tilt_min', c.tilt_min, 'rad', -math.pi / 2, math.pi / 2),
             tilt_max=get('check.tilt_max', c.tilt_max, 'rad', -math.pi / 2, math.pi / 2),
             tilt_step=get('check.tilt_step', c.tilt_step, 'rad', 1e-3, math.pi))
-        return gripper, grasps, place, config
+        return gripper, tuple(grasps), place, config
 
-    def _validator_for(self, spec) -> Validator:
-        key = conv.geometry_key(spec)
+    def _validator_for(self, spec, setup: conv.Setup) -> Validator:
+        """The validator of a part model and setup, built once (placeability tables are the
+        costly part) and kept for the next CACHE_SIZE different ones."""
+        key = (conv.geometry_key(spec), setup)
         validator = self._cache.get(key)
         if validator is None:
-            validator = Validator(build_part(spec), self._gripper, self._grasps, self._place,
-                                  self._config)
+            validator = Validator(build_part(spec), setup.gripper, setup.grasps, setup.place,
+                                  setup.config)
             if len(self._cache) >= CACHE_SIZE:
                 self._cache.pop(next(iter(self._cache)))
             self._cache[key] = validator
@@ -101,7 +104,8 @@ class ValidityNode(Node):
                      response: CheckParts.Response) -> CheckParts.Response:
         try:
             container, spec, ids, poses, targets = conv.request_to_core(request)
-            validator = self._validator_for(spec)
+            validator = self._validator_for(
+                spec, conv.setup_from_request(request, self._defaults))
             report = validator.check(container, ids, poses, targets, request.check_neighbours)
         except WorldError as exc:
             response.error_code = world_conversions.error_code(exc)

@@ -1,0 +1,219 @@
+"""`run`: bring up the graph on this machine and run an experiment file through it.
+
+    run [EXPERIMENT_FILE] [--output DIR | --resume RUN_DIR] [--namespace NS]
+
+Starts `world`, `validity` and `feeder_controller` under <NS>/worker_0 and `experiment_manager`
+under <NS> as separate processes (DDS between them, as on a cell), sends `run_experiment`, shows
+a progress bar, and prints where the results and the recording are. Without a file it runs the
+built-in default (`share/experiment_manager/config/default_experiment.yaml`).
+
+Exit codes: 0 done; 1 the run failed (the message says why; finished iterations are kept);
+2 bad input (the experiment file, an option); 130 interrupted (Ctrl-C: the run is canceled and
+its files closed).
+"""
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+import time
+
+from ament_index_python.packages import get_package_share_directory
+from pick_msgs.action import RunExperiment
+from pick_sim_world.errors import InvalidArgument
+import rclpy
+from rclpy.action import ActionClient
+from rclpy.node import Node
+
+from . import config
+from .launcher import MANAGER, NodeProcess, WORKER_NODES
+
+WORKER = 'worker_0'
+START_TIMEOUT = 60.0    # s for the manager's action server to appear
+STOP_TIMEOUT = 30.0     # s for a canceled run to close its files
+
+
+def default_file() -> str:
+    return os.path.join(get_package_share_directory('experiment_manager'), 'config',
+                        'default_experiment.yaml')
+
+
+class ProgressBar:
+    """One line on a terminal, redrawn; a line per 5 % (and per experiment) otherwise."""
+
+    def __init__(self, stream=sys.stderr, width: int = 30) -> None:
+        self.stream, self.width = stream, width
+        self.tty = stream.isatty()
+        self._last = (None, -1)
+
+    @staticmethod
+    def _clock(seconds: float) -> str:
+        s = int(seconds)
+        return f'{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}'
+
+    def update(self, p) -> None:
+        fraction = p.iterations_done / p.iterations_total if p.iterations_total else 0.0
+        filled = int(fraction * self.width)
+        eta = self._clock(p.eta) if p.eta else '?'
+        line = (f'[{"#" * filled}{"." * (self.width - filled)}] {p.iterations_done}/'
+                f'{p.iterations_total}  {self._clock(p.elapsed)} elapsed, eta {eta}  {p.phase}')
+        if self.tty:
+            self.stream.write('\r' + line[:150].ljust(150))
+        else:
+            key = (p.experiment_id, int(fraction * 20))
+            if key == self._last:
+                return
+            self._last = key
+            self.stream.write(line + '\n')
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.tty:
+            self.stream.write('\n')
+            self.stream.flush()
+
+
+def _parse(argv: list[str]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(prog='run', description=__doc__.split('\n\n')[0])
+    parser.add_argument('experiment_file', nargs='?', default=None,
+                        help='the experiment YAML file (default: the built-in one)')
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument('--output', help="directory for the run's directory (default: the "
+                       "file's output_dir)")
+    where.add_argument('--resume', metavar='RUN_DIR',
+                       help='finish the interrupted run in RUN_DIR (same experiment file)')
+    parser.add_argument('--namespace', default='/',
+                        help='namespace of the graph (default /): the worker runs in '
+                        f'<namespace>/{WORKER}')
+    parser.add_argument('--logs', help="directory for the nodes' logs (default: a temporary "
+                        'directory, printed)')
+    return parser.parse_args(argv)
+
+
+def _start_graph(namespace: str, log_dir: str) -> list[NodeProcess]:
+    ns = '/' + namespace.strip('/') if namespace.strip('/') else ''
+    worker_ns = f'{ns}/{WORKER}'
+    procs = [NodeProcess(pkg, exe, ['-r', f'__ns:={worker_ns}'],
+                         os.path.join(log_dir, f'{exe}.log')) for pkg, exe in WORKER_NODES]
+    pkg, exe = MANAGER
+    procs.append(NodeProcess(pkg, exe, ['-r', f'__ns:={ns or "/"}', '-p', f'worker:={WORKER}'],
+                             os.path.join(log_dir, f'{exe}.log')))
+    return procs
+
+
+def _dead(procs: list[NodeProcess]) -> NodeProcess | None:
+    return next((p for p in procs if not p.running()), None)
+
+
+def _summary_lines(summary: dict) -> list[str]:
+    lines = []
+    for exp_id, s in summary.get('experiments', {}).items():
+        kind = s['type']
+        if kind == 'bin_static':
+            lines.append(f'  {exp_id} (bin_static): best bin {s["best_bin_mm"]} mm')
+        elif kind == 'bin_emptying':
+            r = s['removed']
+            lines.append(f'  {exp_id} (bin_emptying): {s["emptied"]}/{s["iterations"]} bins '
+                         f'emptied, parts removed mean {r["mean"]:.3g} (min {r["min"]:g}, '
+                         f'max {r["max"]:g})')
+        elif kind == 'table_sweep':
+            lines.append(f'  {exp_id} (table_sweep): optimum {s.get("n_star")} parts, range '
+                         f'{s.get("optimal_range")}')
+        else:
+            v = s['vibrations_to_empty']['mean']
+            lines.append(f'  {exp_id} (feeder_emptying): {s["emptied"]}/{s["iterations"]} '
+                         'runs emptied' + (f', {v:.4g} vibrations to empty on average'
+                                           if v is not None else ''))
+    return lines
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parse(sys.argv[1:] if argv is None else argv)
+    path = os.path.abspath(args.experiment_file or default_file())
+    try:
+        file = config.load(path)     # fail here, before any process starts
+    except InvalidArgument as exc:
+        print(f'run: {path}: {exc}', file=sys.stderr)
+        return 2
+    output = args.output or file.output_dir
+    goal = RunExperiment.Goal(experiment_file=path, resume=bool(args.resume),
+                              output_dir=os.path.abspath(args.resume or output))
+    log_dir = args.logs or tempfile.mkdtemp(prefix='pick_run_logs_')
+    os.makedirs(log_dir, exist_ok=True)
+    print(f'run: {file.id}: {len(file.experiments)} experiment(s); node logs in {log_dir}',
+          file=sys.stderr)
+    try:
+        procs = _start_graph(args.namespace, log_dir)
+    except FileNotFoundError as exc:
+        print(f'run: {exc}', file=sys.stderr)
+        return 2
+    rclpy.init(args=['--ros-args', '-r', f'__ns:={args.namespace}'])
+    node = Node('experiment_cli')
+    client = ActionClient(node, RunExperiment, 'run_experiment')
+    bar = ProgressBar()
+    try:
+        return _run(node, client, goal, procs, bar)
+    except KeyboardInterrupt:
+        print('\nrun: interrupted; the run was canceled', file=sys.stderr)
+        return 130
+    finally:
+        bar.close()
+        client.destroy()
+        node.destroy_node()
+        rclpy.try_shutdown()
+        for p in procs:
+            p.stop()
+
+
+def _spin_until(node: Node, done, procs: list[NodeProcess], timeout: float) -> NodeProcess | None:
+    """Spin until done() or timeout; returns a process that died meanwhile, if any."""
+    deadline = time.monotonic() + timeout
+    while not done() and time.monotonic() < deadline:
+        rclpy.spin_once(node, timeout_sec=0.1)
+        dead = _dead(procs)
+        if dead is not None:
+            return dead
+    return None
+
+
+def _run(node: Node, client: ActionClient, goal, procs: list[NodeProcess], bar) -> int:
+    dead = _spin_until(node, client.server_is_ready, procs, START_TIMEOUT)
+    if dead is not None or not client.server_is_ready():
+        why = dead.describe_exit() + '\n' + dead.output(20) if dead else (
+            f'run_experiment did not appear within {START_TIMEOUT:g} s')
+        print(f'run: the graph did not start: {why}', file=sys.stderr)
+        return 1
+    send = client.send_goal_async(goal, feedback_callback=lambda f: bar.update(f.feedback.progress))
+    _spin_until(node, send.done, procs, START_TIMEOUT)
+    handle = send.result()
+    if handle is None or not handle.accepted:
+        print('run: the experiment manager did not accept the goal', file=sys.stderr)
+        return 1
+    result_future = handle.get_result_async()
+    try:
+        dead = _spin_until(node, result_future.done, procs, float('inf'))
+    except KeyboardInterrupt:
+        handle.cancel_goal_async()
+        _spin_until(node, result_future.done, procs, STOP_TIMEOUT)
+        raise
+    if dead is not None:
+        bar.close()
+        print(f'run: {dead.describe_exit()} during the run:\n{dead.output(20)}', file=sys.stderr)
+        if dead.name != 'experiment_manager':
+            handle.cancel_goal_async()
+            _spin_until(node, result_future.done, procs[-1:], STOP_TIMEOUT)
+        if result_future.done():
+            r = result_future.result().result
+            print(f'run: finished iterations are kept in {r.results_path}', file=sys.stderr)
+        return 1
+    result = result_future.result().result
+    bar.close()
+    if result.error_code:
+        print(f'run: failed: {result.error_msg}', file=sys.stderr)
+        return 2 if result.error_code == RunExperiment.Result.INVALID_ARGUMENT else 1
+    print(f'results:   {result.results_path}')
+    print(f'recording: {result.recording_path}')
+    print(f'summary:   {os.path.join(result.results_path, "summary.json")}')
+    print('\n'.join(_summary_lines(json.loads(result.summary_json))))
+    return 0

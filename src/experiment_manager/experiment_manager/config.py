@@ -1,0 +1,459 @@
+"""The experiment file: its schema, read and checked in one place before anything runs.
+
+A YAML file describes the part, the gripper, the containers, the requirements and a list of
+experiments. Lengths are in mm and angles in degrees only where the key says so (`size_mm`,
+`tolerance_deg`); everything is converted to SI here. Unknown keys are errors. Every error is an
+`InvalidArgument` naming the field by its path in the file (`experiments[1].bins_mm[0][2]`), the
+value and the rule. The annotated example is `config/default_experiment.yaml`.
+"""
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+import math
+import os
+from typing import Any
+
+from feeder_controller.policy import check_feeder, FeederConfig
+from pick_sim_world.config import (
+    check_vibration,
+    MAX_PARTS_PER_INSTANCE,
+    MAX_SEED,
+    Vibration,
+)
+from pick_sim_world.containers import (
+    check_container,
+    ContainerSpec,
+    TRAY_DEFAULT_SIZE,
+)
+from pick_sim_world.errors import check_int, check_number, InvalidArgument
+from pick_sim_world.parts import build_part, PartGeometry, PartSpec
+from pick_sim_world.world import PACKING_LIMIT
+from pick_validity.config import (
+    CAPACITOR_GRASPS,
+    check_grasps,
+    check_gripper,
+    check_place,
+    CheckConfig,
+    GraspPose,
+    Gripper,
+    PlaceSpec,
+    tilts,
+)
+import yaml
+
+BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING = (
+    'bin_static', 'bin_emptying', 'table_sweep', 'feeder_emptying')
+TYPES = (BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING)
+SEARCH_ORDERS = ('top_first', 'random', 'id')
+MAX_ITERATIONS = 10_000
+MAX_BINS = 100
+MAX_EXPERIMENTS = 50
+MAX_FILE_BYTES = 1_000_000
+ID_CHARS = set('abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-')
+
+
+@dataclass(frozen=True)
+class Requirements:
+    """The production requirement: parts of this type per hour, hours between refills of a bin
+    or the feeder, and the largest bin length in any dimension, m."""
+
+    parts_per_hour: float = 60.0
+    refill_interval: float = 4.0 * 3600.0      # s
+    max_dimension: float = 0.3                 # m
+
+    @property
+    def capacity(self) -> int:
+        """Parts a bin or feeder must hold to last one refill interval."""
+        return math.ceil(self.parts_per_hour * self.refill_interval / 3600.0)
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """One experiment of the file.
+
+    bins: bin_static's candidate bins. bin: bin_emptying's bin, or None when `bin_from` names
+    the bin_static experiment whose best bin is used. counts: table_sweep's parts on the tray.
+    optimal_range: feeder_emptying's [min*, max*], or None when `range_from` names the
+    table_sweep whose optimum is used.
+    """
+
+    id: str
+    type: str
+    iterations: int
+    parts: int = 0
+    bins: tuple[ContainerSpec, ...] = ()
+    bin: ContainerSpec | None = None
+    bin_from: str = ''
+    counts: tuple[int, ...] = ()
+    margin: int = 5
+    optimal_range: tuple[int, int] | None = None
+    range_from: str = ''
+    max_vibrations: int = 500
+
+
+@dataclass(frozen=True)
+class ExperimentFile:
+    """Everything a run needs, in SI units. `path` is the file read; `text` its content."""
+
+    id: str
+    seed: int
+    output_dir: str
+    part: PartSpec
+    gripper: Gripper
+    grasps: tuple[GraspPose, ...]
+    place: PlaceSpec
+    check: CheckConfig
+    search_order: str
+    tray: ContainerSpec
+    vibration: Vibration
+    bin_wall: float
+    requirements: Requirements
+    experiments: tuple[Experiment, ...]
+    path: str = ''
+    text: str = field(default='', repr=False)
+
+    def experiment(self, experiment_id: str) -> Experiment:
+        return next(e for e in self.experiments if e.id == experiment_id)
+
+
+class _Map:
+    """A mapping of the file under a path; takes its keys one by one and rejects the rest."""
+
+    def __init__(self, value: Any, path: str) -> None:
+        if not isinstance(value, Mapping):
+            raise InvalidArgument(path or 'file', _short(value), 'must be a mapping of keys')
+        self.value, self.path, self.taken = value, path, set()
+
+    def where(self, key: str) -> str:
+        return f'{self.path}.{key}' if self.path else key
+
+    def get(self, key: str, default: Any = None, required: bool = False) -> Any:
+        self.taken.add(key)
+        if key not in self.value:
+            if required:
+                raise InvalidArgument(self.where(key), None, 'is required')
+            return default
+        return self.value[key]
+
+    def number(self, key: str, default: float | None, low: float | None = None,
+               high: float | None = None, low_open: bool = False, scale: float = 1.0) -> float:
+        value = self.get(key, default, required=default is None)
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise InvalidArgument(self.where(key), value, 'is not a number')
+        return scale * check_number(self.where(key), value, low=low, high=high,
+                                    low_open=low_open)
+
+    def integer(self, key: str, default: int | None, low: int, high: int) -> int:
+        value = self.get(key, default, required=default is None)
+        return check_int(self.where(key), value, low=low, high=high)
+
+    def text(self, key: str, default: str | None, choices: tuple[str, ...] = ()) -> str:
+        value = self.get(key, default, required=default is None)
+        if not isinstance(value, str):
+            raise InvalidArgument(self.where(key), _short(value), 'is not a string')
+        if choices and value not in choices:
+            raise InvalidArgument(self.where(key), value, f'must be one of {", ".join(choices)}')
+        return value
+
+    def vector(self, key: str, default: Any, length: int, low: float | None = None,
+               high: float | None = None, low_open: bool = False,
+               scale: float = 1.0) -> tuple[float, ...]:
+        return _vector(self.get(key, default, required=default is None), self.where(key),
+                       length, low, high, low_open, scale)
+
+    def sub(self, key: str) -> '_Map':
+        return _Map(self.get(key, {}), self.where(key))
+
+    def done(self) -> None:
+        """Reject every key that was not taken."""
+        unknown = sorted(str(k) for k in self.value if k not in self.taken)
+        if unknown:
+            allowed = ', '.join(sorted(self.taken))
+            raise InvalidArgument(self.where(unknown[0]), self.value[unknown[0]]
+                                  if not isinstance(self.value[unknown[0]], Mapping) else '{...}',
+                                  f'is not a known key here (known: {allowed})')
+
+
+def _short(value: Any) -> Any:
+    text = repr(value)
+    return value if len(text) < 60 else text[:57] + '...'
+
+
+def _vector(value: Any, where: str, length: int, low: float | None = None,
+            high: float | None = None, low_open: bool = False,
+            scale: float = 1.0) -> tuple[float, ...]:
+    if not isinstance(value, list | tuple) or len(value) != length:
+        raise InvalidArgument(where, _short(value), f'must be a list of {length} numbers')
+    out = []
+    for i, v in enumerate(value):
+        if isinstance(v, bool) or not isinstance(v, int | float):
+            raise InvalidArgument(f'{where}[{i}]', _short(v), 'is not a number')
+        out.append(scale * check_number(f'{where}[{i}]', v, low=low, high=high,
+                                        low_open=low_open))
+    return tuple(out)
+
+
+def _id(m: _Map, key: str, default: str | None = None) -> str:
+    value = m.text(key, default)
+    if not value or len(value) > 64 or not set(value) <= ID_CHARS:
+        raise InvalidArgument(m.where(key), value, 'must be 1..64 letters, digits, _ or -')
+    return value
+
+
+MM, G, DEG = 1e-3, 1e-3, math.pi / 180.0
+
+
+def _part(m: _Map, base_dir: str) -> tuple[PartSpec, tuple[GraspPose, ...], PlaceSpec]:
+    model = m.text('model', 'radial_capacitor')
+    mesh = m.text('mesh', '')
+    if model == 'mesh':
+        if not mesh:
+            raise InvalidArgument(m.where('mesh'), mesh, 'is required when model is mesh')
+        mesh = os.path.normpath(os.path.join(base_dir, os.path.expanduser(mesh)))
+        if not os.path.isfile(mesh):
+            raise InvalidArgument(m.where('mesh'), mesh, 'does not exist or is not a file')
+    elif mesh:
+        raise InvalidArgument(m.where('mesh'), mesh, f'is only read when model is mesh '
+                              f'(model is {model})')
+    dims = m.sub('dimensions_mm')
+    dimensions = {str(k): dims.number(str(k), 0.0, low=0.0, low_open=True, scale=MM)
+                  for k in list(dims.value)}
+    dims.done()
+    if 'pins_per_row' in dimensions:
+        raise InvalidArgument(dims.where('pins_per_row'), dims.value['pins_per_row'],
+                              'is a count, not a length: give it as part.pins_per_row')
+    if 'pins_per_row' in m.value:
+        dimensions['pins_per_row'] = m.integer('pins_per_row', 0, 1, 64)
+    mass = m.number('mass_g', 0.0, low=0.0, high=10_000.0, scale=G)
+    spec = PartSpec(
+        model=model, dimensions=dimensions, mass=mass or None,
+        lateral_friction=m.number('lateral_friction', 0.5, low=0.0, high=10.0),
+        rolling_friction=m.number('rolling_friction_mm', 1.0, low=0.0, high=100.0, scale=MM),
+        spinning_friction=m.number('spinning_friction_mm', 1.0, low=0.0, high=100.0, scale=MM),
+        restitution=m.number('restitution', 0.0, low=0.0, high=1.0),
+        mesh_path=mesh, scale=m.number('mesh_scale', 1.0, low=0.0, high=1000.0, low_open=True))
+    place_map = m.sub('place')
+    place = PlaceSpec(place_axis=place_map.vector('axis', [0.0, 0.0, -1.0], 3),
+                      seat_offset=place_map.number('seat_offset_mm', 5.5, low=-1000.0,
+                                                   high=1000.0, scale=MM))
+    place_map.done()
+    raw = m.get('grasps', None)
+    if raw is None:
+        grasps = CAPACITOR_GRASPS
+    else:
+        if not isinstance(raw, list) or not raw:
+            raise InvalidArgument(m.where('grasps'), _short(raw), 'must be a non-empty list')
+        grasps = []
+        for i, item in enumerate(raw):
+            g = _Map(item, f'{m.where("grasps")}[{i}]')
+            grasps.append(GraspPose(
+                name=g.text('name', f'grasp_{i}'),
+                up_axis=g.vector('up_axis', None, 3),
+                closing_axis=g.vector('closing_axis', None, 3),
+                jaw_opening=g.number('jaw_opening_mm', None, low=0.0, low_open=True, scale=MM),
+                grasp_point=g.vector('grasp_point_mm', [0.0, 0.0, 0.0], 3, scale=MM)))
+            g.done()
+        names = [g.name for g in grasps]
+        if len(set(names)) != len(names):
+            raise InvalidArgument(m.where('grasps'), names, 'has a grasp name twice')
+    m.done()
+    return spec, tuple(grasps), place
+
+
+def _bins(m: _Map, key: str, wall: float, limit: float) -> tuple[ContainerSpec, ...]:
+    raw = m.get(key, None, required=True)
+    where = m.where(key)
+    if not isinstance(raw, list) or not 1 <= len(raw) <= MAX_BINS:
+        raise InvalidArgument(where, _short(raw), f'must be a list of 1..{MAX_BINS} bins '
+                              '[x, y, z] in mm')
+    return tuple(_bin(v, f'{where}[{i}]', wall, limit) for i, v in enumerate(raw))
+
+
+def _bin(value: Any, where: str, wall: float, limit: float) -> ContainerSpec:
+    size = _vector(value, where, 3, low=0.0, low_open=True, scale=MM)
+    for i, s in enumerate(size):
+        if s > limit + 1e-12:
+            raise InvalidArgument(f'{where}[{i}]', round(s / MM, 6),
+                                  f'mm is over the size limit requirements.max_dimension_mm '
+                                  f'= {limit / MM:g}')
+    spec = ContainerSpec(inner_size=size, wall_thickness=wall)
+    _checked(check_container, spec, where)
+    return spec
+
+
+def _checked(check: Callable, value: Any, where: str) -> Any:
+    """Run a core check, naming the field in the file that held the value."""
+    try:
+        return check(value)
+    except InvalidArgument as exc:
+        raise InvalidArgument(f'{where} ({exc.field})', exc.value, exc.rule) from None
+
+
+def _fits(part: PartGeometry, count: int, container: ContainerSpec, where: str) -> None:
+    inner = math.prod(container.inner_size)
+    if count * part.volume > PACKING_LIMIT * inner:
+        most = int(PACKING_LIMIT * inner / part.volume)
+        size = ' x '.join(f'{s / MM:g}' for s in container.inner_size)
+        raise InvalidArgument(where, count, (
+            f'parts do not fit a container of {size} mm: {part.volume * 1e9:.4g} mm^3 each, at '
+            f'most {most} within the packing limit {PACKING_LIMIT:g}'))
+
+
+def _experiment(m: _Map, f: dict, earlier: dict[str, Experiment]) -> Experiment:
+    exp_id = _id(m, 'id')
+    if exp_id in earlier:
+        raise InvalidArgument(m.where('id'), exp_id, 'is the id of an earlier experiment')
+    kind = m.text('type', None, TYPES)
+    iterations = m.integer('iterations', None, 1, MAX_ITERATIONS)
+    part, tray, wall, limit = f['part_geometry'], f['tray'], f['bin_wall'], f['max_dimension']
+    out: dict[str, Any] = {'id': exp_id, 'type': kind, 'iterations': iterations}
+    if kind in (BIN_STATIC, BIN_EMPTYING, FEEDER_EMPTYING):
+        out['parts'] = m.integer('parts', None, 1, MAX_PARTS_PER_INSTANCE)
+    if kind == BIN_STATIC:
+        out['bins'] = _bins(m, 'bins_mm', wall, limit)
+        for i, b in enumerate(out['bins']):
+            _fits(part, out['parts'], b, m.where('parts') + f' (bins_mm[{i}])')
+    elif kind == BIN_EMPTYING:
+        raw = m.get('bin', None, required=True)
+        if isinstance(raw, str):
+            source = earlier.get(raw)
+            if source is None or source.type != BIN_STATIC:
+                raise InvalidArgument(m.where('bin'), raw, 'names no earlier bin_static '
+                                      'experiment (give its id, or a bin [x, y, z] in mm)')
+            out['bin_from'] = raw
+            for i, b in enumerate(source.bins):
+                _fits(part, out['parts'], b, m.where('parts') + f' ({raw}.bins_mm[{i}])')
+        else:
+            out['bin'] = _bin(raw, m.where('bin'), wall, limit)
+            _fits(part, out['parts'], out['bin'], m.where('parts'))
+    elif kind == TABLE_SWEEP:
+        counts = m.sub('counts')
+        first = counts.integer('first', 1, 1, MAX_PARTS_PER_INSTANCE)
+        last = counts.integer('last', 100, first, MAX_PARTS_PER_INSTANCE)
+        step = counts.integer('step', 1, 1, MAX_PARTS_PER_INSTANCE)
+        counts.done()
+        out['counts'] = tuple(range(first, last + 1, step))
+        _fits(part, out['counts'][-1], tray, m.where('counts.last'))
+        out['margin'] = m.integer('margin', 5, 0, 1000)
+    if kind == FEEDER_EMPTYING:
+        raw = m.get('optimal_range', None, required=True)
+        if isinstance(raw, str):
+            source = earlier.get(raw)
+            if source is None or source.type != TABLE_SWEEP:
+                raise InvalidArgument(m.where('optimal_range'), raw, 'names no earlier '
+                                      'table_sweep experiment (give its id, or [min, max])')
+            out['range_from'] = raw
+            high = source.counts[-1] + source.margin
+        else:
+            if not isinstance(raw, list | tuple) or len(raw) != 2:
+                raise InvalidArgument(m.where('optimal_range'), _short(raw),
+                                      'must be [min, max] parts on the table, or a table_sweep id')
+            low = check_int(m.where('optimal_range') + '[0]', raw[0], low=1,
+                            high=MAX_PARTS_PER_INSTANCE)
+            high = check_int(m.where('optimal_range') + '[1]', raw[1], low=1,
+                             high=MAX_PARTS_PER_INSTANCE)
+            if low > high:
+                raise InvalidArgument(m.where('optimal_range'), list(raw),
+                                      'has min > max')
+            out['optimal_range'] = (low, high)
+        out['max_vibrations'] = m.integer('max_vibrations', 500, 1, 1_000_000)
+        if out.get('optimal_range'):
+            _checked(check_feeder, FeederConfig(out['parts'], *out['optimal_range'],
+                                                out['max_vibrations']), m.path)
+        _fits(part, high, tray, m.where('optimal_range') + ' (max)')
+    m.done()
+    return Experiment(**out)
+
+
+def parse(text: str, path: str = '') -> ExperimentFile:
+    """Read and check an experiment file's text. Raises InvalidArgument on the first error."""
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, 'problem_mark', None)
+        where = f'line {mark.line + 1}, column {mark.column + 1}' if mark else 'file'
+        raise InvalidArgument(where, path, f'is not valid YAML: '
+                              f'{getattr(exc, "problem", None) or exc}') from None
+    m = _Map(data, '')
+    base_dir = os.path.dirname(os.path.abspath(path)) if path else os.getcwd()
+    file_id = _id(m, 'id')
+    seed = m.integer('seed', 0, 0, MAX_SEED)
+    output_dir = m.text('output_dir', 'results')
+    part, grasps, place = _part(m.sub('part'), base_dir)
+    g = m.sub('gripper')
+    d = Gripper()
+    gripper = Gripper(
+        body_diameter=g.number('body_diameter_mm', d.body_diameter / MM, scale=MM),
+        body_length=g.number('body_length_mm', d.body_length / MM, scale=MM),
+        jaw_height=g.number('jaw_height_mm', d.jaw_height / MM, scale=MM),
+        jaw_depth=g.number('jaw_depth_mm', d.jaw_depth / MM, scale=MM))
+    g.done()
+    c = m.sub('check')
+    check = CheckConfig(tolerance=c.number('tolerance_deg', 45.0, scale=DEG),
+                        tilt_min=c.number('tilt_min_deg', -45.0, scale=DEG),
+                        tilt_max=c.number('tilt_max_deg', 45.0, scale=DEG),
+                        tilt_step=c.number('tilt_step_deg', 5.0, scale=DEG))
+    search_order = c.text('search_order', 'top_first', SEARCH_ORDERS)
+    c.done()
+    r = m.sub('requirements')
+    requirements = Requirements(
+        parts_per_hour=r.number('parts_per_hour', 60.0, low=0.0, high=1e6, low_open=True),
+        refill_interval=r.number('refill_interval_h', 4.0, low=0.0, high=1000.0,
+                                 low_open=True, scale=3600.0),
+        max_dimension=r.number('max_dimension_mm', 300.0, low=0.0, high=2000.0,
+                               low_open=True, scale=MM))
+    r.done()
+    tray = ContainerSpec.tray(m.vector('tray_mm', [s / MM for s in TRAY_DEFAULT_SIZE], 3,
+                                       low=0.0, low_open=True, scale=MM))
+    _checked(check_container, tray, 'tray_mm')
+    v = m.sub('vibration')
+    d = Vibration()
+    vibration = Vibration(
+        amplitude=v.vector('amplitude_mm', [a / MM for a in d.amplitude], 3, scale=MM),
+        frequency=v.number('frequency_hz', d.frequency),
+        duration=v.number('duration_s', d.duration))
+    v.done()
+    _checked(check_vibration, vibration, 'vibration')
+    bin_wall = m.number('bin_wall_mm', 3.0, low=0.5, high=100.0, scale=MM)
+    # The core's own checks, under the file's names.
+    _checked(check_gripper, gripper, 'gripper')
+    _checked(check_grasps, list(grasps), 'part.grasps')
+    _checked(check_place, place, 'part.place')
+    _checked(tilts, check, 'check')
+    try:
+        geometry = build_part(part)
+    except InvalidArgument as exc:
+        raise InvalidArgument(f'part ({exc.field})', exc.value, exc.rule) from None
+    raw = m.get('experiments', None, required=True)
+    if not isinstance(raw, list) or not 1 <= len(raw) <= MAX_EXPERIMENTS:
+        raise InvalidArgument('experiments', _short(raw),
+                              f'must be a list of 1..{MAX_EXPERIMENTS} experiments')
+    context = {'part_geometry': geometry, 'tray': tray, 'bin_wall': bin_wall,
+               'max_dimension': requirements.max_dimension}
+    experiments: dict[str, Experiment] = {}
+    for i, item in enumerate(raw):
+        e = _experiment(_Map(item, f'experiments[{i}]'), context, experiments)
+        experiments[e.id] = e
+    m.done()
+    return ExperimentFile(
+        id=file_id, seed=seed, output_dir=output_dir, part=part, gripper=gripper, grasps=grasps,
+        place=place, check=check, search_order=search_order, tray=tray, vibration=vibration,
+        bin_wall=bin_wall, requirements=requirements, experiments=tuple(experiments.values()),
+        path=os.path.abspath(path) if path else '', text=text)
+
+
+def load(path: str) -> ExperimentFile:
+    """Read and check the experiment file at `path`."""
+    try:
+        size = os.path.getsize(path)
+        if size > MAX_FILE_BYTES:
+            raise InvalidArgument('experiment_file', path, f'is {size} bytes (limit '
+                                  f'{MAX_FILE_BYTES})')
+        with open(path, encoding='utf-8') as f:
+            text = f.read()
+    except OSError as exc:
+        raise InvalidArgument('experiment_file', path,
+                              f'cannot be read: {exc.strerror or exc}') from None
+    except UnicodeDecodeError as exc:
+        raise InvalidArgument('experiment_file', path, f'is not UTF-8 text: {exc}') from None
+    return parse(text, path)

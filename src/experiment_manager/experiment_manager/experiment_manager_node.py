@@ -1,0 +1,211 @@
+"""The `experiment_manager` node: runs experiment files over a worker's nodes and records them.
+
+Action `run_experiment` (feedback: ExperimentProgress); topic `progress`. It drives the worker's
+`world`, `validity` and `feeder_controller` (graph_backend.py) with the experiment logic of
+experiments.py, writes results as iterations finish (results.py), and records every topic of the
+worker, its own progress, the experiment file and the results into one MCAP file per run
+(recording.py). One run at a time: a second goal is answered BUSY, not queued.
+"""
+
+from datetime import datetime
+import json
+import os
+import threading
+import traceback
+
+from pick_msgs.action import RunExperiment
+from pick_msgs.msg import ExperimentProgress
+from pick_sim_world import conversions as world_conv
+from pick_sim_world.errors import InvalidArgument, WorldError
+from pick_sim_world.node_runner import run
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from rclpy.action import ActionServer, CancelResponse
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.exceptions import InvalidNamespaceException
+from rclpy.executors import MultiThreadedExecutor
+from rclpy.node import Node
+from rclpy.validate_namespace import validate_namespace
+from std_msgs.msg import Header
+
+from . import config
+from .experiments import Progress, Runner
+from .graph_backend import GraphBackend, GraphError
+from .recording import Recorder
+from .results import ResultsWriter
+from .topic_recorder import TopicRecorder
+
+STOP_WAIT = 15.0        # s a shutdown waits for the run to close its files
+RESULT_FILES = ('iterations.csv', 'checks.csv', 'picks.csv', 'parts.csv', 'summary.json')
+
+
+def run_directory(output_dir: str, file_id: str) -> str:
+    """A new directory name <output_dir>/<id>_<YYYYmmdd-HHMMSS>[_k] that does not exist yet."""
+    stamp = datetime.now().strftime('%Y%m%d-%H%M%S')
+    base = os.path.join(os.path.abspath(os.path.expanduser(output_dir)), f'{file_id}_{stamp}')
+    path, k = base, 1
+    while os.path.exists(path):
+        k += 1
+        path = f'{base}_{k}'
+    return path
+
+
+class ExperimentManagerNode(Node):
+    """Translates run_experiment goals into runs of experiments.Runner on the graph."""
+
+    def __init__(self) -> None:
+        super().__init__('experiment_manager')
+        worker = self.declare_parameter('worker', '', ParameterDescriptor(
+            description='namespace of the world, validity and feeder_controller to drive, '
+            "relative to this node's; empty: this node's own", read_only=True)).value.strip('/')
+        if worker:
+            try:
+                validate_namespace('/' + worker)
+            except InvalidNamespaceException as exc:
+                raise InvalidArgument('worker', worker, f'is not a valid namespace: '
+                                      f'{exc}') from None
+        self._call_timeout = self.declare_parameter('call_timeout', 600.0, ParameterDescriptor(
+            description='longest wait for one call to a node of the worker, s', read_only=True,
+            floating_point_range=[FloatingPointRange(from_value=1.0, to_value=86400.0)])).value
+        server_timeout = self.declare_parameter('server_timeout', 10.0, ParameterDescriptor(
+            description="longest wait for the worker's services and actions at the start of a "
+            'run, s', read_only=True,
+            floating_point_range=[FloatingPointRange(from_value=0.1, to_value=3600.0)])).value
+        self._chunk_size = self.declare_parameter('recording.chunk_size', 1 << 20,
+                                                  ParameterDescriptor(
+            description='bytes of messages per MCAP chunk; a killed run loses at most one',
+            read_only=True, integer_range=[IntegerRange(from_value=1024,
+                                                        to_value=1 << 30)])).value
+        group = ReentrantCallbackGroup()
+        self._stopping = threading.Event()
+        self._idle = threading.Event()
+        self._idle.set()
+        self._lock = threading.Lock()
+        self._goal = None
+        self._progress = self.create_publisher(ExperimentProgress, 'progress', 10)
+        self._backend = GraphBackend(self, worker, group, self._call_timeout, server_timeout,
+                                     self._cancel_requested)
+        self._topics = TopicRecorder(f'{self.get_name()}_recorder', self.get_namespace(),
+                                     worker, self.context)
+        ActionServer(self, RunExperiment, 'run_experiment', execute_callback=self._run,
+                     cancel_callback=lambda _: CancelResponse.ACCEPT, callback_group=group)
+        self.get_logger().info(f'driving the worker in '
+                               f'{worker or "this namespace"}; call_timeout '
+                               f'{self._call_timeout:g} s')
+
+    def _cancel_requested(self) -> bool:
+        goal = self._goal
+        return self._stopping.is_set() or (goal is not None and goal.is_cancel_requested)
+
+    def _publish_progress(self, p: Progress) -> None:
+        msg = ExperimentProgress(header=Header(stamp=self.get_clock().now().to_msg()),
+                                 experiment_id=p.experiment_id,
+                                 experiment_type=p.experiment_type, phase=p.phase,
+                                 iterations_total=p.total, iterations_done=p.done,
+                                 elapsed=p.elapsed, eta=p.eta)
+        self._progress.publish(msg)
+        if self._goal is not None:
+            self._goal.publish_feedback(RunExperiment.Feedback(progress=msg))
+        self._topics.write(self._progress.topic_name, msg)
+
+    # ------------------------------------------------------------------------- the action
+    def _run(self, goal_handle) -> RunExperiment.Result:
+        result = RunExperiment.Result()
+        if not self._lock.acquire(blocking=False):
+            result.error_code = RunExperiment.Result.BUSY
+            result.error_msg = ('another experiment is running; goals are not queued: send it '
+                                'again when the running one has finished')
+            goal_handle.abort()
+            return result
+        self._idle.clear()
+        self._goal = goal_handle
+        writer = recorder = None
+        try:
+            goal = goal_handle.request
+            file = config.load(goal.experiment_file)
+            if goal.resume:
+                if not goal.output_dir:
+                    raise InvalidArgument('output_dir', '', 'must name the run '
+                                                 'directory to resume')
+                run_dir = os.path.abspath(os.path.expanduser(goal.output_dir))
+            else:
+                run_dir = run_directory(goal.output_dir or file.output_dir, file.id)
+            writer = ResultsWriter(run_dir, file.text, goal.resume)
+            result.results_path = run_dir
+            recorder = self._open_recording(run_dir, file, goal.resume)
+            result.recording_path = recorder.path
+            self.get_logger().info(f'running {file.path} into {run_dir}')
+            summary = Runner(file, self._backend, writer, self._publish_progress).run()
+            result.summary_json = json.dumps(summary)
+            goal_handle.succeed()
+        except (WorldError, GraphError) as exc:
+            result.error_code = (exc.code if isinstance(exc, GraphError)
+                                 else world_conv.error_code(exc))
+            result.error_msg = str(exc)
+            self.get_logger().error(f'run_experiment: {exc}')
+            self._end(goal_handle, result)
+        except Exception as exc:  # a bug: answer, log, keep serving
+            result.error_code = RunExperiment.Result.INTERNAL
+            result.error_msg = f'internal error: {type(exc).__name__}: {exc}'
+            self.get_logger().error(f'{result.error_msg}\n{traceback.format_exc()}')
+            self._end(goal_handle, result)
+        finally:
+            if recorder is not None:
+                self._close_recording(recorder, writer)
+            if writer is not None:
+                writer.close()
+                if result.error_code:
+                    result.error_msg += (f' (finished iterations are kept in {writer.directory};'
+                                         ' resume the run there to finish it)')
+            self._goal = None
+            self._lock.release()
+            self._idle.set()
+        return result
+
+    def _end(self, goal_handle, result) -> None:
+        if goal_handle.is_cancel_requested:
+            result.error_code = RunExperiment.Result.CANCELED
+            goal_handle.canceled()
+        else:
+            goal_handle.abort()
+
+    def _open_recording(self, run_dir: str, file: config.ExperimentFile,
+                        resume: bool) -> Recorder:
+        path, k = os.path.join(run_dir, 'recording.mcap'), 1
+        while resume and os.path.exists(path):
+            k += 1
+            path = os.path.join(run_dir, f'recording_{k}.mcap')
+        recorder = Recorder(path, self._chunk_size)
+        recorder.attach('experiment.yaml', file.text.encode(), 'application/yaml')
+        recorder.metadata('run', {'experiment_id': file.id, 'seed': str(file.seed),
+                                  'experiment_file': file.path, 'run_directory': run_dir,
+                                  'resumed': str(bool(resume)),
+                                  'node': self.get_fully_qualified_name()})
+        self._topics.start(recorder)
+        return recorder
+
+    def _close_recording(self, recorder: Recorder, writer: ResultsWriter | None) -> None:
+        self._topics.stop()
+        try:
+            for name in RESULT_FILES if writer is not None else ():
+                path = writer.path(name)
+                if os.path.exists(path):
+                    with open(path, 'rb') as f:
+                        recorder.attach(name, f.read(), 'application/json'
+                                        if name.endswith('.json') else 'text/csv')
+        finally:
+            recorder.close()
+
+    def destroy_node(self) -> None:
+        """On shutdown, stop a run at its next call and let it close its files."""
+        self._stopping.set()
+        if not self._idle.wait(STOP_WAIT):
+            self.get_logger().error('the run did not stop within '
+                                    f'{STOP_WAIT:g} s; its recording may be cut off')
+        self._backend.destroy()
+        self._topics.destroy()
+        super().destroy_node()
+
+
+def main(args=None) -> None:
+    run('experiment_manager', ExperimentManagerNode,
+        lambda: MultiThreadedExecutor(num_threads=4), args)

@@ -1,0 +1,208 @@
+"""The experiment backend over the ROS 2 graph: a worker's `world`, `validity` and
+`feeder_controller` nodes, called by relative names under the worker's namespace.
+
+Calls are made from the thread that runs the experiment and wait on their futures while the
+node's executor spins in other threads. A wait ends with an error, never a hang: when the goal
+is canceled, when the server drops out of the graph (its node died), or after `call_timeout`.
+"""
+
+from collections.abc import Callable
+import threading
+import time
+
+from feeder_controller.policy import FeederConfig
+from geometry_msgs.msg import Vector3
+from pick_msgs.action import DropParts, FeedCycle, RemoveParts
+from pick_msgs.msg import PartArray
+from pick_msgs.srv import CheckParts, GetParts, ResetScene
+from pick_sim_world import conversions as world_conv
+from pick_sim_world.containers import ContainerSpec
+from pick_sim_world.world import PartStates, SettleReport
+from pick_validity import conversions as validity_conv
+from pick_validity.validity import Report
+from rclpy.action import ActionClient
+from rclpy.node import Node
+
+from .config import ExperimentFile
+from .experiments import FeedStep
+
+POLL = 0.1              # s between checks of a pending call
+GONE_AFTER = 2.0        # s a server must stay absent from the graph before a call fails
+
+
+class GraphError(Exception):
+    """A call failed: `code` is a pick_msgs error code (the server's own, or INTERNAL when
+    the server is missing or lost, CANCELED when the goal was canceled)."""
+
+    def __init__(self, code: int, message: str) -> None:
+        self.code = code
+        super().__init__(message)
+
+
+class GraphBackend:
+    """Implements experiments.Backend with service and action calls to one worker."""
+
+    def __init__(self, node: Node, worker: str, callback_group, call_timeout: float,
+                 server_timeout: float, canceled: Callable[[], bool]) -> None:
+        self._node = node
+        self._ns = worker.strip('/')
+        self._call_timeout = call_timeout
+        self._server_timeout = server_timeout
+        self._canceled = canceled
+        name = self.name
+        group = {'callback_group': callback_group}
+        self._reset = node.create_client(ResetScene, name('reset_scene'), **group)
+        self._get = node.create_client(GetParts, name('get_parts'), **group)
+        self._check_client = node.create_client(CheckParts, name('check_parts'), **group)
+        self._drop = ActionClient(node, DropParts, name('drop_parts'), **group)
+        self._remove = ActionClient(node, RemoveParts, name('remove_parts'), **group)
+        self._feed = ActionClient(node, FeedCycle, name('feed_cycle'), **group)
+        self._file: ExperimentFile | None = None
+        self._parts_msg = PartArray()
+
+    def name(self, endpoint: str) -> str:
+        """The relative name of a worker endpoint."""
+        return f'{self._ns}/{endpoint}' if self._ns else endpoint
+
+    def destroy(self) -> None:
+        for client in (self._reset, self._get, self._check_client):
+            self._node.destroy_client(client)
+        for action in (self._drop, self._remove, self._feed):
+            action.destroy()
+
+    # ------------------------------------------------------------------------- waiting
+    def _ready(self, client) -> bool:
+        if isinstance(client, ActionClient):
+            return client.server_is_ready()
+        return client.service_is_ready()
+
+    def _endpoint(self, client) -> str:
+        name = client._action_name if isinstance(client, ActionClient) else client.srv_name
+        return self._node.resolve_service_name(name)
+
+    def wait_for_servers(self) -> None:
+        """Fail with the missing endpoints' names unless all are there within server_timeout."""
+        clients = (self._reset, self._get, self._check_client, self._drop, self._remove,
+                   self._feed)
+        deadline = time.monotonic() + self._server_timeout
+        while time.monotonic() < deadline:
+            if all(self._ready(c) for c in clients):
+                return
+            if self._canceled():
+                raise GraphError(CheckParts.Response.CANCELED, 'canceled')
+            time.sleep(POLL)
+        missing = [self._endpoint(c) for c in clients if not self._ready(c)]
+        where = f'namespace {self._ns!r}' if self._ns else "the manager's namespace"
+        raise GraphError(CheckParts.Response.INTERNAL, (
+            f'not in the graph after {self._server_timeout:g} s: {", ".join(missing)} (are the '
+            f'world, validity and feeder_controller nodes running in {where}?)'))
+
+    def _wait(self, future, client, what: str):
+        done = threading.Event()
+        future.add_done_callback(lambda _: done.set())
+        start = time.monotonic()
+        absent_since = None
+        while not done.wait(POLL):
+            now = time.monotonic()
+            if self._canceled():
+                future.cancel()
+                raise GraphError(CheckParts.Response.CANCELED, f'canceled during {what}')
+            if now - start > self._call_timeout:
+                raise GraphError(CheckParts.Response.INTERNAL, (
+                    f'{what}: no answer from {self._endpoint(client)} within call_timeout '
+                    f'{self._call_timeout:g} s'))
+            if self._ready(client):
+                absent_since = None
+            elif absent_since is None:
+                absent_since = now
+            elif now - absent_since > GONE_AFTER:
+                raise GraphError(CheckParts.Response.INTERNAL, (
+                    f'{what}: {self._endpoint(client)} left the graph while answering (its '
+                    'node died or was stopped)'))
+        return future.result()
+
+    def _service(self, client, request, what: str):
+        if not self._ready(client):
+            self.wait_for_servers()
+        response = self._wait(client.call_async(request), client, what)
+        self._raise_on_error(response, what)
+        return response
+
+    def _action(self, client: ActionClient, goal, what: str):
+        if not self._ready(client):
+            self.wait_for_servers()
+        handle = self._wait(client.send_goal_async(goal), client, what)
+        if not handle.accepted:
+            raise GraphError(CheckParts.Response.INTERNAL, f'{what}: the goal was rejected')
+        try:
+            result = self._wait(handle.get_result_async(), client, what).result
+        except GraphError:
+            handle.cancel_goal_async()
+            raise
+        self._raise_on_error(result, what)
+        return result
+
+    @staticmethod
+    def _raise_on_error(answer, what: str) -> None:
+        if answer.error_code != world_conv.ERROR_NONE:
+            raise GraphError(answer.error_code, f'{what}: {answer.error_msg}')
+
+    # ------------------------------------------------------------------------- Backend
+    def start(self, file: ExperimentFile) -> None:
+        self._file = file
+        self._part_msg = world_conv.part_spec_to_msg(file.part)
+        self._setup = validity_conv.Setup(file.gripper, file.grasps, file.place, file.check)
+        self.wait_for_servers()
+
+    def reset(self, container: ContainerSpec, seed: int) -> None:
+        request = ResetScene.Request(container=world_conv.container_to_msg(container),
+                                     part_model=self._part_msg, instance_count=1, seed=seed)
+        self._service(self._reset, request, 'reset_scene')
+        self._parts_msg = PartArray()
+
+    def _states(self, msg: PartArray) -> PartStates:
+        self._parts_msg = msg
+        return world_conv.states_from_msg(msg)
+
+    def drop(self, count: int, zone: str) -> tuple[PartStates, SettleReport]:
+        goal = DropParts.Goal(count=count, zone=DropParts.Goal.ZONE_FEEDER if zone == 'feeder'
+                              else DropParts.Goal.ZONE_CONTAINER)
+        result = self._action(self._drop, goal, 'drop_parts')
+        return self._states(result.parts), world_conv.settle_from_msg(result.settle)
+
+    def remove(self, ids: list[int], settle: bool = True) -> tuple[PartStates, SettleReport]:
+        goal = RemoveParts.Goal(part_ids=[int(i) for i in ids], skip_settle=not settle)
+        result = self._action(self._remove, goal, 'remove_parts')
+        return self._states(result.parts), world_conv.settle_from_msg(result.settle)
+
+    def parts(self) -> PartStates:
+        return self._states(self._service(self._get, GetParts.Request(), 'get_parts').parts)
+
+    def check(self, container: ContainerSpec, states: PartStates, targets: list[int],
+              neighbours: bool) -> Report:
+        parts = self._parts_msg.parts
+        if [p.id for p in parts] != states.ids.tolist():
+            raise GraphError(CheckParts.Response.INTERNAL,
+                             'check_parts: the parts to check are not the last ones received')
+        request = CheckParts.Request(container=world_conv.container_to_msg(container),
+                                     part_model=self._part_msg, parts=parts,
+                                     target_ids=[int(t) for t in targets],
+                                     check_neighbours=neighbours)
+        validity_conv.setup_to_request(self._setup, request)
+        response = self._service(self._check_client, request, 'check_parts')
+        return validity_conv.report_from_msg(response.report)
+
+    def feed(self, valid: int, on_table: int, restart: FeederConfig | None) -> FeedStep:
+        v = self._file.vibration
+        goal = FeedCycle.Goal(valid_parts=valid, parts_on_table=on_table,
+                              amplitude=Vector3(x=v.amplitude[0], y=v.amplitude[1],
+                                                z=v.amplitude[2]),
+                              frequency=v.frequency, duration=v.duration)
+        if restart is not None:
+            goal.restart = True
+            goal.feeder_parts, goal.min_count = restart.feeder_parts, restart.min_count
+            goal.max_count, goal.max_vibrations = restart.max_count, restart.max_vibrations
+        result = self._action(self._feed, goal, 'feed_cycle')
+        s = result.state
+        return FeedStep(result.decision, result.parts_fed, s.vibrations, s.feeds,
+                        s.parts_in_feeder)

@@ -1,0 +1,75 @@
+"""The cores in this process: a `World`, a `Validator` and a `FeederPolicy`, no ROS graph.
+
+The same physics and checks as the nodes, one call away instead of one message away: the tests of
+the experiment logic and the benchmark's graph-against-core ratio run on it.
+"""
+
+from feeder_controller.policy import FeederConfig, FeederPolicy
+from pick_sim_world.config import PhysicsConfig, SceneSpec
+from pick_sim_world.containers import ContainerSpec
+from pick_sim_world.world import PartStates, SettleReport, World
+from pick_validity.validity import Report, Validator
+
+from .config import ExperimentFile
+from .experiments import FeedStep
+
+
+class LocalBackend:
+    """Implements experiments.Backend with the cores. Call close() (or use `with`)."""
+
+    def __init__(self, physics: PhysicsConfig | None = None) -> None:
+        self._physics = physics
+        self._world: World | None = None
+        self._validator: Validator | None = None
+        self._policy: FeederPolicy | None = None
+        self._file: ExperimentFile | None = None
+
+    def start(self, file: ExperimentFile) -> None:
+        self._file = file
+        self._world = self._world or World(SceneSpec(file.tray, file.part), self._physics)
+        self._validator = Validator(self._world.part, file.gripper, file.grasps, file.place,
+                                    file.check)
+
+    def reset(self, container: ContainerSpec, seed: int) -> None:
+        self._world.reset(SceneSpec(container, self._file.part, 1, seed))
+
+    def drop(self, count: int, zone: str) -> tuple[PartStates, SettleReport]:
+        _, report = self._world.drop(count, zone=zone)
+        return self._world.snapshot(), report
+
+    def remove(self, ids: list[int], settle: bool = True) -> tuple[PartStates, SettleReport]:
+        _, report = self._world.remove(ids, settle=settle)
+        return self._world.snapshot(), report
+
+    def parts(self) -> PartStates:
+        return self._world.snapshot()
+
+    def check(self, container: ContainerSpec, states: PartStates, targets: list[int],
+              neighbours: bool) -> Report:
+        return self._validator.check(container, states.ids.tolist(), states.poses, targets,
+                                     neighbours)
+
+    def feed(self, valid: int, on_table: int, restart: FeederConfig | None) -> FeedStep:
+        if restart is not None:
+            self._policy = FeederPolicy(restart)
+        policy = self._policy
+        step = policy.decide(valid, on_table)
+        if step.feed:
+            self._world.drop(step.feed, zone='feeder')
+            policy.fed(step.feed)
+        if step.vibrates:
+            self._world.vibrate(self._file.vibration)
+            policy.vibrated()
+        s = policy.state
+        return FeedStep(step.decision, step.feed, s.vibrations, s.feeds, s.in_feeder)
+
+    def close(self) -> None:
+        if self._world is not None:
+            self._world.close()
+            self._world = None
+
+    def __enter__(self) -> 'LocalBackend':
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()

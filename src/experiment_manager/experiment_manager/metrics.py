@@ -1,0 +1,132 @@
+"""The metrics of each experiment type, from the rows of its finished iterations.
+
+bin_static: figure 14 (fractions of parts passing candidacy, placeability and the container stage
+per bin) and the best bin. bin_emptying: Table 2 (emptied bins, parts removed: mean, min, max,
+standard deviation; searches before each pick). table_sweep: figure 15 (mean valid parts per n),
+the 4th-order polynomial fit, its maximum n* and the optimal range n* +- margin. feeder_emptying:
+Table 3 (emptied runs, vibrations to empty the feeder, and the time per vibration the refill
+interval allows). Standard deviations are sample ones (n - 1), 0 for a single value.
+"""
+
+import numpy as np
+
+from .config import BIN_EMPTYING, BIN_STATIC, Experiment, ExperimentFile, TABLE_SWEEP
+
+FIT_ORDER = 4
+
+
+def stats(values) -> dict:
+    """mean, min, max, std (sample) and n of a list of numbers; None for an empty list (so that
+    summary.json stays strict JSON)."""
+    a = np.asarray(values, dtype=float)
+    if a.size == 0:
+        return {'n': 0, 'mean': None, 'min': None, 'max': None, 'std': None}
+    return {'n': int(a.size), 'mean': float(a.mean()), 'min': float(a.min()),
+            'max': float(a.max()), 'std': float(a.std(ddof=1)) if a.size > 1 else 0.0}
+
+
+def _fractions(rows: list[dict]) -> dict:
+    out = {}
+    for stage in ('candidates', 'placeable', 'container_free', 'valid'):
+        values = [r[stage] / r['checked'] for r in rows if r['checked']]
+        out[stage] = stats(values)
+    return out
+
+
+def bin_static(exp: Experiment, rows: list[dict]) -> dict:
+    bins = []
+    for b, spec in enumerate(exp.bins):
+        mine = [r for r in rows if r['group'] == b]
+        bins.append({'index': b, 'size_mm': [round(s * 1000, 6) for s in spec.inner_size],
+                     'xy_area_mm2': round(spec.inner_size[0] * spec.inner_size[1] * 1e6, 3),
+                     'iterations': len(mine), 'fractions': _fractions(mine),
+                     'escaped': stats([r['escaped'] for r in mine])})
+    scored = [(b['fractions']['container_free']['mean'], -b['index']) for b in bins
+              if b['fractions']['container_free']['mean'] is not None]
+    best = -max(scored)[1] if scored else None
+    return {'bins': bins, 'best_bin': best,
+            'best_bin_mm': bins[best]['size_mm'] if best is not None else None}
+
+
+def bin_emptying(exp: Experiment, rows: list[dict], picks: list[dict]) -> dict:
+    first = rows[0] if rows else None
+    return {'iterations': len(rows), 'parts': exp.parts,
+            'bin_mm': [round(first[k] * 1000, 6) for k in ('container_x', 'container_y',
+                                                             'container_z')] if first else None,
+            'emptied': sum(bool(r['emptied']) for r in rows),
+            'removed': stats([r['picks'] for r in rows]),
+            'searches_per_pick': stats([p['searches'] for p in picks]),
+            'first_check': _fractions(rows)}
+
+
+def fit_optimum(counts, valid, first: int, last: int, margin: int) -> dict:
+    """The polynomial fit (order 4, lower with fewer distinct counts) of valid parts against
+    parts on the table, n* at its maximum over the integers in [first, last], and the range
+    [max(1, n* - margin), n* + margin]. Coefficients highest power first."""
+    n = np.asarray(counts, dtype=float)
+    order = min(FIT_ORDER, len(np.unique(n)) - 1)
+    if order < 1:
+        best = int(n[0])
+        return {'order': 0, 'coefficients': [float(np.mean(valid))], 'n_star': best,
+                'optimal_range': [max(1, best - margin), best + margin]}
+    coefficients = np.polyfit(n, np.asarray(valid, dtype=float), order)
+    grid = np.arange(first, last + 1)
+    best = int(grid[int(np.argmax(np.polyval(coefficients, grid)))])
+    return {'order': order, 'coefficients': coefficients.tolist(), 'n_star': best,
+            'fit_max': float(np.polyval(coefficients, best)),
+            'optimal_range': [max(1, best - margin), best + margin]}
+
+
+def table_sweep(exp: Experiment, rows: list[dict]) -> dict:
+    per_n = []
+    for n in exp.counts:
+        mine = [r['valid'] for r in rows if r['group'] == n]
+        if mine:
+            per_n.append({'n': n, 'valid': stats(mine)})
+    out = {'iterations': exp.iterations, 'per_n': per_n, 'margin': exp.margin}
+    if rows:
+        out.update(fit_optimum([r['group'] for r in rows], [r['valid'] for r in rows],
+                               exp.counts[0], exp.counts[-1], exp.margin))
+    return out
+
+
+def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
+                    optimal_range) -> dict:
+    emptied = [r for r in rows if r['emptied']]
+    vibrations = stats([r['vibrations'] for r in emptied])
+    interval = file.requirements.refill_interval
+    per_vibration = (interval / vibrations['mean'] / 60.0
+                     if vibrations['mean'] else None)
+    return {'iterations': len(rows), 'parts': exp.parts, 'optimal_range': list(optimal_range),
+            'max_vibrations': exp.max_vibrations, 'emptied': len(emptied),
+            'vibrations_to_empty': vibrations, 'feeds': stats([r['feeds'] for r in rows]),
+            'lost': sum(r['lost'] for r in rows),
+            'stops': {s: sum(r['stop'] == s for r in rows) for s in sorted({r['stop']
+                                                                            for r in rows})},
+            'minutes_per_vibration_allowed': per_vibration}
+
+
+def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: list[dict],
+              earlier: dict | None = None) -> dict:
+    """The metrics of one experiment. `earlier`: the summaries of the experiments before it
+    (for feeder_emptying's range taken from a table_sweep)."""
+    if exp.type == BIN_STATIC:
+        out = bin_static(exp, rows)
+    elif exp.type == BIN_EMPTYING:
+        out = bin_emptying(exp, rows, picks)
+    elif exp.type == TABLE_SWEEP:
+        out = table_sweep(exp, rows)
+    else:
+        low_high = exp.optimal_range or (earlier or {})[exp.range_from]['optimal_range']
+        out = feeder_emptying(file, exp, rows, low_high)
+    return {'type': exp.type, **out}
+
+
+def file_summary(file: ExperimentFile, summaries: dict) -> dict:
+    r = file.requirements
+    return {'id': file.id, 'seed': file.seed,
+            'requirements': {'parts_per_hour': r.parts_per_hour,
+                             'refill_interval_h': r.refill_interval / 3600.0,
+                             'capacity': r.capacity,
+                             'max_dimension_mm': round(r.max_dimension * 1000, 6)},
+            'experiments': summaries}

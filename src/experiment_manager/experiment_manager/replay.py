@@ -1,0 +1,122 @@
+"""`replay`: republish a run's MCAP recording on the graph, for review without `ros2 bag`.
+
+    replay RECORDING.mcap [--rate R] [--topics T ...] [--prefix NS] [--info]
+
+Messages go out on their recorded topics (under --prefix, if given) with the recorded spacing
+divided by the rate; `scene` and `markers` are latched (transient local) as the world publishes
+them. --info lists the topics, types, message counts and attachments, and exits. Payloads are
+published as recorded (CDR, no decode), so any type in the file replays if its package is
+installed.
+"""
+
+import argparse
+import importlib
+import sys
+import time
+
+from mcap.exceptions import McapError
+from mcap.reader import make_reader
+from pick_sim_world.node_runner import LATCHED
+import rclpy
+from rclpy.node import Node
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+LATCHED_TOPICS = ('scene', 'markers')
+STREAM = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
+MATCH_WAIT = 1.0     # s given to subscribers to match before the first message
+
+
+def message_type(name: str) -> type:
+    """The message class of 'pkg/msg/Type' (the schema name of a ROS 2 MCAP channel)."""
+    parts = name.split('/')
+    if len(parts) != 3 or parts[1] != 'msg':
+        raise ValueError(f'schema {name!r} is not a ROS 2 message type name (pkg/msg/Type)')
+    return getattr(importlib.import_module(f'{parts[0]}.msg'), parts[2])
+
+
+def _parse(argv: list[str]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(prog='replay', description=__doc__.split('\n\n')[0])
+    parser.add_argument('recording', help='an MCAP file written by the experiment manager')
+    parser.add_argument('--rate', type=float, default=1.0,
+                        help='playback speed factor (default 1: as recorded)')
+    parser.add_argument('--topics', nargs='*', default=None, help='only these topics')
+    parser.add_argument('--prefix', default='',
+                        help='namespace put in front of every topic (default: none)')
+    parser.add_argument('--info', action='store_true', help='list the content and exit')
+    args = parser.parse_args(argv)
+    if not 0.001 <= args.rate <= 1000.0:
+        parser.error(f'--rate: {args.rate:g} must be within [0.001, 1000]')
+    return args
+
+
+def info(path: str) -> str:
+    """Topics, types and counts, attachments and metadata of a recording (like
+    `ros2 bag info`)."""
+    with open(path, 'rb') as f:
+        summary = make_reader(f).get_summary()
+    if summary is None:
+        raise McapError(f'{path} has no summary section (cut off before it was closed? '
+                        'see README, "Recovering a recording")')
+    counts = summary.statistics.channel_message_counts if summary.statistics else {}
+    lines = [f'{path}: {summary.statistics.message_count if summary.statistics else "?"} '
+             'messages']
+    for cid, channel in sorted(summary.channels.items(), key=lambda c: c[1].topic):
+        schema = summary.schemas.get(channel.schema_id)
+        lines.append(f'  {channel.topic:<36} {schema.name if schema else "?":<36} '
+                     f'{counts.get(cid, 0)}')
+    for a in summary.attachment_indexes:
+        lines.append(f'  attachment {a.name} ({a.data_size} bytes)')
+    for m in summary.metadata_indexes:
+        lines.append(f'  metadata {m.name}')
+    return '\n'.join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parse(sys.argv[1:] if argv is None else argv)
+    try:
+        if args.info:
+            print(info(args.recording))
+            return 0
+        f = open(args.recording, 'rb')
+    except (OSError, McapError) as exc:
+        print(f'replay: {args.recording}: {exc}', file=sys.stderr)
+        return 2
+    rclpy.init()
+    node = Node('replay')
+    publishers: dict[int, object] = {}
+    sent = 0
+    try:
+        reader = make_reader(f)
+        start_log = start_wall = None
+        for schema, channel, message in reader.iter_messages(
+                topics=args.topics or None, log_time_order=True):
+            pub = publishers.get(channel.id)
+            if pub is None:
+                msg_type = message_type(schema.name)
+                topic = args.prefix.rstrip('/') + channel.topic if args.prefix else channel.topic
+                latched = channel.topic.rsplit('/', 1)[-1] in LATCHED_TOPICS
+                pub = publishers[channel.id] = node.create_publisher(
+                    msg_type, topic, LATCHED if latched else STREAM)
+                time.sleep(MATCH_WAIT if start_log is None else 0.0)
+            if start_log is None:
+                start_log, start_wall = message.log_time, time.monotonic()
+            due = start_wall + (message.log_time - start_log) / 1e9 / args.rate
+            delay = due - time.monotonic()
+            if delay > 0:
+                time.sleep(delay)
+            pub.publish(message.data)
+            sent += 1
+        print(f'replay: published {sent} messages on {len(publishers)} topics',
+              file=sys.stderr)
+        return 0
+    except KeyboardInterrupt:
+        print(f'\nreplay: stopped after {sent} messages', file=sys.stderr)
+        return 130
+    except (McapError, ValueError, AttributeError, ModuleNotFoundError) as exc:
+        print(f'replay: {args.recording}: after {sent} messages: {type(exc).__name__}: {exc}',
+              file=sys.stderr)
+        return 1
+    finally:
+        f.close()
+        node.destroy_node()
+        rclpy.try_shutdown()

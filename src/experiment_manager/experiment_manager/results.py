@@ -1,0 +1,169 @@
+"""Results files of a run, written as iterations finish.
+
+A run directory holds:
+- `experiment.yaml`: the experiment file as it was read;
+- `iterations.csv`: one row per iteration (ITERATION_COLUMNS);
+- `checks.csv`: one row per validity check (CHECK_COLUMNS);
+- `parts.csv`: one row per part per check, with its pose and stage (PART_COLUMNS);
+- `picks.csv`: one row per picked part, with the gripper pose (PICK_COLUMNS);
+- `summary.json`: the metrics, rewritten (atomically) after each experiment.
+
+An iteration's rows are appended and flushed together, `iterations.csv` last: a run that stops
+keeps every finished iteration, and an `iterations.csv` row means the iteration is whole. On
+resume, rows of unfinished iterations are dropped from the other files and the finished ones
+are skipped. Floats are written with repr(), which reads back to the same float.
+"""
+
+import csv
+import json
+import os
+import tempfile
+
+from pick_sim_world.errors import InvalidArgument
+
+from .experiments import GRIPPER_POSE, POSE, Record
+
+KEY = ('experiment', 'group', 'iteration')
+ITERATION_COLUMNS = (
+    'experiment', 'type', 'group', 'iteration', 'seed', 'container_x', 'container_y',
+    'container_z', 'parts', 'checked', 'candidates', 'placeable', 'container_free', 'valid',
+    'checks', 'picks', 'settled', 'escaped', 'emptied', 'vibrations', 'feeds', 'lost', 'stop',
+    'wall_time')
+CHECK_COLUMNS = (*KEY, 'check', 'parts_on_table', 'checked', 'candidates', 'placeable',
+                 'container_free', 'valid', 'picked_id', 'searches', 'vibrations', 'wall_time')
+PART_COLUMNS = (*KEY, 'check', 'part_id', *POSE, 'inside', 'stage', 'grasp', 'tilts')
+PICK_COLUMNS = (*KEY, 'pick', 'check', 'part_id', 'searches', 'vibrations', 'grasp',
+                *GRIPPER_POSE)
+FILES = {'iterations': ITERATION_COLUMNS, 'checks': CHECK_COLUMNS, 'parts': PART_COLUMNS,
+         'picks': PICK_COLUMNS}
+TEXT = {'experiment', 'type', 'stop'}
+FLOAT = {'container_x', 'container_y', 'container_z', 'wall_time', *POSE, *GRIPPER_POSE}
+BOOL = {'settled', 'emptied', 'inside'}
+
+
+def parse_row(row: dict) -> dict:
+    """A CSV row with its values typed again."""
+    out = {}
+    for k, v in row.items():
+        if k in TEXT:
+            out[k] = v
+        elif k in FLOAT:
+            out[k] = float(v)
+        elif k in BOOL:
+            out[k] = v == 'True'
+        else:
+            out[k] = int(v)
+    return out
+
+
+def read_csv(path: str) -> list[dict]:
+    with open(path, newline='', encoding='utf-8') as f:
+        return [parse_row(r) for r in csv.DictReader(f)]
+
+
+def _key(row: dict) -> tuple:
+    return row['experiment'], row['group'], row['iteration']
+
+
+class ResultsWriter:
+    """The results of one run directory. `resume`: keep the finished iterations found there."""
+
+    def __init__(self, directory: str, experiment_text: str, resume: bool = False) -> None:
+        self.directory = directory
+        self._rows: dict[str, list[dict]] = {'iterations': [], 'picks': []}
+        try:
+            os.makedirs(directory, exist_ok=True)
+            probe = tempfile.NamedTemporaryFile(dir=directory, prefix='.write-test-')
+            probe.close()
+        except OSError as exc:
+            raise InvalidArgument('output_dir', directory,
+                                  f'cannot be written: {exc.strerror or exc}') from None
+        existing = os.path.exists(self.path('iterations'))
+        if existing and not resume:
+            raise InvalidArgument('output_dir', directory, 'already holds results: resume '
+                                  'the run there, or choose another directory')
+        if resume and not existing:
+            raise InvalidArgument('output_dir', directory, 'holds no run to resume '
+                                  '(no iterations.csv)')
+        if resume:
+            self._resume(experiment_text)
+        else:
+            self._write_text('experiment.yaml', experiment_text)
+        self._files = {}
+        self._writers = {}
+        for name, columns in FILES.items():
+            new = not os.path.exists(self.path(name))
+            f = open(self.path(name), 'a', newline='', encoding='utf-8')
+            self._files[name] = f
+            self._writers[name] = csv.DictWriter(f, columns, extrasaction='raise')
+            if new:
+                self._writers[name].writeheader()
+                f.flush()
+        self._done = {_key(r) for r in self._rows['iterations']}
+
+    def path(self, name: str) -> str:
+        return os.path.join(self.directory, name if '.' in name else f'{name}.csv')
+
+    def _write_text(self, name: str, text: str) -> None:
+        """Write a file atomically (a reader never sees half of it)."""
+        fd, tmp = tempfile.mkstemp(dir=self.directory, prefix=f'.{name}.')
+        with os.fdopen(fd, 'w', encoding='utf-8') as f:
+            f.write(text)
+        os.replace(tmp, self.path(name))
+
+    def _resume(self, experiment_text: str) -> None:
+        try:
+            with open(self.path('experiment.yaml'), encoding='utf-8') as f:
+                before = f.read()
+        except OSError:
+            before = None
+        if before != experiment_text:
+            raise InvalidArgument('experiment_file', self.path('experiment.yaml'),
+                                  'differs from the file of the run being resumed: results '
+                                  'would mix two experiments')
+        done = {_key(r) for r in read_csv(self.path('iterations'))}
+        for name, columns in FILES.items():
+            if not os.path.exists(self.path(name)):
+                continue
+            rows = [r for r in read_csv(self.path(name)) if _key(r) in done]
+            if name in self._rows:
+                self._rows[name] = rows
+            # Drop the rows of the iteration that was in flight.
+            fd, tmp = tempfile.mkstemp(dir=self.directory, prefix=f'.{name}.')
+            with os.fdopen(fd, 'w', newline='', encoding='utf-8') as f:
+                writer = csv.DictWriter(f, columns)
+                writer.writeheader()
+                writer.writerows(rows)
+            os.replace(tmp, self.path(name))
+
+    # ------------------------------------------------------------------------- Sink
+    def is_done(self, experiment_id: str, group: int, iteration: int) -> bool:
+        return (experiment_id, group, iteration) in self._done
+
+    def write(self, record: Record) -> None:
+        for name, rows in (('parts', record.parts), ('checks', record.checks),
+                           ('picks', record.picks), ('iterations', [record.iteration])):
+            self._writers[name].writerows(rows)
+            self._files[name].flush()
+        self._rows['iterations'].append(record.iteration)
+        self._rows['picks'] += record.picks
+        self._done.add(_key(record.iteration))
+
+    def iterations(self, experiment_id: str) -> list[dict]:
+        return [r for r in self._rows['iterations'] if r['experiment'] == experiment_id]
+
+    def picks(self, experiment_id: str) -> list[dict]:
+        return [r for r in self._rows['picks'] if r['experiment'] == experiment_id]
+
+    def write_summary(self, summary: dict) -> None:
+        self._write_text('summary.json', json.dumps(summary, indent=2, allow_nan=False) + '\n')
+
+    def close(self) -> None:
+        for f in self._files.values():
+            f.close()
+
+    def __enter__(self) -> 'ResultsWriter':
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
