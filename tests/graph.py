@@ -6,11 +6,10 @@ uses) and talk to the test's client node over DDS on loopback.
 
 from collections.abc import Callable
 import os
-import signal
-import subprocess
+import tempfile
 import time
 
-from ament_index_python.packages import get_package_prefix
+from experiment_manager import launcher
 import rclpy
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
@@ -33,34 +32,14 @@ def unique_namespace(base: str) -> str:
     return f'/{base}_{os.getpid()}'
 
 
-def executable(package: str, name: str) -> str:
-    """The installed executable, where `ros2 run package name` finds it."""
-    return os.path.join(get_package_prefix(package), 'lib', package, name)
-
-
-class NodeProcess:
-    """A node started as a process; stop() sends SIGINT and returns its exit code."""
+class NodeProcess(launcher.NodeProcess):
+    """A node started as a process, its output in a temporary log file (a pipe nobody reads
+    can fill and stall the node)."""
 
     def __init__(self, package: str, name: str, args: list[str]) -> None:
-        self.command = [executable(package, name), '--ros-args', *args]
-        self.process = subprocess.Popen(self.command, stdout=subprocess.PIPE,
-                                        stderr=subprocess.STDOUT, text=True)
-
-    def stop(self, timeout: float = 20.0) -> int:
-        if self.process.poll() is None:
-            self.process.send_signal(signal.SIGINT)
-            try:
-                self.process.wait(timeout)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait()
-        return self.process.returncode
-
-    def output(self) -> str:
-        return self.process.stdout.read() if self.process.stdout else ''
-
-    def running(self) -> bool:
-        return self.process.poll() is None
+        fd, log = tempfile.mkstemp(prefix=f'{name}_', suffix='.log')
+        os.close(fd)
+        super().__init__(package, name, args, log)
 
 
 class Client:

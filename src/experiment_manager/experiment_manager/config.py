@@ -26,7 +26,7 @@ from pick_sim_world.containers import (
     TRAY_DEFAULT_SIZE,
 )
 from pick_sim_world.errors import check_int, check_number, InvalidArgument
-from pick_sim_world.parts import build_part, PartGeometry, PartSpec
+from pick_sim_world.parts import build_part, BUILTIN_MODELS, PartGeometry, PartSpec
 from pick_sim_world.world import PACKING_LIMIT
 from pick_validity.config import (
     CAPACITOR_GRASPS,
@@ -204,9 +204,12 @@ MM, G, DEG = 1e-3, 1e-3, math.pi / 180.0
 
 
 def _part(m: _Map, base_dir: str) -> tuple[PartSpec, tuple[GraspPose, ...], PlaceSpec]:
-    model = m.text('model', 'radial_capacitor')
+    model = m.text('model', 'radial_capacitor', (*sorted(BUILTIN_MODELS), 'mesh'))
     mesh = m.text('mesh', '')
+    mass = m.number('mass_g', 0.0, low=0.0, high=10_000.0, scale=G)
     if model == 'mesh':
+        if mass == 0.0:
+            raise InvalidArgument(m.where('mass_g'), 0, 'is required (> 0) for a mesh part')
         if not mesh:
             raise InvalidArgument(m.where('mesh'), mesh, 'is required when model is mesh')
         mesh = os.path.normpath(os.path.join(base_dir, os.path.expanduser(mesh)))
@@ -224,7 +227,7 @@ def _part(m: _Map, base_dir: str) -> tuple[PartSpec, tuple[GraspPose, ...], Plac
                               'is a count, not a length: give it as part.pins_per_row')
     if 'pins_per_row' in m.value:
         dimensions['pins_per_row'] = m.integer('pins_per_row', 0, 1, 64)
-    mass = m.number('mass_g', 0.0, low=0.0, high=10_000.0, scale=G)
+
     spec = PartSpec(
         model=model, dimensions=dimensions, mass=mass or None,
         lateral_friction=m.number('lateral_friction', 0.5, low=0.0, high=10.0),

@@ -23,6 +23,8 @@ from pick_sim_world.errors import InvalidArgument
 
 from .experiments import GRIPPER_POSE, POSE, Record
 
+UMASK = os.umask(0o022)
+os.umask(UMASK)
 KEY = ('experiment', 'group', 'iteration')
 ITERATION_COLUMNS = (
     'experiment', 'type', 'group', 'iteration', 'seed', 'container_x', 'container_y',
@@ -109,6 +111,7 @@ class ResultsWriter:
         fd, tmp = tempfile.mkstemp(dir=self.directory, prefix=f'.{name}.')
         with os.fdopen(fd, 'w', encoding='utf-8') as f:
             f.write(text)
+        os.chmod(tmp, 0o666 & ~UMASK)   # as open() would create it, not mkstemp's 0600
         os.replace(tmp, self.path(name))
 
     def _resume(self, experiment_text: str) -> None:
@@ -134,6 +137,7 @@ class ResultsWriter:
                 writer = csv.DictWriter(f, columns)
                 writer.writeheader()
                 writer.writerows(rows)
+            os.chmod(tmp, 0o666 & ~UMASK)
             os.replace(tmp, self.path(name))
 
     # ------------------------------------------------------------------------- Sink

@@ -1,0 +1,121 @@
+"""The experiment file: the default parses into SI units; every kind of bad file is refused with
+a message naming the field, the value and the rule."""
+
+import math
+import os
+import re
+
+from experiment_manager import config
+from pick_sim_world.errors import InvalidArgument
+import pytest
+
+HERE = os.path.dirname(__file__)
+DEFAULT = os.path.join(HERE, '..', 'config', 'default_experiment.yaml')
+MINIMAL = """id: t
+experiments:
+  - {id: b, type: bin_static, iterations: 1, parts: 10, bins_mm: [[100, 100, 20]]}
+"""
+
+
+def test_the_default_file_parses_into_si_units():
+    f = config.load(DEFAULT)
+    assert f.id == 'capacitor_demo' and [e.type for e in f.experiments] == list(config.TYPES)
+    assert f.gripper.body_diameter == pytest.approx(0.020)
+    assert f.check.tolerance == pytest.approx(math.radians(45))
+    assert f.tray.inner_size == pytest.approx((0.195, 0.150, 0.027))
+    assert f.vibration.amplitude == pytest.approx((0.0, 0.0, 0.003))
+    assert f.requirements.refill_interval == 4 * 3600 and f.requirements.capacity == 480
+    emptying = f.experiment('emptying')
+    assert emptying.bin is None and emptying.bin_from == 'bins'
+    assert f.experiment('feeder').range_from == 'sweep'
+    assert f.experiment('sweep').counts == tuple(range(5, 61, 5))
+
+
+def test_omitted_keys_take_the_documented_defaults():
+    f = config.parse(MINIMAL)
+    assert f.seed == 0 and f.search_order == 'top_first' and len(f.grasps) == 5
+    assert f.experiments[0].bins[0].inner_size == pytest.approx((0.1, 0.1, 0.02))
+    assert f.experiments[0].bins[0].wall_thickness == pytest.approx(0.003)
+
+
+BAD = [
+    ('colour: red\n' + MINIMAL, r"colour: 'red' is not a known key here \(known: "),
+    ('gripper: {body_diameter: 20}\n' + MINIMAL,
+     r'gripper\.body_diameter: 20 is not a known key here \(known: body_diameter_mm'),
+    ('seed: abc\n' + MINIMAL, r"seed: 'abc' is not an integer"),
+    ('seed: -1\n' + MINIMAL, r'seed: -1 must be within \[0, '),
+    ('check: {tolerance_deg: .nan}\n' + MINIMAL, r'check\.tolerance_deg: nan must be finite'),
+    ('check: {tolerance_deg: 120}\n' + MINIMAL, r'check \(check\.tolerance\): .* must be <='),
+    ('check: {search_order: nearest}\n' + MINIMAL, r'search_order: .nearest. must be one of'),
+    (MINIMAL.replace('iterations: 1', 'iterations: 0'),
+     r'experiments\[0\]\.iterations: 0 must be within \[1, 10000\]'),
+    (MINIMAL.replace('[[100, 100, 20]]', '[[400, 100, 20]]'),
+     r'experiments\[0\]\.bins_mm\[0\]\[0\]: 400\.0 mm is over the size limit '
+     r'requirements\.max_dimension_mm = 300'),
+    (MINIMAL.replace('[[100, 100, 20]]', '[[100, 100]]'),
+     r'bins_mm\[0\]: \[100, 100\] must be a list of 3 numbers'),
+    (MINIMAL.replace('parts: 10', 'parts: 3000'),
+     r'experiments\[0\]\.parts \(bins_mm\[0\]\): 3000 parts do not fit a container of '
+     r'100 x 100 x 20 mm: .* at most \d+ within the packing limit'),
+    (MINIMAL.replace('type: bin_static', 'type: bin_sweep'), r'type: .bin_sweep. must be one of'),
+    ('id: t\n', r'experiments: None is required'),
+    ('id: t\nexperiments: []\n', r'experiments: \[\] must be a list of 1\.\.50'),
+    ('id: "t/../x"\n' + MINIMAL.split('\n', 1)[1], r'id: .t/\.\./x. must be 1\.\.64 letters'),
+    (MINIMAL + '  - {id: b, type: bin_emptying, iterations: 1, parts: 10, bin: b}\n',
+     r'experiments\[1\]\.id: .b. is the id of an earlier experiment'),
+    (MINIMAL + '  - {id: e, type: bin_emptying, iterations: 1, parts: 10, bin: nope}\n',
+     r'experiments\[1\]\.bin: .nope. names no earlier bin_static experiment'),
+    (MINIMAL + '  - {id: f, type: feeder_emptying, iterations: 1, parts: 10, '
+     'optimal_range: [30, 20]}\n', r'optimal_range: \[30, 20\] has min > max'),
+    (MINIMAL + '  - {id: f, type: feeder_emptying, iterations: 1, parts: 10, '
+     'optimal_range: b}\n', r'optimal_range: .b. names no earlier table_sweep'),
+    (MINIMAL + '  - {id: s, type: table_sweep, iterations: 1, counts: {first: 9, last: 3}}\n',
+     r'counts\.last: 3 must be within \[9, '),
+    (MINIMAL + '  - {id: s, type: table_sweep, iterations: 1, bins_mm: [[1, 1, 1]]}\n',
+     r'experiments\[1\]\.bins_mm: .* is not a known key here'),
+    ('part: {model: mesh, mass_g: 1, mesh: no_such.stl}\n' + MINIMAL,
+     r'part\.mesh: .*no_such\.stl. does not exist or is not a file'),
+    ('part: {model: mesh, mass_g: 1}\n' + MINIMAL,
+     r'part\.mesh: .. is required when model is mesh'),
+    ('part: {model: resistor}\n' + MINIMAL,
+     r"part\.model: 'resistor' must be one of dip, radial_capacitor, to220, mesh"),
+    ('part: {model: mesh, mesh: x.stl}\n' + MINIMAL, r'part\.mass_g: 0 is required'),
+    ('part: {dimensions_mm: {body_diameter: -5}}\n' + MINIMAL,
+     r'part\.dimensions_mm\.body_diameter: -5 must be > 0'),
+    ('part: {dimensions_mm: {pins_per_row: 4}}\n' + MINIMAL, r'pins_per_row.*is a count'),
+    ('part:\n  grasps:\n    - {up_axis: [0, 0, 1], closing_axis: [0, 0, 2], jaw_opening_mm: 5}\n'
+     + MINIMAL, r'part\.grasps \(grasps\.grasp_0\.closing_axis\): .* is parallel to up_axis'),
+    ('part:\n  grasps:\n    - {up_axis: [0, 0, 1], closing_axis: [1, 0, 0]}\n' + MINIMAL,
+     r'part\.grasps\[0\]\.jaw_opening_mm: None is required'),
+    ('vibration: {amplitude_mm: [0, 0, 10], frequency_hz: 50}\n' + MINIMAL,
+     r'vibration \(vibration\.amplitude\): .* gives a peak acceleration of .* \(limit 200\)'),
+    ('experiments: [\n', r'line \d+, column \d+: .* is not valid YAML'),
+    ('- just\n- a list\n', r'file: .* must be a mapping of keys'),
+]
+
+
+@pytest.mark.parametrize('text, message', BAD)
+def test_a_bad_file_is_refused_with_field_value_and_rule(text, message):
+    with pytest.raises(InvalidArgument) as info:
+        config.parse(text)
+    assert re.search(message, str(info.value)), str(info.value)
+
+
+def test_a_file_that_cannot_be_read_is_named(tmp_path):
+    with pytest.raises(InvalidArgument, match=r"experiment_file: '.*missing\.yaml' cannot be "
+                       'read: No such file'):
+        config.load(str(tmp_path / 'missing.yaml'))
+    (tmp_path / 'binary.yaml').write_bytes(b'\xff\xfe\x00')
+    with pytest.raises(InvalidArgument, match='is not UTF-8 text'):
+        config.load(str(tmp_path / 'binary.yaml'))
+
+
+def test_a_mesh_path_is_relative_to_the_file(tmp_path):
+    import trimesh
+    trimesh.creation.box((0.004, 0.002, 0.01)).export(tmp_path / 'clip.stl')
+    path = tmp_path / 'exp.yaml'
+    path.write_text('part:\n  model: mesh\n  mesh: clip.stl\n  mass_g: 0.2\n  grasps:\n'
+                    '    - {up_axis: [0, 0, 1], closing_axis: [1, 0, 0], jaw_opening_mm: 8}\n'
+                    + MINIMAL)
+    f = config.load(str(path))
+    assert f.part.mesh_path == str(tmp_path / 'clip.stl')

@@ -1,0 +1,166 @@
+"""The four experiment types on the real cores (LocalBackend: PyBullet, FCL, the feeder
+policy), the results files they leave, resumption, and the metrics."""
+
+import csv
+import json
+import os
+
+from experiment_manager import config, metrics
+from experiment_manager.experiments import iteration_seed, plan, Runner, search_order
+from experiment_manager.local_backend import LocalBackend
+from experiment_manager.results import FILES, ResultsWriter
+from feeder_controller.policy import NAMES
+import numpy as np
+from pick_sim_world.errors import InvalidArgument
+from pick_sim_world.world import PartStates
+import pytest
+
+SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
+
+
+def read(directory: str, name: str) -> list[dict]:
+    with open(os.path.join(directory, f'{name}.csv'), newline='') as f:
+        return [{k: v for k, v in r.items() if k != 'wall_time'} for r in csv.DictReader(f)]
+
+
+def run(directory: str, resume: bool = False, file=None) -> dict:
+    file = file or config.load(SMALL)
+    with LocalBackend() as backend, ResultsWriter(directory, file.text, resume) as writer:
+        return Runner(file, backend, writer).run()
+
+
+@pytest.fixture(scope='module')
+def small(tmp_path_factory):
+    directory = str(tmp_path_factory.mktemp('small'))
+    return directory, run(directory)
+
+
+def test_every_type_records_its_rows_and_metrics(small):
+    directory, summary = small
+    rows = read(directory, 'iterations')
+    by_type = {t: [r for r in rows if r['type'] == t] for t in config.TYPES}
+    assert [len(by_type[t]) for t in config.TYPES] == [4, 1, 8, 1]
+    for r in rows:
+        n = [int(r[k]) for k in ('checked', 'candidates', 'placeable', 'container_free')]
+        assert n == sorted(n, reverse=True), r      # each stage passes a subset of the last
+        assert r['settled'] == 'True' and int(r['escaped']) == 0
+    s = summary['experiments']
+    assert s['bins']['best_bin'] in (0, 1)
+    best = s['bins']['bins'][s['bins']['best_bin']]
+    assert best['fractions']['container_free']['mean'] == max(
+        b['fractions']['container_free']['mean'] for b in s['bins']['bins'])
+    assert s['emptying']['bin_mm'] == best['size_mm']
+    # bin_emptying: one pick per check but the last, each the first valid in search order.
+    picks = [p for p in read(directory, 'picks') if p['experiment'] == 'emptying']
+    checks = [c for c in read(directory, 'checks') if c['experiment'] == 'emptying']
+    assert len(picks) == int(by_type['bin_emptying'][0]['picks']) == len(checks) - 1 + (
+        by_type['bin_emptying'][0]['stop'] == 'empty')
+    parts = read(directory, 'parts')
+    for p in picks:
+        stages = {r['part_id']: int(r['stage']) for r in parts
+                  if r['experiment'] == 'emptying' and r['check'] == p['check']}
+        assert stages[p['part_id']] == 5 and int(p['searches']) >= 1
+        assert np.isfinite([float(p[k]) for k in p if k.startswith('gripper_')]).all()
+    # table_sweep: the fit's optimum lies in the tested range, the range is n* +- margin.
+    sweep = s['sweep']
+    assert [x['n'] for x in sweep['per_n']] == [2, 6, 10, 14]
+    assert 2 <= sweep['n_star'] <= 14 and sweep['order'] == 3
+    assert sweep['optimal_range'] == [max(1, sweep['n_star'] - 2), sweep['n_star'] + 2]
+    # feeder_emptying: the range came from the sweep; the run stopped by the policy.
+    feeder = by_type['feeder_emptying'][0]
+    assert s['feeder']['optimal_range'] == sweep['optimal_range']
+    assert feeder['stop'] in NAMES and int(feeder['vibrations']) <= 15
+    assert int(feeder['picks']) + int(feeder['lost']) <= 12
+    with open(os.path.join(directory, 'summary.json')) as f:
+        assert json.load(f) == summary
+
+
+def test_runs_are_deterministic_and_independent_of_order(small, tmp_path):
+    directory, _ = small
+    file = config.load(SMALL)
+    summary: dict = {}
+    units = []
+    for exp in file.experiments:   # planned as the run plans them, then run backwards
+        units += plan(file, exp, summary)
+        summary[exp.id] = json.load(open(os.path.join(directory, 'summary.json')))[
+            'experiments'][exp.id]
+    records = {}
+    with LocalBackend() as backend:
+        runner = Runner(file, backend, None)
+        backend.start(file)
+        for u in reversed(units):
+            records[(u.experiment.id, u.group, u.iteration)] = runner.run_unit(u)
+    rows = read(directory, 'iterations')
+    for row in rows:
+        again = records[(row['experiment'], int(row['group']), int(row['iteration']))]
+        assert {k: str(v) for k, v in again.iteration.items() if k != 'wall_time'} == row
+
+
+def test_an_interrupted_run_resumes_to_the_same_results(small, tmp_path):
+    directory, summary = small
+    file = config.load(SMALL)
+
+    class Interrupt(Exception):
+        pass
+
+    class StopAfter(ResultsWriter):
+        def write(self, record):
+            if record.iteration['experiment'] == 'sweep' and record.iteration['group'] == 6:
+                # half of the iteration's rows are written, then the run dies
+                self._writers['parts'].writerows(record.parts[:3])
+                self._files['parts'].flush()
+                raise Interrupt
+            super().write(record)
+
+    out = str(tmp_path / 'run')
+    with LocalBackend() as backend, StopAfter(out, file.text) as writer:
+        with pytest.raises(Interrupt):
+            Runner(file, backend, writer).run()
+    assert len(read(out, 'iterations')) == 7        # every finished iteration is on disk
+    with pytest.raises(InvalidArgument, match='already holds results'):
+        ResultsWriter(out, file.text)
+    with pytest.raises(InvalidArgument, match='differs from the file of the run'):
+        ResultsWriter(out, file.text + '# edited\n', resume=True)
+    assert run(out, resume=True) == summary
+    for name in FILES:
+        assert read(out, name) == read(directory, name), name
+
+
+def test_an_unwritable_output_directory_is_named(tmp_path):
+    blocker = tmp_path / 'file'
+    blocker.write_text('')
+    with pytest.raises(InvalidArgument, match=r"output_dir: '.*file/run' cannot be written"):
+        ResultsWriter(str(blocker / 'run'), 'x')
+    with pytest.raises(InvalidArgument, match='holds no run to resume'):
+        ResultsWriter(str(tmp_path / 'empty'), 'x', resume=True)
+
+
+def test_iteration_seeds_differ_per_key_and_do_not_change():
+    seeds = {iteration_seed(7, e, (g, i)) for e in ('a', 'b') for g in range(3)
+             for i in range(3)}
+    assert len(seeds) == 18 and all(0 <= s < 2**63 for s in seeds)
+    assert iteration_seed(7, 'a', (0, 0)) == iteration_seed(7, 'a', (0, 0))
+    assert iteration_seed(7, 'a', (0, 0)) != iteration_seed(8, 'a', (0, 0))
+
+
+def test_search_orders():
+    poses = np.zeros((4, 7))
+    poses[:, 2] = [0.01, 0.03, 0.02, 0.03]
+    states = PartStates(np.array([5, 6, 7, 8]), np.zeros(4, int), poses, np.ones(4, bool), 0.0)
+    targets = np.array([5, 6, 7, 8])
+    assert search_order('top_first', states, targets, 0).tolist() == [6, 8, 7, 5]
+    assert search_order('id', states, targets[::-1], 0).tolist() == [5, 6, 7, 8]
+    shuffled = search_order('random', states, targets, 3).tolist()
+    assert sorted(shuffled) == [5, 6, 7, 8]
+    assert shuffled == search_order('random', states, targets, 3).tolist()
+
+
+def test_the_fit_finds_the_maximum_of_a_known_curve():
+    n = np.repeat(np.arange(1, 61), 3)
+    valid = 20.0 - 0.02 * (n - 37.0) ** 2 + 1e-6 * (n - 37.0) ** 4
+    fit = metrics.fit_optimum(n, valid, 1, 60, 5)
+    assert fit['order'] == 4 and fit['n_star'] == 37 and fit['optimal_range'] == [32, 42]
+    assert metrics.fit_optimum([4, 4], [1, 3], 4, 4, 5)['optimal_range'] == [1, 9]
+    assert metrics.stats([1, 2, 3]) == {'n': 3, 'mean': 2.0, 'min': 1.0, 'max': 3.0,
+                                        'std': 1.0}
+    assert metrics.stats([])['mean'] is None
