@@ -23,7 +23,7 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 LATCHED_TOPICS = ('scene', 'markers')
 STREAM = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
-MATCH_WAIT = 1.0     # s given to subscribers to match before the first message
+MATCH_WAIT = 2.0     # s a new topic waits for a subscriber to match before its first message
 
 
 def message_type(name: str) -> type:
@@ -97,7 +97,12 @@ def main(argv: list[str] | None = None) -> int:
                 latched = channel.topic.rsplit('/', 1)[-1] in LATCHED_TOPICS
                 pub = publishers[channel.id] = node.create_publisher(
                     msg_type, topic, LATCHED if latched else STREAM)
-                time.sleep(MATCH_WAIT if start_log is None else 0.0)
+                deadline = time.monotonic() + MATCH_WAIT
+                while pub.get_subscription_count() == 0 and time.monotonic() < deadline:
+                    time.sleep(0.02)
+                if start_log is not None:   # keep the recorded spacing after the wait
+                    start_wall = time.monotonic() - (
+                        message.log_time - start_log) / 1e9 / args.rate
             if start_log is None:
                 start_log, start_wall = message.log_time, time.monotonic()
             due = start_wall + (message.log_time - start_log) / 1e9 / args.rate

@@ -1,0 +1,190 @@
+"""End to end: the `run` command brings up world, validity, feeder_controller and
+experiment_manager as processes, runs a small file of every experiment type over DDS, and leaves
+results and a recording. The recording is decoded by an independent reader (mcap-ros2-support,
+from the schema text in the file) and matched against the results; the results are matched
+against the same file run on the cores in one process. Then: replay, a bad file, a second goal,
+and a node killed mid-run."""
+
+import csv
+import glob
+import os
+import re
+import signal
+import subprocess
+import time
+
+from experiment_manager import config
+from experiment_manager.experiments import Runner
+from experiment_manager.launcher import executable
+from experiment_manager.local_backend import LocalBackend
+from experiment_manager.results import FILES, ResultsWriter
+from graph import unique_namespace
+from mcap.reader import make_reader
+from mcap_ros2.decoder import DecoderFactory
+from pick_msgs.action import RunExperiment
+from pick_msgs.msg import ValidityReport
+import pytest
+from rclpy.action import ActionClient
+
+pytestmark = pytest.mark.graph
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SMALL = os.path.join(ROOT, 'src', 'experiment_manager', 'test', 'small_experiment.yaml')
+NS = unique_namespace('exp')
+STAGE_COUNTS = ('checked', 'candidates', 'placeable', 'container_free', 'valid')
+
+
+def rows(directory: str, name: str, drop=('wall_time',)) -> list[dict]:
+    with open(os.path.join(directory, f'{name}.csv'), newline='') as f:
+        return [{k: v for k, v in r.items() if k not in drop} for r in csv.DictReader(f)]
+
+
+def run_command(*args: str, timeout: float = 600.0) -> subprocess.CompletedProcess:
+    return subprocess.run([executable('experiment_manager', 'run'), *args],
+                          capture_output=True, text=True, timeout=timeout)
+
+
+@pytest.fixture(scope='module')
+def graph_run(tmp_path_factory, private_ros_domain):
+    out, logs = tmp_path_factory.mktemp('out'), tmp_path_factory.mktemp('logs')
+    done = run_command(SMALL, '--output', str(out), '--namespace', NS, '--logs', str(logs))
+    node_logs = '\n'.join(f'== {p}\n{open(p).read()[-3000:]}' for p in glob.glob(f'{logs}/*'))
+    assert done.returncode == 0, done.stderr + node_logs
+    run_dir = re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1)
+    recording = re.search(r'^recording:\s+(\S+)', done.stdout, re.M).group(1)
+    return run_dir, recording, done
+
+
+def test_the_graph_gives_the_results_of_the_cores(graph_run, tmp_path):
+    run_dir, _, done = graph_run
+    assert 'best bin' in done.stdout and 'optimum' in done.stdout
+    file = config.load(SMALL)
+    with LocalBackend() as backend, ResultsWriter(str(tmp_path), file.text) as writer:
+        Runner(file, backend, writer).run()
+    for name in FILES:
+        assert rows(run_dir, name) == rows(str(tmp_path), name), name
+
+
+def test_every_recorded_message_decodes_and_matches_the_results(graph_run):
+    run_dir, recording, _ = graph_run
+    with open(recording, 'rb') as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        messages = [(channel.topic, msg) for _, channel, _, msg
+                    in reader.iter_decoded_messages(log_time_order=True)]
+        attachments = {a.name: a.data for a in reader.iter_attachments()}
+    by_topic: dict[str, list] = {}
+    for topic, msg in messages:
+        by_topic.setdefault(topic[len(NS):], []).append(msg)
+    assert set(by_topic) == {'/progress', '/worker_0/parts', '/worker_0/scene',
+                             '/worker_0/markers', '/worker_0/results',
+                             '/worker_0/feeder/state'}
+    iterations = rows(run_dir, 'iterations')
+    assert len(by_topic['/worker_0/scene']) == len(iterations)      # a reset per iteration
+    progress = by_topic['/progress'][-1]
+    assert progress.iterations_done == progress.iterations_total == len(iterations)
+
+    # One ValidityReport per check that had parts to check, in order, with the same counts
+    # and, part by part, the same stage as parts.csv.
+    checks = [c for c in rows(run_dir, 'checks') if int(c['parts_on_table'])]
+    reports = by_topic['/worker_0/results']
+    assert [tuple(getattr(r, k) for k in STAGE_COUNTS) for r in reports] == [
+        tuple(int(c[k]) for k in STAGE_COUNTS) for c in checks]
+    stages: dict[tuple, dict[int, int]] = {}
+    for p in rows(run_dir, 'parts'):
+        if p['inside'] == 'True':
+            key = (p['experiment'], p['group'], p['iteration'], p['check'])
+            stages.setdefault(key, {})[int(p['part_id'])] = int(p['stage'])
+    for c, r in zip(checks, reports, strict=True):
+        key = (c['experiment'], c['group'], c['iteration'], c['check'])
+        assert {x.part_id: x.stage_reached for x in r.results} == stages[key]
+    feeder = next(i for i in iterations if i['type'] == 'feeder_emptying')
+    assert by_topic['/worker_0/feeder/state'][-1].vibrations == int(feeder['vibrations'])
+
+    with open(SMALL, 'rb') as f:
+        assert attachments['experiment.yaml'] == f.read()
+    for name in ('iterations.csv', 'checks.csv', 'parts.csv', 'picks.csv', 'summary.json'):
+        with open(os.path.join(run_dir, name), 'rb') as f:
+            assert attachments[name] == f.read(), name
+
+
+def test_replay_republishes_a_topic_of_the_recording(graph_run, client):
+    _, recording, _ = graph_run
+    prefix = unique_namespace('replay')
+    expected = sum(1 for _ in make_reader(open(recording, 'rb')).iter_messages(
+        topics=[f'{NS}/worker_0/results']))
+    received = []
+    client.node.create_subscription(ValidityReport, f'{prefix}{NS}/worker_0/results',
+                                    received.append, 100)
+    replay = subprocess.Popen([executable('experiment_manager', 'replay'), recording,
+                               '--rate', '100', '--prefix', prefix,
+                               '--topics', f'{NS}/worker_0/results'],
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    assert client.wait(lambda: len(received) == expected, 60.0), replay.communicate()[0]
+    assert replay.wait(30) == 0
+    info = subprocess.run([executable('experiment_manager', 'replay'), recording, '--info'],
+                          capture_output=True, text=True, timeout=60)
+    assert f'{NS}/worker_0/results' in info.stdout and 'attachment iterations.csv' in info.stdout
+
+
+def test_a_bad_file_fails_before_any_node_starts(tmp_path):
+    bad = tmp_path / 'bad.yaml'
+    bad.write_text(open(SMALL).read().replace('max_vibrations: 15', 'max_vibrations: -3'))
+    start = time.monotonic()
+    done = run_command(str(bad), '--output', str(tmp_path), timeout=120)
+    assert done.returncode == 2
+    assert re.search(r'experiments\[3\]\.max_vibrations: -3 must be within \[1, ',
+                     done.stderr), done.stderr
+    assert time.monotonic() - start < 30 and 'node logs' not in done.stderr
+
+
+LONG = """id: long
+seed: 3
+experiments:
+  - {id: sweep, type: table_sweep, iterations: 1, counts: {first: 5, last: 5}}
+  - {id: feeder, type: feeder_emptying, iterations: 3, parts: 150, optimal_range: [20, 30],
+     max_vibrations: 100000}
+"""
+
+
+def _world_pid(namespace: str) -> int:
+    found = subprocess.run(['pgrep', '-f', f'lib/pick_sim_world/world --ros-args -r '
+                            f'__ns:={namespace}/worker_0'], capture_output=True, text=True)
+    return int(found.stdout.split()[0])
+
+
+def test_a_second_goal_is_busy_and_a_killed_world_ends_the_run(tmp_path, client,
+                                                               private_ros_domain):
+    ns = unique_namespace('exp_kill')
+    path = tmp_path / 'long.yaml'
+    path.write_text(LONG)
+    out = tmp_path / 'out'
+    run = subprocess.Popen([executable('experiment_manager', 'run'), str(path), '--output',
+                            str(out), '--namespace', ns, '--logs', str(tmp_path / 'logs')],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        def first_iteration_done() -> bool:
+            found = glob.glob(f'{out}/long_*/iterations.csv')
+            return bool(found) and len(open(found[0]).read().splitlines()) >= 2
+        assert client.wait(first_iteration_done, 120.0), 'no iteration finished'
+
+        manager = ActionClient(client.node, RunExperiment, f'{ns}/run_experiment')
+        assert client.wait(manager.server_is_ready, 30.0)
+        handle = client.result(manager.send_goal_async(RunExperiment.Goal(
+            experiment_file=str(path), output_dir=str(tmp_path / 'other'))))
+        busy = client.result(handle.get_result_async()).result
+        assert busy.error_code == RunExperiment.Result.BUSY and 'not queued' in busy.error_msg
+
+        os.kill(_world_pid(ns), signal.SIGKILL)
+        stdout, stderr = run.communicate(timeout=120)
+    finally:
+        if run.poll() is None:
+            run.kill()
+    assert run.returncode == 1, stderr
+    assert re.search(r'world \(pid \d+\) was killed by signal 9', stderr), stderr
+    assert 'finished iterations are kept in' in stderr
+    run_dir = glob.glob(f'{out}/long_*')[0]
+    assert [r['experiment'] for r in rows(run_dir, 'iterations')][:1] == ['sweep']
+    with open(os.path.join(run_dir, 'recording.mcap'), 'rb') as f:
+        summary = make_reader(f).get_summary()     # closed properly: it has a summary
+    assert summary is not None and summary.statistics.message_count > 0
+    assert {a.name for a in summary.attachment_indexes} >= {'experiment.yaml', 'iterations.csv'}
+    assert not os.path.exists(tmp_path / 'other'), 'the busy goal wrote nothing'
