@@ -19,8 +19,9 @@ def nodes(private_ros_domain):
         '-r', f'__ns:={NS}', '-p', 'container.kind:=tray', '-p', 'publish_markers:=false'])
     feeder = NodeProcess('feeder_controller', 'feeder_controller', ['-r', f'__ns:={NS}'])
     yield world, feeder
-    for proc in (world, feeder):
-        assert proc.stop() == 0, proc.output()
+    codes = [proc.stop() for proc in (world, feeder)]   # stop all before judging any
+    for proc, code in zip((world, feeder), codes, strict=True):
+        assert code == 0, proc.output()
 
 
 class Feeder:

@@ -28,8 +28,9 @@ def nodes(private_ros_domain):
         '-p', 'publish_markers:=false'])
     validity = NodeProcess('pick_validity', 'validity', ['-r', f'__ns:={NS}'])
     yield world, validity
-    for proc in (world, validity):
-        assert proc.stop() == 0, proc.output()
+    codes = [proc.stop() for proc in (world, validity)]   # stop all before judging any
+    for proc, code in zip((world, validity), codes, strict=True):
+        assert code == 0, proc.output()
 
 
 @pytest.fixture(scope='module')
