@@ -11,13 +11,14 @@ DEPS_STAMP := $(VENV)/.deps-stamp
 BUILD_STAMP := install/.build-stamp
 SOURCES := $(shell find src -type f -not -path '*/__pycache__/*' -not -name '*.pyc' 2>/dev/null)
 PYTEST_ARGS ?=
+RUN_ARGS ?=
 
 .PHONY: help run test lint bench deps build lock clean
 
 help:
-	@echo 'make run    - drop parts into a bin and onto a vibrating tray, print a summary'
+	@echo 'make run    - run the built-in experiment file through the graph (RUN_ARGS="file.yaml")'
 	@echo 'make test   - lint and run every test (installs and builds on first use)'
-	@echo 'make bench  - world and validity benchmarks (figures in the READMEs)'
+	@echo 'make bench  - world, validity and vibration benchmarks (figures in the READMEs)'
 	@echo 'make clean  - remove build/, install/, log/ (keeps the venv)'
 
 $(DEPS_STAMP): requirements.txt constraints.txt tools/fix_cmake_paths.py
@@ -37,7 +38,7 @@ $(BUILD_STAMP): $(DEPS_STAMP) $(SOURCES) colcon.meta
 build: $(BUILD_STAMP)
 
 run: $(BUILD_STAMP)
-	$(WS) install/pick_sim_world/lib/pick_sim_world/pick_world_demo
+	$(WS) install/experiment_manager/lib/experiment_manager/run $(RUN_ARGS)
 
 lint: $(DEPS_STAMP)
 	$(WS) ruff check src tests bench tools
@@ -48,6 +49,7 @@ test: $(BUILD_STAMP) lint
 bench: $(BUILD_STAMP)
 	$(WS) python bench/bench_world.py
 	$(WS) python bench/bench_validity.py
+	$(WS) python bench/bench_vibration.py
 
 lock: $(DEPS_STAMP)
 	$(VENV)/bin/python -m pip freeze --exclude-editable | sort > constraints.txt.new

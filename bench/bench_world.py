@@ -77,7 +77,7 @@ def bench_tray(seeds: list[int]) -> None:
     print('\n== 50 radial capacitors onto the 195 x 150 x 27 mm tray, then one vibration')
     runs = [drop(TRAY, 50, s, PhysicsConfig(), vibrate=True) for s in seeds]
     row('drop and settle', runs)
-    print(f'{"vibrate 1 s at 30 Hz, then settle":<44} '
+    print(f'{"one default vibration, then settle":<44} '
           f'wall {statistics.median(r["vib_wall"] for r in runs):6.2f} s  '
           f'sim {statistics.median(r["vib_sim"] for r in runs):5.2f} s  '
           f'settled {sum(r["vib_settled"] for r in runs)}/{len(runs)}  '

@@ -23,7 +23,6 @@ setup(
     entry_points={
         'console_scripts': [
             'world = pick_sim_world.world_node:main',
-            'pick_world_demo = pick_sim_world.demo:main',
         ],
     },
 )

@@ -24,6 +24,7 @@ from pick_msgs.action import RunExperiment
 from pick_sim_world.errors import InvalidArgument
 import rclpy
 from rclpy.action import ActionClient
+from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 
 from . import config
@@ -154,15 +155,16 @@ def main(argv: list[str] | None = None) -> int:
     bar = ProgressBar()
     try:
         return _run(node, client, goal, procs, bar)
-    except KeyboardInterrupt:
-        print('\nrun: interrupted; the run was canceled', file=sys.stderr)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        print('\nrun: interrupted; the run was canceled (its files are closed by the manager)',
+              file=sys.stderr)
         return 130
     finally:
         bar.close()
         client.destroy()
         node.destroy_node()
         rclpy.try_shutdown()
-        for p in procs:
+        for p in procs:   # SIGINT: the manager cancels its run and closes its files
             p.stop()
 
 

@@ -102,6 +102,8 @@ class ExperimentManagerNode(Node):
                                  experiment_type=p.experiment_type, phase=p.phase,
                                  iterations_total=p.total, iterations_done=p.done,
                                  elapsed=p.elapsed, eta=p.eta)
+        if self._stopping.is_set():
+            return   # shutting down: the publishers may be gone
         self._progress.publish(msg)
         if self._goal is not None:
             self._goal.publish_feedback(RunExperiment.Feedback(progress=msg))
@@ -162,8 +164,11 @@ class ExperimentManagerNode(Node):
         return result
 
     def _end(self, goal_handle, result) -> None:
-        if goal_handle.is_cancel_requested:
+        if goal_handle.is_cancel_requested or self._stopping.is_set():
             result.error_code = RunExperiment.Result.CANCELED
+        if self._stopping.is_set():
+            return   # shutting down: the action server is being destroyed
+        if goal_handle.is_cancel_requested:
             goal_handle.canceled()
         else:
             goal_handle.abort()

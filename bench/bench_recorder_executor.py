@@ -1,0 +1,98 @@
+"""Where the recording subscriptions run, and what it costs the calls the manager waits on.
+
+Starts a worker (world, validity, feeder_controller) and drives one feeder_emptying iteration
+through GraphBackend from a node on a multi-threaded executor, three ways: no recording
+subscriptions; the five recording subscriptions on that same node and executor; the five on
+their own node and single-threaded executor (TopicRecorder, what the manager does). Prints the
+wall time of the iteration and of each kind of call.
+
+    tools/ws python bench/bench_recorder_executor.py
+"""
+
+import collections
+import os
+import sys
+import tempfile
+import threading
+import time
+
+from experiment_manager import config
+from experiment_manager.experiments import plan, Runner
+from experiment_manager.graph_backend import GraphBackend
+from experiment_manager.launcher import NodeProcess, WORKER_NODES
+from experiment_manager.topic_recorder import QOS, RECORDED, TopicRecorder
+import rclpy
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import MultiThreadedExecutor
+from rclpy.node import Node
+
+FILE = """id: probe
+seed: 1
+experiments:
+  - {id: feeder, type: feeder_emptying, iterations: 1, parts: 60, optimal_range: [51, 61],
+     max_vibrations: 300}
+"""
+
+
+def iteration(ns: str, mode: str) -> tuple[float, dict]:
+    node = Node(f'probe_{mode}', namespace=ns)
+    executor = MultiThreadedExecutor(num_threads=4)
+    executor.add_node(node)
+    group = ReentrantCallbackGroup()
+    recorder = None
+    if mode == 'same executor':
+        for topic, msg_type in RECORDED:
+            node.create_subscription(msg_type, f'worker_0/{topic}', lambda data: None, QOS,
+                                     raw=True, callback_group=group)
+    elif mode == 'own executor':
+        recorder = TopicRecorder(f'probe_rec_{os.getpid()}', ns, 'worker_0')
+    thread = threading.Thread(target=executor.spin, daemon=True)
+    thread.start()
+    backend = GraphBackend(node, 'worker_0', group, 600.0, 30.0, lambda: False)
+    times: dict[str, float] = collections.defaultdict(float)
+    for name in ('reset', 'drop', 'remove', 'parts', 'check', 'feed'):
+        call = getattr(backend, name)
+
+        def timed(*args, _call=call, _name=name, **kwargs):
+            start = time.perf_counter()
+            try:
+                return _call(*args, **kwargs)
+            finally:
+                times[_name] += time.perf_counter() - start
+        setattr(backend, name, timed)
+    file = config.parse(FILE)
+    backend.start(file)
+    start = time.perf_counter()
+    Runner(file, backend, None).run_unit(plan(file, file.experiments[0], {})[0])
+    total = time.perf_counter() - start
+    executor.shutdown()
+    backend.destroy()
+    if recorder:
+        recorder.destroy()
+    node.destroy_node()
+    return total, times
+
+
+def main() -> int:
+    os.environ.setdefault('ROS_DOMAIN_ID', str(150 + os.getpid() % 50))
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    ns = f'/probe_{os.getpid()}'
+    logs = tempfile.mkdtemp(prefix='probe_logs_')
+    procs = [NodeProcess(pkg, exe, ['-r', f'__ns:={ns}/worker_0'], f'{logs}/{exe}.log')
+             for pkg, exe in WORKER_NODES]
+    rclpy.init()
+    try:
+        print('one feeder_emptying iteration (60 parts, range 51-61, 300 vibrations)')
+        for mode in ('none', 'same executor', 'own executor'):
+            total, times = iteration(ns, mode)
+            calls = ', '.join(f'{k} {v:.1f}' for k, v in sorted(times.items()))
+            print(f'recording subscriptions: {mode:<14} iteration {total:7.1f} s  ({calls} s)')
+    finally:
+        rclpy.try_shutdown()
+        for p in procs:
+            p.stop()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
