@@ -11,6 +11,7 @@ wall time of the iteration and of each kind of call.
 
 import collections
 import os
+import subprocess
 import sys
 import tempfile
 import threading
@@ -34,18 +35,21 @@ experiments:
 """
 
 
+MODES = ('none', 'same executor', 'own executor')
+
+
 def iteration(ns: str, mode: str) -> tuple[float, dict]:
-    node = Node(f'probe_{mode}', namespace=ns)
+    node = Node('probe', namespace=ns)
     executor = MultiThreadedExecutor(num_threads=4)
     executor.add_node(node)
     group = ReentrantCallbackGroup()
-    recorder = None
+    keep = []   # the TopicRecorder lives as long as the iteration
     if mode == 'same executor':
         for topic, msg_type in RECORDED:
             node.create_subscription(msg_type, f'worker_0/{topic}', lambda data: None, QOS,
                                      raw=True, callback_group=group)
     elif mode == 'own executor':
-        recorder = TopicRecorder(f'probe_rec_{os.getpid()}', ns, 'worker_0')
+        keep.append(TopicRecorder(f'probe_rec_{os.getpid()}', ns, 'worker_0'))
     thread = threading.Thread(target=executor.spin, daemon=True)
     thread.start()
     backend = GraphBackend(node, 'worker_0', group, 600.0, 30.0, lambda: False)
@@ -65,30 +69,30 @@ def iteration(ns: str, mode: str) -> tuple[float, dict]:
     start = time.perf_counter()
     Runner(file, backend, None).run_unit(plan(file, file.experiments[0], {})[0])
     total = time.perf_counter() - start
-    executor.shutdown()
-    backend.destroy()
-    if recorder:
-        recorder.destroy()
-    node.destroy_node()
+    keep.clear()
     return total, times
 
 
 def main() -> int:
+    if len(sys.argv) == 3:    # one mode, in a process of its own (a fresh rclpy)
+        rclpy.init()
+        total, times = iteration(sys.argv[1], sys.argv[2])
+        calls = ', '.join(f'{k} {v:.1f}' for k, v in sorted(times.items()))
+        print(f'recording subscriptions: {sys.argv[2]:<14} iteration {total:7.1f} s  '
+              f'({calls} s)', flush=True)
+        os._exit(0)   # the executor threads are daemons; nothing to close cleanly
     os.environ.setdefault('ROS_DOMAIN_ID', str(150 + os.getpid() % 50))
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     ns = f'/probe_{os.getpid()}'
     logs = tempfile.mkdtemp(prefix='probe_logs_')
     procs = [NodeProcess(pkg, exe, ['-r', f'__ns:={ns}/worker_0'], f'{logs}/{exe}.log')
              for pkg, exe in WORKER_NODES]
-    rclpy.init()
     try:
-        print('one feeder_emptying iteration (60 parts, range 51-61, 300 vibrations)')
-        for mode in ('none', 'same executor', 'own executor'):
-            total, times = iteration(ns, mode)
-            calls = ', '.join(f'{k} {v:.1f}' for k, v in sorted(times.items()))
-            print(f'recording subscriptions: {mode:<14} iteration {total:7.1f} s  ({calls} s)')
+        print('one feeder_emptying iteration (60 parts, range 51-61, 300 vibrations)',
+              flush=True)
+        for mode in MODES:
+            subprocess.run([sys.executable, __file__, ns, mode], check=True)
     finally:
-        rclpy.try_shutdown()
         for p in procs:
             p.stop()
     return 0

@@ -302,6 +302,16 @@ def _fits(part: PartGeometry, count: int, container: ContainerSpec, where: str) 
             f'most {most} within the packing limit {PACKING_LIMIT:g}'))
 
 
+def _earlier(m: _Map, key: str, exp_id: str, earlier: dict[str, Experiment], kind: str,
+             alternative: str) -> Experiment:
+    """The earlier experiment of type `kind` that `key` names by id."""
+    source = earlier.get(exp_id)
+    if source is None or source.type != kind:
+        raise InvalidArgument(m.where(key), exp_id, f'names no earlier {kind} experiment (give '
+                              f'its id, or {alternative})')
+    return source
+
+
 def _experiment(m: _Map, f: dict, earlier: dict[str, Experiment]) -> Experiment:
     exp_id = _id(m, 'id')
     if exp_id in earlier:
@@ -319,10 +329,7 @@ def _experiment(m: _Map, f: dict, earlier: dict[str, Experiment]) -> Experiment:
     elif kind == BIN_EMPTYING:
         raw = m.get('bin', None, required=True)
         if isinstance(raw, str):
-            source = earlier.get(raw)
-            if source is None or source.type != BIN_STATIC:
-                raise InvalidArgument(m.where('bin'), raw, 'names no earlier bin_static '
-                                      'experiment (give its id, or a bin [x, y, z] in mm)')
+            source = _earlier(m, 'bin', raw, earlier, BIN_STATIC, 'a bin [x, y, z] in mm')
             out['bin_from'] = raw
             for i, b in enumerate(source.bins):
                 _fits(part, out['parts'], b, m.where('parts') + f' ({raw}.bins_mm[{i}])')
@@ -341,10 +348,7 @@ def _experiment(m: _Map, f: dict, earlier: dict[str, Experiment]) -> Experiment:
     if kind == FEEDER_EMPTYING:
         raw = m.get('optimal_range', None, required=True)
         if isinstance(raw, str):
-            source = earlier.get(raw)
-            if source is None or source.type != TABLE_SWEEP:
-                raise InvalidArgument(m.where('optimal_range'), raw, 'names no earlier '
-                                      'table_sweep experiment (give its id, or [min, max])')
+            source = _earlier(m, 'optimal_range', raw, earlier, TABLE_SWEEP, '[min, max]')
             out['range_from'] = raw
             high = source.counts[-1] + source.margin
         else:

@@ -1,8 +1,8 @@
 """Recording a worker's topics into a `Recorder`, from raw (still serialized) messages.
 
 The subscriptions live on their own node, spun by their own single-threaded executor in a
-thread: on the manager's multi-threaded executor they slowed the calls it waits on by up to
-10x (measured: a feeder_emptying iteration took 173 s instead of 20 s; README, "Decisions").
+thread: on the manager's multi-threaded executor they slowed the calls it waits on about 9x
+(bench/bench_recorder_executor.py: a feeder_emptying iteration took 184 s instead of 31 s).
 """
 
 import threading
