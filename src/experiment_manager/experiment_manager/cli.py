@@ -1,11 +1,14 @@
-"""`run`: bring up the graph on this machine and run an experiment file through it.
+"""`run`: bring up the graph on this machine and run experiment files through it.
 
-    run [EXPERIMENT_FILE] [--output DIR | --resume RUN_DIR] [--namespace NS]
+    run [EXPERIMENT_FILE ...] [--output DIR | --resume RUN_DIR] [--iterations N]
+        [--namespace NS] [--logs DIR]
 
 Starts `world`, `validity` and `feeder_controller` under <NS>/worker_0 and `experiment_manager`
-under <NS> as separate processes (DDS between them, as on a cell), sends `run_experiment`, shows
-a progress bar, and prints where the results and the recording are. Without a file it runs the
-built-in default (`share/experiment_manager/config/default_experiment.yaml`).
+under <NS> as separate processes (DDS between them, as on a cell), sends `run_experiment` for
+each file in turn, shows a progress bar, and prints where the results and the recording are.
+Without a file it runs the built-in default (`share/experiment_manager/config/
+default_experiment.yaml`). --iterations N caps every experiment at N iterations (a quick look
+at a long study; the run directory keeps the file that ran).
 
 Exit codes: 0 done; 1 the run failed (the message says why; finished iterations are kept);
 2 bad input (the experiment file, an option); 130 interrupted (Ctrl-C: the run is canceled and
@@ -77,8 +80,8 @@ class ProgressBar:
 
 def _parse(argv: list[str]) -> argparse.Namespace:
     parser = argparse.ArgumentParser(prog='run', description=__doc__.split('\n\n')[0])
-    parser.add_argument('experiment_file', nargs='?', default=None,
-                        help='the experiment YAML file (default: the built-in one)')
+    parser.add_argument('experiment_files', nargs='*', metavar='experiment_file',
+                        help='experiment YAML files, run in turn (default: the built-in one)')
     where = parser.add_mutually_exclusive_group()
     where.add_argument('--output', help="directory for the run's directory (default: the "
                        "file's output_dir)")
@@ -87,9 +90,16 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     parser.add_argument('--namespace', default='/',
                         help='namespace of the graph (default /): the worker runs in '
                         f'<namespace>/{WORKER}')
+    parser.add_argument('--iterations', type=int, metavar='N',
+                        help='cap every experiment at N iterations')
     parser.add_argument('--logs', help="directory for the nodes' logs (default: a temporary "
                         'directory, printed)')
-    return parser.parse_args(argv)
+    args = parser.parse_args(argv)
+    if args.resume and len(args.experiment_files) > 1:
+        parser.error('--resume finishes one run: give one experiment file')
+    if args.iterations is not None and args.resume:
+        parser.error('--resume runs the file of the run directory: no --iterations')
+    return args
 
 
 def _start_graph(namespace: str, log_dir: str) -> list[NodeProcess]:
@@ -129,21 +139,35 @@ def _summary_lines(summary: dict) -> list[str]:
     return lines
 
 
+def _goals(args: argparse.Namespace) -> list[RunExperiment.Goal]:
+    """A goal per file, every file checked first. Raises InvalidArgument naming the file."""
+    goals = []
+    for path in [os.path.abspath(p) for p in args.experiment_files or [default_file()]]:
+        try:
+            file = config.load(path)
+            if args.iterations is not None:
+                fd, path = tempfile.mkstemp(prefix=f'{file.id}_', suffix='.yaml')
+                with os.fdopen(fd, 'w') as f:
+                    f.write(config.reduced(file, args.iterations))
+                config.load(path)
+        except InvalidArgument as exc:
+            raise InvalidArgument(f'{path}: {exc.field}', exc.value, exc.rule) from None
+        output = os.path.abspath(args.resume or args.output or file.output_dir)
+        goals.append(RunExperiment.Goal(experiment_file=path, resume=bool(args.resume),
+                                        output_dir=output))
+    return goals
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parse(sys.argv[1:] if argv is None else argv)
-    path = os.path.abspath(args.experiment_file or default_file())
     try:
-        file = config.load(path)     # fail here, before any process starts
+        goals = _goals(args)     # fail here, before any process starts
     except InvalidArgument as exc:
-        print(f'run: {path}: {exc}', file=sys.stderr)
+        print(f'run: {exc}', file=sys.stderr)
         return 2
-    output = args.output or file.output_dir
-    goal = RunExperiment.Goal(experiment_file=path, resume=bool(args.resume),
-                              output_dir=os.path.abspath(args.resume or output))
     log_dir = args.logs or tempfile.mkdtemp(prefix='pick_run_logs_')
     os.makedirs(log_dir, exist_ok=True)
-    print(f'run: {file.id}: {len(file.experiments)} experiment(s); node logs in {log_dir}',
-          file=sys.stderr)
+    print(f'run: {len(goals)} experiment file(s); node logs in {log_dir}', file=sys.stderr)
     try:
         procs = _start_graph(args.namespace, log_dir)
     except FileNotFoundError as exc:
@@ -154,7 +178,11 @@ def main(argv: list[str] | None = None) -> int:
     client = ActionClient(node, RunExperiment, 'run_experiment')
     bar = ProgressBar()
     try:
-        return _run(node, client, goal, procs, bar)
+        for goal in goals:
+            code = _run(node, client, goal, procs, bar)
+            if code:
+                return code
+        return 0
     except (KeyboardInterrupt, ExternalShutdownException):
         print('\nrun: interrupted; the run was canceled (its files are closed by the manager)',
               file=sys.stderr)
@@ -180,6 +208,7 @@ def _spin_until(node: Node, done, procs: list[NodeProcess], timeout: float) -> N
 
 
 def _run(node: Node, client: ActionClient, goal, procs: list[NodeProcess], bar) -> int:
+    print(f'run: {goal.experiment_file}', file=sys.stderr)
     dead = _spin_until(node, client.server_is_ready, procs, START_TIMEOUT)
     if dead is not None or not client.server_is_ready():
         why = dead.describe_exit() + '\n' + dead.output(20) if dead else (
@@ -217,5 +246,7 @@ def _run(node: Node, client: ActionClient, goal, procs: list[NodeProcess], bar) 
     print(f'results:   {result.results_path}')
     print(f'recording: {result.recording_path}')
     print(f'summary:   {os.path.join(result.results_path, "summary.json")}')
+    if result.report_path:
+        print(f'report:    {result.report_path}')
     print('\n'.join(_summary_lines(json.loads(result.summary_json))))
     return 0

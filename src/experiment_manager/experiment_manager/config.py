@@ -464,3 +464,18 @@ def load(path: str) -> ExperimentFile:
     except UnicodeDecodeError as exc:
         raise InvalidArgument('experiment_file', path, f'is not UTF-8 text: {exc}') from None
     return parse(text, path)
+
+
+def reduced(file: ExperimentFile, max_iterations: int) -> str:
+    """The text of `file` with every experiment's iterations capped at `max_iterations` and
+    the mesh path made absolute, as a file that can live anywhere (a quick look at a long
+    study; the run directory keeps the file that ran). Comments are not kept."""
+    check_int('max_iterations', max_iterations, low=1, high=MAX_ITERATIONS)
+    data = yaml.safe_load(file.text)
+    for item in data['experiments']:
+        item['iterations'] = min(int(item['iterations']), max_iterations)
+    if file.part.mesh_path:
+        data['part']['mesh'] = file.part.mesh_path
+    header = (f'# {file.path or file.id}, with every experiment capped at {max_iterations} '
+              'iteration(s)\n')
+    return header + yaml.safe_dump(data, sort_keys=False)

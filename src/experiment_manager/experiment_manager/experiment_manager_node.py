@@ -27,7 +27,7 @@ from rclpy.node import Node
 from rclpy.validate_namespace import validate_namespace
 from std_msgs.msg import Header
 
-from . import config
+from . import config, report
 from .experiments import Progress, Runner
 from .graph_backend import GraphBackend, GraphError
 from .recording import Recorder
@@ -138,6 +138,11 @@ class ExperimentManagerNode(Node):
             self.get_logger().info(f'running {file.path} into {run_dir}')
             summary = Runner(file, self._backend, writer, self._publish_progress).run()
             result.summary_json = json.dumps(summary)
+            try:
+                result.report_path = report.write(run_dir)
+            except Exception as exc:  # the results stand without their report
+                self.get_logger().error(f'the report could not be written: {exc}\n'
+                                        f'{traceback.format_exc()}')
             goal_handle.succeed()
         except (WorldError, GraphError) as exc:
             result.error_code = (exc.code if isinstance(exc, GraphError)

@@ -23,18 +23,6 @@ def read(directory: str, name: str) -> list[dict]:
         return [{k: v for k, v in r.items() if k != 'wall_time'} for r in csv.DictReader(f)]
 
 
-def run(directory: str, resume: bool = False, file=None) -> dict:
-    file = file or config.load(SMALL)
-    with LocalBackend() as backend, ResultsWriter(directory, file.text, resume) as writer:
-        return Runner(file, backend, writer).run()
-
-
-@pytest.fixture(scope='module')
-def small(tmp_path_factory):
-    directory = str(tmp_path_factory.mktemp('small'))
-    return directory, run(directory)
-
-
 def test_every_type_records_its_rows_and_metrics(small):
     directory, summary = small
     rows = read(directory, 'iterations')
@@ -96,7 +84,7 @@ def test_runs_are_deterministic_and_independent_of_order(small, tmp_path):
         assert {k: str(v) for k, v in again.iteration.items() if k != 'wall_time'} == row
 
 
-def test_an_interrupted_run_resumes_to_the_same_results(small, tmp_path):
+def test_an_interrupted_run_resumes_to_the_same_results(small, run_file, tmp_path):
     directory, summary = small
     file = config.load(SMALL)
 
@@ -121,7 +109,7 @@ def test_an_interrupted_run_resumes_to_the_same_results(small, tmp_path):
         ResultsWriter(out, file.text)
     with pytest.raises(InvalidArgument, match='differs from the file of the run'):
         ResultsWriter(out, file.text + '# edited\n', resume=True)
-    assert run(out, resume=True) == summary
+    assert run_file(out, resume=True) == summary
     for name in FILES:
         assert read(out, name) == read(directory, name), name
 

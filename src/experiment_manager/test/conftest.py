@@ -1,0 +1,30 @@
+"""Fixtures of the experiment manager's tests: running the small experiment file on the cores."""
+
+import os
+
+from experiment_manager import config
+from experiment_manager.experiments import Runner
+from experiment_manager.local_backend import LocalBackend
+from experiment_manager.results import ResultsWriter
+import pytest
+
+SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
+
+
+def run_small(directory: str, resume: bool = False) -> dict:
+    """Run the small file on the cores (LocalBackend) into `directory`; returns the summary."""
+    file = config.load(SMALL)
+    with LocalBackend() as backend, ResultsWriter(directory, file.text, resume) as writer:
+        return Runner(file, backend, writer).run()
+
+
+@pytest.fixture(scope='session')
+def run_file():
+    return run_small
+
+
+@pytest.fixture(scope='session')
+def small(tmp_path_factory) -> tuple[str, dict]:
+    """The small file run once: (run directory, summary)."""
+    directory = str(tmp_path_factory.mktemp('small'))
+    return directory, run_small(directory)
