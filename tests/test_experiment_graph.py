@@ -57,6 +57,10 @@ def graph_run(tmp_path_factory, private_ros_domain):
 def test_the_graph_gives_the_results_of_the_cores(graph_run, tmp_path):
     run_dir, _, done = graph_run
     assert 'best bin' in done.stdout and 'optimum' in done.stdout
+    report = re.search(r'^report:\s+(\S+)', done.stdout, re.M).group(1)
+    assert report == os.path.join(run_dir, 'report.html')
+    for name in ('report.md', 'fig14_bins.png', 'fig15_table.png', 'bin.png', 'tray.png'):
+        assert os.path.exists(os.path.join(run_dir, name)), name
     file = config.load(SMALL)
     with LocalBackend() as backend, ResultsWriter(str(tmp_path), file.text) as writer:
         Runner(file, backend, writer).run()

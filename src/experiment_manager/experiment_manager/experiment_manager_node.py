@@ -27,7 +27,7 @@ from rclpy.node import Node
 from rclpy.validate_namespace import validate_namespace
 from std_msgs.msg import Header
 
-from . import config, report
+from . import config, pictures, report
 from .experiments import Progress, Runner
 from .graph_backend import GraphBackend, GraphError
 from .recording import Recorder
@@ -139,6 +139,7 @@ class ExperimentManagerNode(Node):
             summary = Runner(file, self._backend, writer, self._publish_progress).run()
             result.summary_json = json.dumps(summary)
             try:
+                pictures.write(file, run_dir)
                 result.report_path = report.write(run_dir)
             except Exception as exc:  # the results stand without their report
                 self.get_logger().error(f'the report could not be written: {exc}\n'

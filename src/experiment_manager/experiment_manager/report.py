@@ -1,6 +1,7 @@
 """The report of a run: the decision the engineer came for, with the figures behind it.
 
-From a run directory (`summary.json`, `experiment.yaml`) it writes
+From a run directory (`summary.json`, `experiment.yaml`, and `pictures.json` with the pictures
+of pictures.py when they were rendered) it writes
 `report.md` and `report.html` (the same content) and the plots `fig14_bins.png` (fractions of
 parts passing each stage per bin, paper figure 14) and `fig15_table.png` (valid parts against
 parts on the tray with the 4th-order fit, paper figure 15). Tables follow the paper's Tables 2
@@ -169,8 +170,9 @@ def _table(header: list[str], rows: list[list]) -> list[str]:
     return lines
 
 
-def markdown(summary: dict, spec: dict, figures: dict[str, bool]) -> str:
-    """The report as Markdown."""
+def markdown(summary: dict, spec: dict, figures: dict[str, bool],
+             pictures: dict[str, str] | None = None) -> str:
+    """The report as Markdown. pictures: {image file: caption} (pictures.py)."""
     paper = PAPER.get(summary['id'])
     part = spec.get('part', {})
     r = summary['requirements']
@@ -248,6 +250,10 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool]) -> str:
         lines += ['', f'Time per vibration the refill interval allows: '
                   f'{_fmt(s["minutes_per_vibration_allowed"])} min. Parts lost over the edge: '
                   f'{s["lost"]}.']
+    if pictures:
+        lines += ['', '## Pictures']
+        for name, caption in pictures.items():
+            lines += ['', f'![{name}]({name})', '', caption]
     return '\n'.join(lines) + '\n'
 
 
@@ -301,7 +307,11 @@ def write(run_dir: str) -> str:
         spec = yaml.safe_load(f) or {}
     figures = {'fig14': plot_bins(summary, os.path.join(run_dir, 'fig14_bins.png')),
                'fig15': plot_sweep(summary, os.path.join(run_dir, 'fig15_table.png'))}
-    text = markdown(summary, spec, figures)
+    pictures = None
+    if os.path.exists(os.path.join(run_dir, 'pictures.json')):
+        with open(os.path.join(run_dir, 'pictures.json'), encoding='utf-8') as f:
+            pictures = json.load(f)
+    text = markdown(summary, spec, figures, pictures)
     with open(os.path.join(run_dir, 'report.md'), 'w', encoding='utf-8') as f:
         f.write(text)
     path = os.path.join(run_dir, 'report.html')

@@ -6,7 +6,7 @@ import json
 import os
 import shutil
 
-from experiment_manager import report
+from experiment_manager import config, pictures, report
 from experiment_manager.report import FEASIBLE, NOT_ANALYSED, NOT_FEASIBLE
 import pytest
 
@@ -66,3 +66,17 @@ def test_the_papers_numbers_stand_beside_ours_for_its_test_case(run_dir, tmp_pat
     assert '| paper | 40 | 480 | 0 | 2.7 | 0 | 6 | 1.67 |' in text
     assert '| paper | 50 | 480 | 17-27 | 50 | 167 |' in text
     assert 'paper: n* = 22, 17-27' in text
+
+
+def test_pictures_re_simulate_the_recorded_iteration(run_dir):
+
+    captions = pictures.write(config.load(os.path.join(run_dir, 'experiment.yaml')), run_dir)
+    assert set(captions) == {'bin.png', 'tray.png'}
+    for name, caption in captions.items():
+        assert 'poses identical to the recorded ones' in caption, caption
+        with open(os.path.join(run_dir, name), 'rb') as f:
+            assert f.read(8) == b'\x89PNG\r\n\x1a\n'
+    assert 'green: the first pick' in captions['bin.png']
+    report.write(run_dir)
+    text = open(os.path.join(run_dir, 'report.md')).read()
+    assert '## Pictures' in text and '![bin.png](bin.png)' in text

@@ -78,6 +78,18 @@ class SettleReport:
     canceled: bool = False
 
 
+@dataclass(frozen=True)
+class Overlay:
+    """A shape drawn in a picture only (no physics). kind: 'box' (size = half extents x, y, z)
+    or 'cylinder' (size = radius, length, along its z); pose: (7,) xyz + xyzw, world frame, m;
+    rgba: colour, 0..1."""
+
+    kind: str
+    size: tuple[float, ...]
+    pose: tuple[float, ...]
+    rgba: tuple[float, float, float, float] = (0.2, 0.8, 0.2, 0.6)
+
+
 @dataclass(frozen=True, eq=False)
 class PartStates:
     """A snapshot. ids, instances: (N,) int64; poses: (N, 7) float64 in each part's instance
@@ -270,6 +282,40 @@ class World:
                 pass
             self._client = None
         shutil.rmtree(self._tmp, ignore_errors=True)
+
+    def render(self, width: int, height: int, distance: float, yaw: float = 30.0,
+               pitch: float = -60.0, target: Sequence[float] = (0.0, 0.0, 0.0),
+               overlays: Sequence[Overlay] = ()) -> np.ndarray:
+        """A picture of the world from a camera orbiting `target` (world frame, m) at
+        `distance` m, `yaw` and `pitch` in degrees, with PyBullet's CPU renderer (no GPU).
+        `overlays` are drawn for this picture only (e.g. a gripper). Returns (height, width, 3)
+        uint8 RGB."""
+        width = check_int('width', width, low=16, high=4096)
+        height = check_int('height', height, low=16, high=4096)
+        c = self._client
+        bodies = []
+        try:
+            for o in overlays:
+                if o.kind == 'box':
+                    shape = pb.createVisualShape(pb.GEOM_BOX, halfExtents=list(o.size),
+                                                 rgbaColor=list(o.rgba), physicsClientId=c)
+                else:
+                    shape = pb.createVisualShape(pb.GEOM_CYLINDER, radius=o.size[0],
+                                                 length=o.size[1], rgbaColor=list(o.rgba),
+                                                 physicsClientId=c)
+                bodies.append(pb.createMultiBody(0.0, -1, shape, list(o.pose[:3]),
+                                                 list(o.pose[3:]), physicsClientId=c))
+            view = pb.computeViewMatrixFromYawPitchRoll(list(target), distance, yaw, pitch, 0.0,
+                                                        2, physicsClientId=c)
+            projection = pb.computeProjectionMatrixFOV(40.0, width / height, 0.01,
+                                                       10.0 * distance, physicsClientId=c)
+            _, _, rgba, _, _ = pb.getCameraImage(width, height, view, projection,
+                                                 renderer=pb.ER_TINY_RENDERER,
+                                                 physicsClientId=c)
+        finally:
+            for body in bodies:
+                pb.removeBody(body, physicsClientId=c)
+        return np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3]
 
     def __enter__(self) -> 'World':
         return self
