@@ -119,3 +119,13 @@ def test_a_mesh_path_is_relative_to_the_file(tmp_path):
                     + MINIMAL)
     f = config.load(str(path))
     assert f.part.mesh_path == str(tmp_path / 'clip.stl')
+
+
+def test_a_reduced_copy_caps_iterations_and_keeps_the_rest(tmp_path):
+    f = config.load(DEFAULT)
+    small = config.parse(config.reduced(f, 1))
+    assert [e.iterations for e in small.experiments] == [1, 1, 1, 1]
+    assert small.experiment('sweep').counts == f.experiment('sweep').counts
+    assert (small.part, small.gripper, small.grasps) == (f.part, f.gripper, f.grasps)
+    with pytest.raises(InvalidArgument, match=r'max_iterations: 0 must be within \[1, '):
+        config.reduced(f, 0)
