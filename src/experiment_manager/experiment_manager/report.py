@@ -45,6 +45,7 @@ PAPER = {
              'n_star': 27, 'range': [22, 32],
              'table3': {'iterations': 50, 'parts': 480, 'emptied': 50, 'vibrations': 139.07}},
 }
+FIGSIZE = (6.4, 4.0)   # inches
 FEASIBLE, NOT_FEASIBLE, NOT_ANALYSED = 'FEASIBLE', 'NOT FEASIBLE', 'not analysed'
 
 
@@ -118,23 +119,29 @@ def plot_bins(summary: dict, path: str) -> bool:
     bins = [b for b in s['bins'] if b['iterations']]
     area = [b['xy_area_mm2'] / 100.0 for b in bins]      # cm^2
     order = np.argsort(area)
-    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    fig, ax = plt.subplots(figsize=FIGSIZE)
     for key, label in (('candidates', 'candidacy'), ('placeable', 'placeability'),
                        ('container_free', 'bin collision free')):
         mean = [100 * bins[i]['fractions'][key]['mean'] for i in order]
         std = [100 * bins[i]['fractions'][key]['std'] for i in order]
         ax.errorbar([area[i] for i in order], mean, yerr=std, marker='o', capsize=3,
                     label=label)
-    ax.set_xlabel('bin XY surface (cm$^2$)')
-    ax.set_ylabel('parts passing the stage (%)')
     ax.set_ylim(0, 100)
+    _finish(fig, ax, path, f'{summary["id"]}: static bin analysis (figure 14)',
+            'bin XY surface (cm$^2$)', 'parts passing the stage (%)')
+    return True
+
+
+def _finish(fig, ax, path: str, title: str, xlabel: str, ylabel: str) -> None:
+    """Label, grid, legend, save and close a plot."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
     ax.grid(alpha=0.3)
     ax.legend()
-    ax.set_title(f'{summary["id"]}: static bin analysis (figure 14)')
+    ax.set_title(title)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
-    return True
 
 
 def plot_sweep(summary: dict, path: str) -> bool:
@@ -144,7 +151,7 @@ def plot_sweep(summary: dict, path: str) -> bool:
     _, s = sweeps[-1]
     n = np.array([p['n'] for p in s['per_n']], dtype=float)
     mean = np.array([p['valid']['mean'] for p in s['per_n']])
-    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    fig, ax = plt.subplots(figsize=FIGSIZE)
     ax.plot(n, mean, 'o', markersize=3, label='mean valid parts')
     if 'coefficients' in s and len(n):
         grid = np.linspace(n.min(), n.max(), 200)
@@ -153,14 +160,8 @@ def plot_sweep(summary: dict, path: str) -> bool:
         low, high = s['optimal_range']
         ax.axvspan(low, high, alpha=0.15, color='green',
                    label=f'optimal range {low}-{high} (n* = {s["n_star"]})')
-    ax.set_xlabel('parts on the table')
-    ax.set_ylabel('valid parts')
-    ax.grid(alpha=0.3)
-    ax.legend()
-    ax.set_title(f'{summary["id"]}: vibrating table analysis (figure 15)')
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    _finish(fig, ax, path, f'{summary["id"]}: vibrating table analysis (figure 15)',
+            'parts on the table', 'valid parts')
     return True
 
 
