@@ -7,7 +7,6 @@ experiment type, the ratio, and whether the result files are identical (they mus
 
 import argparse
 import collections
-import csv
 import os
 import re
 import subprocess
@@ -20,12 +19,11 @@ from experiment_manager.cli import default_file
 from experiment_manager.experiments import Runner
 from experiment_manager.launcher import executable
 from experiment_manager.local_backend import LocalBackend
-from experiment_manager.results import FILES, ResultsWriter
+from experiment_manager.results import FILES, read_text_rows, ResultsWriter
 
 
-def rows(directory: str, name: str) -> list[dict]:
-    with open(os.path.join(directory, f'{name}.csv'), newline='') as f:
-        return list(csv.DictReader(f))
+def rows(directory: str, name: str, drop: tuple[str, ...] = ()) -> list[dict]:
+    return read_text_rows(os.path.join(directory, f'{name}.csv'), drop)
 
 
 def per_type(directory: str) -> dict[str, float]:
@@ -60,12 +58,8 @@ def main() -> int:
         return 1
     graph_dir = re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1)
 
-    def same(name: str) -> bool:
-        drop = [[{k: v for k, v in r.items() if k != 'wall_time'} for r in rows(d, name)]
-                for d in (graph_dir, local_dir)]
-        return drop[0] == drop[1]
-
-    identical = all(same(name) for name in FILES)
+    identical = all(rows(graph_dir, name, ('wall_time',)) == rows(local_dir, name, ('wall_time',))
+                    for name in FILES)
     g, c = per_type(graph_dir), per_type(local_dir)
     print(f'{file.id}: {sum(1 for _ in rows(local_dir, "iterations"))} iterations')
     print(f'{"experiment type":<18} {"graph s":>9} {"core s":>9} {"ratio":>7}')

@@ -42,6 +42,14 @@ class NodeProcess(launcher.NodeProcess):
         super().__init__(package, name, args, log)
 
 
+def stop_all(procs) -> None:
+    """Stop every node process (SIGINT), then fail if any did not exit with 0: stopping all
+    before judging any leaves no node running after a failure."""
+    codes = [proc.stop() for proc in procs]
+    for proc, code in zip(procs, codes, strict=True):
+        assert code == 0, f'{proc.name} exited with {code} on SIGINT:\n{proc.output()}'
+
+
 class Client:
     """A client node in its own context with a single-threaded executor."""
 

@@ -5,7 +5,6 @@ from the schema text in the file) and matched against the results; the results a
 against the same file run on the cores in one process. Then: replay, a bad file, a second goal,
 and a node killed mid-run."""
 
-import csv
 import glob
 import os
 import re
@@ -17,7 +16,7 @@ from experiment_manager import config
 from experiment_manager.experiments import Runner
 from experiment_manager.launcher import executable
 from experiment_manager.local_backend import LocalBackend
-from experiment_manager.results import FILES, ResultsWriter
+from experiment_manager.results import FILES, read_text_rows, ResultsWriter
 from graph import unique_namespace
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
@@ -33,9 +32,8 @@ NS = unique_namespace('exp')
 STAGE_COUNTS = ('checked', 'candidates', 'placeable', 'container_free', 'valid')
 
 
-def rows(directory: str, name: str, drop=('wall_time',)) -> list[dict]:
-    with open(os.path.join(directory, f'{name}.csv'), newline='') as f:
-        return [{k: v for k, v in r.items() if k not in drop} for r in csv.DictReader(f)]
+def rows(directory: str, name: str) -> list[dict]:
+    return read_text_rows(os.path.join(directory, f'{name}.csv'), drop=('wall_time',))
 
 
 def run_command(*args: str, timeout: float = 600.0) -> subprocess.CompletedProcess:

@@ -1,6 +1,6 @@
 """The real `feeder_controller` commanding the real `world` (a tray) over DDS."""
 
-from graph import NodeProcess, unique_namespace
+from graph import NodeProcess, stop_all, unique_namespace
 from pick_msgs.action import FeedCycle, RemoveParts
 from pick_msgs.msg import FeederState
 from pick_msgs.srv import GetParts
@@ -19,9 +19,7 @@ def nodes(private_ros_domain):
         '-r', f'__ns:={NS}', '-p', 'container.kind:=tray', '-p', 'publish_markers:=false'])
     feeder = NodeProcess('feeder_controller', 'feeder_controller', ['-r', f'__ns:={NS}'])
     yield world, feeder
-    codes = [proc.stop() for proc in (world, feeder)]   # stop all before judging any
-    for proc, code in zip((world, feeder), codes, strict=True):
-        assert code == 0, proc.output()
+    stop_all((world, feeder))
 
 
 class Feeder:

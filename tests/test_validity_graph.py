@@ -4,7 +4,7 @@ agrees part by part with the pure core; bad requests get an error and it keeps s
 import copy
 import math
 
-from graph import NodeProcess, unique_namespace
+from graph import NodeProcess, stop_all, unique_namespace
 from pick_msgs.action import DropParts
 from pick_msgs.msg import Scene, ValidityReport
 from pick_msgs.srv import CheckParts, GetParts
@@ -28,9 +28,7 @@ def nodes(private_ros_domain):
         '-p', 'publish_markers:=false'])
     validity = NodeProcess('pick_validity', 'validity', ['-r', f'__ns:={NS}'])
     yield world, validity
-    codes = [proc.stop() for proc in (world, validity)]   # stop all before judging any
-    for proc, code in zip((world, validity), codes, strict=True):
-        assert code == 0, proc.output()
+    stop_all((world, validity))
 
 
 @pytest.fixture(scope='module')

@@ -5,7 +5,7 @@ import os
 
 from ament_index_python.packages import get_package_share_directory
 from geometry_msgs.msg import Vector3
-from graph import NodeProcess, unique_namespace
+from graph import NodeProcess, stop_all, unique_namespace
 import numpy as np
 from pick_msgs.action import DropParts, RemoveParts, Vibrate
 from pick_msgs.msg import ContainerGeometry, PartArray, Scene
@@ -27,8 +27,7 @@ def world(private_ros_domain):
         '-r', f'__ns:={NS}', '-p', 'container.kind:=tray', '-p', 'seed:=5',
         '-p', 'publish_markers:=true'])
     yield proc
-    code = proc.stop()
-    assert code == 0, f'world exited with {code} on SIGINT:\n{proc.output()}'
+    stop_all((proc,))
 
 
 class Cell:

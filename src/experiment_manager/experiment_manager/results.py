@@ -59,8 +59,15 @@ def parse_row(row: dict) -> dict:
 
 
 def read_csv(path: str) -> list[dict]:
+    """The rows of a results file, typed."""
+    return [parse_row(r) for r in read_text_rows(path)]
+
+
+def read_text_rows(path: str, drop: tuple[str, ...] = ()) -> list[dict]:
+    """The rows of a results file as written (strings), without the `drop` columns: what two
+    runs are compared on (wall times differ from run to run)."""
     with open(path, newline='', encoding='utf-8') as f:
-        return [parse_row(r) for r in csv.DictReader(f)]
+        return [{k: v for k, v in r.items() if k not in drop} for r in csv.DictReader(f)]
 
 
 def _key(row: dict) -> tuple:

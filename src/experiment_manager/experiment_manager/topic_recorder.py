@@ -32,14 +32,12 @@ class TopicRecorder:
         self._lock = threading.Lock()
         self._recorder: Recorder | None = None
         self._last = 0.0
-        self.topics = []
         for topic, msg_type in RECORDED:
             relative = f'{prefix}/{topic}' if prefix else topic
             resolved = self.node.resolve_topic_name(relative)
             self.node.create_subscription(msg_type, relative,
                                           self._callback(resolved, type_name(msg_type)), QOS,
                                           raw=True)
-            self.topics.append(resolved)
         self._executor = SingleThreadedExecutor(context=context)
         self._executor.add_node(self.node)
         self._thread = threading.Thread(target=self._spin, name=name, daemon=True)

@@ -1,14 +1,13 @@
 """The four experiment types on the real cores (LocalBackend: PyBullet, FCL, the feeder
 policy), the results files they leave, resumption, and the metrics."""
 
-import csv
 import json
 import os
 
 from experiment_manager import config, metrics
 from experiment_manager.experiments import iteration_seed, plan, Runner, search_order
 from experiment_manager.local_backend import LocalBackend
-from experiment_manager.results import FILES, ResultsWriter
+from experiment_manager.results import FILES, read_text_rows, ResultsWriter
 from feeder_controller.policy import NAMES
 import numpy as np
 from pick_sim_world.errors import InvalidArgument
@@ -19,8 +18,7 @@ SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
 
 
 def read(directory: str, name: str) -> list[dict]:
-    with open(os.path.join(directory, f'{name}.csv'), newline='') as f:
-        return [{k: v for k, v in r.items() if k != 'wall_time'} for r in csv.DictReader(f)]
+    return read_text_rows(os.path.join(directory, f'{name}.csv'), drop=('wall_time',))
 
 
 def test_every_type_records_its_rows_and_metrics(small):
