@@ -63,7 +63,7 @@ class ExperimentManagerNode(Node):
             except InvalidNamespaceException as exc:
                 raise InvalidArgument('worker', worker, f'is not a valid namespace: '
                                       f'{exc}') from None
-        self._call_timeout = self.declare_parameter('call_timeout', 600.0, ParameterDescriptor(
+        call_timeout = self.declare_parameter('call_timeout', 600.0, ParameterDescriptor(
             description='longest wait for one call to a node of the worker, s', read_only=True,
             floating_point_range=[FloatingPointRange(from_value=1.0, to_value=86400.0)])).value
         server_timeout = self.declare_parameter('server_timeout', 10.0, ParameterDescriptor(
@@ -77,12 +77,10 @@ class ExperimentManagerNode(Node):
                                                         to_value=1 << 30)])).value
         group = ReentrantCallbackGroup()
         self._stopping = threading.Event()
-        self._idle = threading.Event()
-        self._idle.set()
         self._lock = threading.Lock()
         self._goal = None
         self._progress = self.create_publisher(ExperimentProgress, 'progress', 10)
-        self._backend = GraphBackend(self, worker, group, self._call_timeout, server_timeout,
+        self._backend = GraphBackend(self, worker, group, call_timeout, server_timeout,
                                      self._cancel_requested)
         self._topics = TopicRecorder(f'{self.get_name()}_recorder', self.get_namespace(),
                                      worker, self.context)
@@ -90,11 +88,15 @@ class ExperimentManagerNode(Node):
                      cancel_callback=lambda _: CancelResponse.ACCEPT, callback_group=group)
         self.get_logger().info(f'driving the worker in '
                                f'{worker or "this namespace"}; call_timeout '
-                               f'{self._call_timeout:g} s')
+                               f'{call_timeout:g} s')
+
+    def _shutting_down(self) -> bool:
+        """destroy_node was called, or a signal already shut the context down under the run."""
+        return self._stopping.is_set() or not self.context.ok()
 
     def _cancel_requested(self) -> bool:
         goal = self._goal
-        return self._stopping.is_set() or (goal is not None and goal.is_cancel_requested)
+        return self._shutting_down() or (goal is not None and goal.is_cancel_requested)
 
     def _publish_progress(self, p: Progress) -> None:
         msg = ExperimentProgress(header=Header(stamp=self.get_clock().now().to_msg()),
@@ -102,8 +104,8 @@ class ExperimentManagerNode(Node):
                                  experiment_type=p.experiment_type, phase=p.phase,
                                  iterations_total=p.total, iterations_done=p.done,
                                  elapsed=p.elapsed, eta=p.eta)
-        if self._stopping.is_set():
-            return   # shutting down: the publishers may be gone
+        if self._shutting_down():
+            return   # the publishers may be gone
         self._progress.publish(msg)
         if self._goal is not None:
             self._goal.publish_feedback(RunExperiment.Feedback(progress=msg))
@@ -118,7 +120,6 @@ class ExperimentManagerNode(Node):
                                 'again when the running one has finished')
             goal_handle.abort()
             return result
-        self._idle.clear()
         self._goal = goal_handle
         writer = recorder = None
         try:
@@ -166,14 +167,13 @@ class ExperimentManagerNode(Node):
                                          ' resume the run there to finish it)')
             self._goal = None
             self._lock.release()
-            self._idle.set()
         return result
 
     def _end(self, goal_handle, result) -> None:
-        if goal_handle.is_cancel_requested or self._stopping.is_set():
+        if goal_handle.is_cancel_requested or self._shutting_down():
             result.error_code = RunExperiment.Result.CANCELED
-        if self._stopping.is_set():
-            return   # shutting down: the action server is being destroyed
+        if self._shutting_down():
+            return   # the action server is being destroyed
         if goal_handle.is_cancel_requested:
             goal_handle.canceled()
         else:
@@ -209,7 +209,9 @@ class ExperimentManagerNode(Node):
     def destroy_node(self) -> None:
         """On shutdown, stop a run at its next call and let it close its files."""
         self._stopping.set()
-        if not self._idle.wait(STOP_WAIT):
+        if self._lock.acquire(timeout=STOP_WAIT):   # held while a run is in flight
+            self._lock.release()
+        else:
             self.get_logger().error('the run did not stop within '
                                     f'{STOP_WAIT:g} s; its recording may be cut off')
         self._backend.destroy()
