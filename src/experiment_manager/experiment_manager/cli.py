@@ -18,6 +18,7 @@ its files closed).
 import argparse
 import json
 import os
+import signal
 import sys
 import tempfile
 import time
@@ -27,8 +28,8 @@ from pick_msgs.action import RunExperiment
 from pick_sim_world.errors import InvalidArgument
 import rclpy
 from rclpy.action import ActionClient
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
 
 from . import config
 from .launcher import MANAGER, NodeProcess, WORKER_NODES
@@ -102,6 +103,10 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     return args
 
 
+def _interrupt(signum, frame) -> None:
+    raise KeyboardInterrupt
+
+
 def _start_graph(namespace: str, log_dir: str) -> list[NodeProcess]:
     ns = '/' + namespace.strip('/') if namespace.strip('/') else ''
     worker_ns = f'{ns}/{WORKER}'
@@ -173,7 +178,11 @@ def main(argv: list[str] | None = None) -> int:
     except FileNotFoundError as exc:
         print(f'run: {exc}', file=sys.stderr)
         return 2
-    rclpy.init(args=['--ros-args', '-r', f'__ns:={args.namespace}'])
+    # No rclpy signal handlers: Ctrl-C (or SIGTERM) must leave the context alive to cancel the
+    # run and wait for the manager to close its files (rclpy's handler shuts it down first).
+    signal.signal(signal.SIGTERM, _interrupt)
+    rclpy.init(args=['--ros-args', '-r', f'__ns:={args.namespace}'],
+               signal_handler_options=SignalHandlerOptions.NO)
     node = Node('experiment_cli')
     client = ActionClient(node, RunExperiment, 'run_experiment')
     bar = ProgressBar()
@@ -183,7 +192,7 @@ def main(argv: list[str] | None = None) -> int:
             if code:
                 return code
         return 0
-    except (KeyboardInterrupt, ExternalShutdownException):
+    except KeyboardInterrupt:
         print('\nrun: interrupted; the run was canceled (its files are closed by the manager)',
               file=sys.stderr)
         return 130
