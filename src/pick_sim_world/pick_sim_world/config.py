@@ -25,8 +25,9 @@ class PhysicsConfig:
     0.02 m suits metre-sized bodies; for mm parts 0.001 m cuts the contact count).
     settle_*: a part rests when over the last `settle_window` s its position changed by at most
     `settle_linear_tolerance` m and its orientation by at most `settle_angular_tolerance` rad;
-    the scene is settled when every part rests. Checked every `settle_check_period` s of
-    simulated time. `max_settle_time`: the cap on simulated time, s, reported when hit.
+    the scene is settled when at most `settle_moving_fraction` of its parts (rounded down) do
+    not rest: 0 waits for every part. Checked every `settle_check_period` s of simulated time.
+    `max_settle_time`: the cap on simulated time, s, reported when hit.
     """
 
     time_step: float = 1.0 / 240.0
@@ -36,6 +37,7 @@ class PhysicsConfig:
     settle_window: float = 0.2
     settle_linear_tolerance: float = 0.0005
     settle_angular_tolerance: float = 0.035
+    settle_moving_fraction: float = 0.02
     max_settle_time: float = 10.0
 
 
@@ -78,6 +80,7 @@ def check_physics(cfg: PhysicsConfig) -> PhysicsConfig:
                  low_open=True)
     check_number('settle.angular_tolerance', cfg.settle_angular_tolerance, low=0.0, high=3.2,
                  low_open=True)
+    check_number('settle.moving_fraction', cfg.settle_moving_fraction, low=0.0, high=0.5)
     check_number('settle.max_time', cfg.max_settle_time, low=cfg.settle_window, high=600.0)
     return cfg
 

@@ -555,8 +555,9 @@ class World:
         """Step for up to `duration` s of simulated time, checking rest every check period.
 
         A part rests when, over the settle window, its position changed by at most the linear
-        tolerance and its orientation by at most the angular tolerance. Bullet's sleeping is not
-        used for this: it does not trigger for a jittering pile.
+        tolerance and its orientation by at most the angular tolerance; the scene is settled when
+        at most the moving fraction of its parts do not rest. Bullet's sleeping is not used for
+        this: it does not trigger for a jittering pile.
         """
         cfg = self._physics
         c = self._client
@@ -565,6 +566,7 @@ class World:
         window = max(1, int(round(cfg.settle_window / cfg.settle_check_period)))
         total_steps = max(1, int(math.ceil(duration / dt - 1e-9)))
         ids = [pid for inst in self._instances for pid in inst.part_ids]
+        tolerated = int(cfg.settle_moving_fraction * len(ids))
         history: deque[np.ndarray] = deque(maxlen=window + 1)
         history.append(self._world_poses(ids))
         start = time.perf_counter()
@@ -594,13 +596,13 @@ class World:
                     float(shift.max()) if len(ids) else 0.0)):
                 canceled = True
                 break
-            if stop_when_settled and full and not moving.any():
+            if stop_when_settled and full and moving.sum() <= tolerated:
                 settled = True
                 break
         self._sim_time += steps * dt
         wall = time.perf_counter() - start
         if not stop_when_settled:
             settled = not canceled
-        unsettled = [] if settled else [ids[i] for i in np.flatnonzero(moving)]
+        unsettled = [ids[i] for i in np.flatnonzero(moving)]
         return SettleReport(settled, steps * dt, wall, steps, unsettled, self._escaped(),
                             canceled)

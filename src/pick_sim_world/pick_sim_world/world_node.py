@@ -153,6 +153,9 @@ class WorldNode(Node):
                                          cfg.settle_angular_tolerance,
                                          'largest rotation at rest over the window, rad',
                                          1e-6, 3.2),
+            settle_moving_fraction=get('settle.moving_fraction', cfg.settle_moving_fraction,
+                                       'largest fraction of parts still moving when settled',
+                                       0.0, 0.5),
             max_settle_time=get('settle.max_time', cfg.max_settle_time,
                                 'cap on simulated settle time, s', 1e-3, 600.0))
         vib = Vibration()

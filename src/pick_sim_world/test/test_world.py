@@ -238,3 +238,22 @@ def test_feeding_a_bin_is_refused():
 def test_bad_settle_time_is_refused():
     with _world() as world, pytest.raises(InvalidArgument, match='max_settle_time: nan'):
         world.drop(1, max_settle_time=math.nan)
+
+
+def test_a_moving_fraction_ends_the_settle_earlier_and_names_the_parts_still_moving():
+    """60 TO-220s rest after about 4 s; with 5 % tolerated the drop ends when at most 3 parts
+    still move (on the same trajectory: same seed), and a further settle brings those to rest."""
+    bin_ = ContainerSpec(inner_size=(0.12, 0.10, 0.03))
+    with _world(bin_, 'to220', settle_moving_fraction=0.0) as strict:
+        _, full = strict.drop(60)
+    with _world(bin_, 'to220', settle_moving_fraction=0.05) as world:
+        _, early = world.drop(60)
+        before = world.snapshot()
+        rest = world.settle()
+        moved = np.linalg.norm(world.snapshot().poses[:, :3] - before.poses[:, :3], axis=1)
+    assert full.settled and full.unsettled_ids == []
+    assert early.settled and 0 < len(early.unsettled_ids) <= 3
+    assert early.sim_time < full.sim_time and rest.settled
+    assert moved.max() > world.physics.settle_linear_tolerance
+    with pytest.raises(InvalidArgument, match=r'settle.moving_fraction: 0.6 must be <= 0.5'):
+        _world(settle_moving_fraction=0.6)
