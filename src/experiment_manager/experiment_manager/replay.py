@@ -18,12 +18,14 @@ from mcap.exceptions import McapError
 from mcap.reader import make_reader
 from pick_sim_world.node_runner import LATCHED
 import rclpy
+from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 LATCHED_TOPICS = ('scene', 'markers')
 STREAM = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 MATCH_WAIT = 2.0     # s a new topic waits for a subscriber to match before its first message
+ACK_WAIT = 5.0       # s at the end for subscribers to acknowledge the last messages
 
 
 def message_type(name: str) -> type:
@@ -111,6 +113,8 @@ def main(argv: list[str] | None = None) -> int:
                 time.sleep(delay)
             pub.publish(message.data)
             sent += 1
+        for pub in publishers.values():   # exiting at once would drop messages still in flight
+            pub.wait_for_all_acked(Duration(seconds=ACK_WAIT))
         print(f'replay: published {sent} messages on {len(publishers)} topics',
               file=sys.stderr)
         return 0
