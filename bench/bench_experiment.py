@@ -45,7 +45,7 @@ def main() -> int:
     start = time.perf_counter()
     local_dir = os.path.join(work, 'local')
     with LocalBackend() as backend, ResultsWriter(local_dir, file.text) as writer:
-        Runner(file, backend, writer).run()
+        Runner(file, [backend], writer).run()
     local_wall = time.perf_counter() - start
 
     start = time.perf_counter()

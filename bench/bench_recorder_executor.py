@@ -49,7 +49,8 @@ def iteration(ns: str, mode: str) -> tuple[float, dict]:
             node.create_subscription(msg_type, f'worker_0/{topic}', lambda data: None, QOS,
                                      raw=True, callback_group=group)
     elif mode == 'own executor':
-        keep.append(TopicRecorder(f'probe_rec_{os.getpid()}', ns, 'worker_0'))
+        keep.append(TopicRecorder(f'probe_rec_{os.getpid()}', ns))
+        keep[-1].add('worker_0')
     thread = threading.Thread(target=executor.spin, daemon=True)
     thread.start()
     backend = GraphBackend(node, 'worker_0', group, 600.0, 30.0, lambda: False)
@@ -67,7 +68,7 @@ def iteration(ns: str, mode: str) -> tuple[float, dict]:
     file = config.parse(FILE)
     backend.start(file)
     start = time.perf_counter()
-    Runner(file, backend, None).run_unit(plan(file, file.experiments[0], {})[0])
+    Runner(file, [backend], None).run_unit(plan(file, file.experiments[0], {})[0], backend)
     total = time.perf_counter() - start
     keep.clear()
     return total, times

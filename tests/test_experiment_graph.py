@@ -1,10 +1,12 @@
-"""End to end: the `run` command brings up world, validity, feeder_controller and
+"""End to end: the `run` command brings up two workers (world, validity, feeder_controller) and
 experiment_manager as processes, runs a small file of every experiment type over DDS, and leaves
 results and a recording. The recording is decoded by an independent reader (mcap-ros2-support,
 from the schema text in the file) and matched against the results; the results are matched
-against the same file run on the cores in one process. Then: replay, a bad file, a second goal,
-and a node killed mid-run."""
+against the same file run on the cores in one process. Then: replay, a bad file, a worker
+killed mid-run (the other finishes the run with the same results), a second goal, and the last
+worker killed (the run fails, keeping what finished)."""
 
+from collections.abc import Callable
 import glob
 import os
 import re
@@ -22,6 +24,7 @@ from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 from pick_msgs.action import RunExperiment
 from pick_msgs.msg import ValidityReport
+from pick_sim_world.world import instance_seed
 import pytest
 from rclpy.action import ActionClient
 
@@ -29,6 +32,7 @@ pytestmark = pytest.mark.graph
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SMALL = os.path.join(ROOT, 'src', 'experiment_manager', 'test', 'small_experiment.yaml')
 NS = unique_namespace('exp')
+WORKERS = 2
 STAGE_COUNTS = ('checked', 'candidates', 'placeable', 'container_free', 'valid')
 
 
@@ -44,7 +48,8 @@ def run_command(*args: str, timeout: float = 600.0) -> subprocess.CompletedProce
 @pytest.fixture(scope='module')
 def graph_run(tmp_path_factory, private_ros_domain):
     out, logs = tmp_path_factory.mktemp('out'), tmp_path_factory.mktemp('logs')
-    done = run_command(SMALL, '--output', str(out), '--namespace', NS, '--logs', str(logs))
+    done = run_command(SMALL, '--output', str(out), '--namespace', NS, '--logs', str(logs),
+                       '--workers', str(WORKERS))
     node_logs = '\n'.join(f'== {p}\n{open(p).read()[-3000:]}' for p in glob.glob(f'{logs}/*'))
     assert done.returncode == 0, done.stderr + node_logs
     run_dir = re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1)
@@ -52,54 +57,78 @@ def graph_run(tmp_path_factory, private_ros_domain):
     return run_dir, recording, done
 
 
-def test_the_graph_gives_the_results_of_the_cores(graph_run, tmp_path):
+@pytest.fixture(scope='module')
+def core_run(tmp_path_factory) -> str:
+    """The small file run on the cores in this process: the results the graph must give."""
+    directory = str(tmp_path_factory.mktemp('cores'))
+    file = config.load(SMALL)
+    with LocalBackend() as backend, ResultsWriter(directory, file.text) as writer:
+        Runner(file, [backend], writer).run()
+    return directory
+
+
+def test_the_graph_gives_the_results_of_the_cores(graph_run, core_run):
     run_dir, _, done = graph_run
     assert 'best bin' in done.stdout and 'optimum' in done.stdout
     report = re.search(r'^report:\s+(\S+)', done.stdout, re.M).group(1)
     assert report == os.path.join(run_dir, 'report.html')
     for name in ('report.md', 'fig14_bins.png', 'fig15_table.png', 'bin.png', 'tray.png'):
         assert os.path.exists(os.path.join(run_dir, name)), name
-    file = config.load(SMALL)
-    with LocalBackend() as backend, ResultsWriter(str(tmp_path), file.text) as writer:
-        Runner(file, backend, writer).run()
     for name in FILES:
-        assert rows(run_dir, name) == rows(str(tmp_path), name), name
+        assert rows(run_dir, name) == rows(core_run, name), name
 
 
 def test_every_recorded_message_decodes_and_matches_the_results(graph_run):
     run_dir, recording, _ = graph_run
     with open(recording, 'rb') as f:
         reader = make_reader(f, decoder_factories=[DecoderFactory()])
-        messages = [(channel.topic, msg) for _, channel, _, msg
+        messages = [(channel.topic, message.log_time, msg) for _, channel, message, msg
                     in reader.iter_decoded_messages(log_time_order=True)]
         attachments = {a.name: a.data for a in reader.iter_attachments()}
     by_topic: dict[str, list] = {}
-    for topic, msg in messages:
+    for topic, _, msg in messages:
         by_topic.setdefault(topic[len(NS):], []).append(msg)
-    assert set(by_topic) == {'/progress', '/worker_0/parts', '/worker_0/scene',
-                             '/worker_0/markers', '/worker_0/results',
-                             '/worker_0/feeder/state'}
+    workers = [f'/worker_{k}' for k in range(WORKERS)]
+    assert set(by_topic) <= {'/progress'} | {f'{w}/{t}' for w in workers for t in (
+        'parts', 'scene', 'markers', 'results', 'feeder/state')}
+    assert all(f'{w}/results' in by_topic for w in workers), 'a worker ran no iteration'
     iterations = rows(run_dir, 'iterations')
-    assert len(by_topic['/worker_0/scene']) == len(iterations)      # a reset per iteration
+    assert sum(len(by_topic[f'{w}/scene']) for w in workers) == len(iterations)  # a reset each
     progress = by_topic['/progress'][-1]
     assert progress.iterations_done == progress.iterations_total == len(iterations)
 
-    # One ValidityReport per check that had parts to check, in order, with the same counts
-    # and, part by part, the same stage as parts.csv.
-    checks = [c for c in rows(run_dir, 'checks') if int(c['parts_on_table'])]
-    reports = by_topic['/worker_0/results']
-    assert [tuple(getattr(r, k) for k in STAGE_COUNTS) for r in reports] == [
-        tuple(int(c[k]) for k in STAGE_COUNTS) for c in checks]
+    # Each worker's ValidityReports belong to the iteration of the scene it published last
+    # (its instance seed names the iteration); per iteration, one report per check that had
+    # parts to check, in order, with the same counts and, part by part, the same stage as
+    # parts.csv.
+    key_of_seed = {instance_seed(int(i['seed']), 0): (i['experiment'], i['group'],
+                                                      i['iteration']) for i in iterations}
+    reports: dict[tuple, list] = {}
+    for w in workers:
+        key = None
+        for topic, _, msg in messages:
+            if topic == f'{NS}{w}/scene':
+                key = key_of_seed[msg.instances[0].seed]
+            elif topic == f'{NS}{w}/results':
+                reports.setdefault(key, []).append(msg)
+    checks: dict[tuple, list] = {}
+    for c in rows(run_dir, 'checks'):
+        if int(c['parts_on_table']):
+            checks.setdefault((c['experiment'], c['group'], c['iteration']), []).append(c)
+    assert set(reports) == set(checks)
     stages: dict[tuple, dict[int, int]] = {}
     for p in rows(run_dir, 'parts'):
         if p['inside'] == 'True':
             key = (p['experiment'], p['group'], p['iteration'], p['check'])
             stages.setdefault(key, {})[int(p['part_id'])] = int(p['stage'])
-    for c, r in zip(checks, reports, strict=True):
-        key = (c['experiment'], c['group'], c['iteration'], c['check'])
-        assert {x.part_id: x.stage_reached for x in r.results} == stages[key]
+    for key, got in reports.items():
+        assert [tuple(getattr(r, k) for k in STAGE_COUNTS) for r in got] == [
+            tuple(int(c[k]) for k in STAGE_COUNTS) for c in checks[key]]
+        for c, r in zip(checks[key], got, strict=True):
+            assert {x.part_id: x.stage_reached for x in r.results} == stages[(*key, c['check'])]
     feeder = next(i for i in iterations if i['type'] == 'feeder_emptying')
-    assert by_topic['/worker_0/feeder/state'][-1].vibrations == int(feeder['vibrations'])
+    assert int(feeder['vibrations']) in [by_topic[f'{w}/feeder/state'][-1].vibrations
+                                         for w in workers if f'{w}/feeder/state' in by_topic]
 
     with open(SMALL, 'rb') as f:
         assert attachments['experiment.yaml'] == f.read()
@@ -120,7 +149,8 @@ def test_replay_republishes_a_topic_of_the_recording(graph_run, client):
                                '--rate', '100', '--prefix', prefix,
                                '--topics', f'{NS}/worker_0/results'],
                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    assert client.wait(lambda: len(received) == expected, 60.0), replay.communicate()[0]
+    assert client.wait(lambda: len(received) == expected, 60.0), (
+        f'{len(received)} of {expected}: {replay.communicate()[0]}')
     assert replay.wait(30) == 0
     info = subprocess.run([executable('experiment_manager', 'replay'), recording, '--info'],
                           capture_output=True, text=True, timeout=60)
@@ -147,26 +177,54 @@ experiments:
 """
 
 
+def first_iteration_done(out) -> Callable[[], bool]:
+    def done() -> bool:
+        found = glob.glob(f'{out}/*/iterations.csv')
+        return bool(found) and len(open(found[0]).read().splitlines()) >= 2
+    return done
+
+
+def test_a_killed_worker_s_iterations_run_on_the_other_with_the_same_results(
+        tmp_path, client, core_run, private_ros_domain):
+    ns = unique_namespace('exp_lose')
+    out = tmp_path / 'out'
+    run = subprocess.Popen([executable('experiment_manager', 'run'), SMALL, '--output',
+                            str(out), '--namespace', ns, '--workers', '2', '--logs',
+                            str(tmp_path / 'logs')],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert client.wait(first_iteration_done(out), 120.0), 'no iteration finished'
+        os.kill(_world_pid(ns), signal.SIGKILL)
+        stdout, stderr = run.communicate(timeout=600)
+    finally:
+        if run.poll() is None:
+            run.kill()
+    assert run.returncode == 0, stderr
+    assert re.search(r'worker_0/world \(pid \d+\) was killed by signal 9', stderr), stderr
+    assert 'its worker is lost' in stderr
+    run_dir = re.search(r'^results:\s+(\S+)', stdout, re.M).group(1)
+    for name in FILES:
+        assert rows(run_dir, name) == rows(core_run, name), name
+
+
 def _world_pid(namespace: str) -> int:
     found = subprocess.run(['pgrep', '-f', f'lib/pick_sim_world/world --ros-args -r '
                             f'__ns:={namespace}/worker_0'], capture_output=True, text=True)
     return int(found.stdout.split()[0])
 
 
-def test_a_second_goal_is_busy_and_a_killed_world_ends_the_run(tmp_path, client,
-                                                               private_ros_domain):
+def test_a_second_goal_is_busy_and_a_killed_last_worker_ends_the_run(tmp_path, client,
+                                                                     private_ros_domain):
     ns = unique_namespace('exp_kill')
     path = tmp_path / 'long.yaml'
     path.write_text(LONG)
     out = tmp_path / 'out'
     run = subprocess.Popen([executable('experiment_manager', 'run'), str(path), '--output',
-                            str(out), '--namespace', ns, '--logs', str(tmp_path / 'logs')],
+                            str(out), '--namespace', ns, '--workers', '1', '--logs',
+                            str(tmp_path / 'logs')],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        def first_iteration_done() -> bool:
-            found = glob.glob(f'{out}/long_*/iterations.csv')
-            return bool(found) and len(open(found[0]).read().splitlines()) >= 2
-        assert client.wait(first_iteration_done, 120.0), 'no iteration finished'
+        assert client.wait(first_iteration_done(out), 120.0), 'no iteration finished'
 
         manager = ActionClient(client.node, RunExperiment, f'{ns}/run_experiment')
         assert client.wait(manager.server_is_ready, 30.0)

@@ -1,11 +1,13 @@
 """`run`: bring up the graph on this machine and run experiment files through it.
 
     run [EXPERIMENT_FILE ...] [--output DIR | --resume RUN_DIR] [--iterations N]
-        [--namespace NS] [--logs DIR]
+        [--workers N] [--namespace NS] [--logs DIR]
 
-Starts `world`, `validity` and `feeder_controller` under <NS>/worker_0 and `experiment_manager`
-under <NS> as separate processes (DDS between them, as on a cell), sends `run_experiment` for
-each file in turn, shows a progress bar, and prints where the results and the recording are.
+Starts N workers (`world`, `validity` and `feeder_controller` under <NS>/worker_<k>, default: a
+worker per CPU) and `experiment_manager` under <NS> as separate processes (DDS between them, as
+on a cell), sends `run_experiment` for each file in turn, shows a progress bar, and prints where
+the results and the recording are. A worker node that dies is reported; the manager runs its
+iteration again on another worker, and the run fails only when no worker is left.
 Without a file it runs the built-in default (`share/experiment_manager/config/
 default_experiment.yaml`). --iterations N caps every experiment at N iterations (a quick look
 at a long study; the run directory keeps the file that ran).
@@ -34,9 +36,14 @@ from rclpy.signals import SignalHandlerOptions
 from . import config
 from .launcher import MANAGER, NodeProcess, WORKER_NODES
 
-WORKER = 'worker_0'
+MAX_WORKERS = 64
 START_TIMEOUT = 60.0    # s for the manager's action server to appear
 STOP_TIMEOUT = 30.0     # s for a canceled run to close its files
+
+
+def default_workers() -> int:
+    """A worker per CPU this process may use (PyBullet steps on one thread), at most 8."""
+    return min(len(os.sched_getaffinity(0)), 8)
 
 
 def default_file() -> str:
@@ -89,8 +96,11 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     where.add_argument('--resume', metavar='RUN_DIR',
                        help='finish the interrupted run in RUN_DIR (same experiment file)')
     parser.add_argument('--namespace', default='/',
-                        help='namespace of the graph (default /): the worker runs in '
-                        f'<namespace>/{WORKER}')
+                        help='namespace of the graph (default /): worker k runs in '
+                        '<namespace>/worker_<k>')
+    parser.add_argument('--workers', type=int, metavar='N', default=default_workers(),
+                        help=f'worker processes to start (default {default_workers()}: a '
+                        'worker per CPU, at most 8)')
     parser.add_argument('--iterations', type=int, metavar='N',
                         help='cap every experiment at N iterations')
     parser.add_argument('--logs', help="directory for the nodes' logs (default: a temporary "
@@ -100,6 +110,8 @@ def _parse(argv: list[str]) -> argparse.Namespace:
         parser.error('--resume finishes one run: give one experiment file')
     if args.iterations is not None and args.resume:
         parser.error('--resume runs the file of the run directory: no --iterations')
+    if not 1 <= args.workers <= MAX_WORKERS:
+        parser.error(f'--workers {args.workers} must be within [1, {MAX_WORKERS}]')
     return args
 
 
@@ -107,13 +119,18 @@ def _interrupt(signum, frame) -> None:
     raise KeyboardInterrupt
 
 
-def _start_graph(namespace: str, log_dir: str) -> list[NodeProcess]:
+def _start_graph(namespace: str, log_dir: str, workers: int) -> list[NodeProcess]:
+    """The workers' nodes, then the manager (last)."""
     ns = '/' + namespace.strip('/') if namespace.strip('/') else ''
-    worker_ns = f'{ns}/{WORKER}'
-    procs = [NodeProcess(pkg, exe, ['-r', f'__ns:={worker_ns}'],
-                         os.path.join(log_dir, f'{exe}.log')) for pkg, exe in WORKER_NODES]
+    names = [f'worker_{k}' for k in range(workers)]
+    procs = []
+    for worker in names:
+        procs += [NodeProcess(pkg, exe, ['-r', f'__ns:={ns}/{worker}'],
+                              os.path.join(log_dir, f'{worker}.{exe}.log'), f'{worker}/{exe}')
+                  for pkg, exe in WORKER_NODES]
     pkg, exe = MANAGER
-    procs.append(NodeProcess(pkg, exe, ['-r', f'__ns:={ns or "/"}', '-p', f'worker:={WORKER}'],
+    procs.append(NodeProcess(pkg, exe, ['-r', f'__ns:={ns or "/"}', '-p',
+                                        f'workers:=[{", ".join(names)}]'],
                              os.path.join(log_dir, f'{exe}.log')))
     return procs
 
@@ -174,7 +191,7 @@ def main(argv: list[str] | None = None) -> int:
     os.makedirs(log_dir, exist_ok=True)
     print(f'run: {len(goals)} experiment file(s); node logs in {log_dir}', file=sys.stderr)
     try:
-        procs = _start_graph(args.namespace, log_dir)
+        procs = _start_graph(args.namespace, log_dir, args.workers)
     except FileNotFoundError as exc:
         print(f'run: {exc}', file=sys.stderr)
         return 2
@@ -231,22 +248,22 @@ def _run(node: Node, client: ActionClient, goal, procs: list[NodeProcess], bar) 
         print('run: the experiment manager did not accept the goal', file=sys.stderr)
         return 1
     result_future = handle.get_result_async()
+    manager = procs[-1]
+    watched = [p for p in procs if p.running()]
     try:
-        dead = _spin_until(node, result_future.done, procs, float('inf'))
+        while (dead := _spin_until(node, result_future.done, watched, float('inf'))):
+            watched.remove(dead)
+            bar.close()
+            print(f'run: {dead.describe_exit()} during the run:\n{dead.output(20)}',
+                  file=sys.stderr)
+            if dead is manager:
+                return 1
+            print('run: its worker is lost; the manager runs its iterations on the others',
+                  file=sys.stderr)
     except KeyboardInterrupt:
         handle.cancel_goal_async()
-        _spin_until(node, result_future.done, procs, STOP_TIMEOUT)
+        _spin_until(node, result_future.done, [manager], STOP_TIMEOUT)
         raise
-    if dead is not None:
-        bar.close()
-        print(f'run: {dead.describe_exit()} during the run:\n{dead.output(20)}', file=sys.stderr)
-        if dead.name != 'experiment_manager':
-            handle.cancel_goal_async()
-            _spin_until(node, result_future.done, procs[-1:], STOP_TIMEOUT)
-        if result_future.done():
-            r = result_future.result().result
-            print(f'run: finished iterations are kept in {r.results_path}', file=sys.stderr)
-        return 1
     result = result_future.result().result
     bar.close()
     if result.error_code:

@@ -1,16 +1,19 @@
-"""The `experiment_manager` node: runs experiment files over a worker's nodes and records them.
+"""The `experiment_manager` node: runs experiment files over workers' nodes and records them.
 
-Action `run_experiment` (feedback: ExperimentProgress); topic `progress`. It drives the worker's
-`world`, `validity` and `feeder_controller` (graph_backend.py) with the experiment logic of
-experiments.py, writes results as iterations finish (results.py), and records every topic of the
-worker, its own progress, the experiment file and the results into one MCAP file per run
-(recording.py). One run at a time: a second goal is answered BUSY, not queued.
+Action `run_experiment` (feedback: ExperimentProgress); topic `progress`. It drives one or more
+workers, each a `world`, `validity` and `feeder_controller` under its own namespace
+(graph_backend.py), with the experiment logic of experiments.py: iterations are spread over the
+workers, and one whose worker dies or stops answering runs again on another. It writes results
+as iterations finish (results.py), and records every topic of the workers, its own progress, the
+experiment file and the results into one MCAP file per run (recording.py). One run at a time: a
+second goal is answered BUSY, not queued.
 """
 
 from datetime import datetime
 import json
 import os
 import threading
+import time
 import traceback
 
 from pick_msgs.action import RunExperiment
@@ -35,6 +38,7 @@ from .results import ResultsWriter
 from .topic_recorder import TopicRecorder
 
 STOP_WAIT = 15.0        # s a shutdown waits for the run to close its files
+DISCOVERY_SETTLE = 1.0  # s the worker list must stay the same before discovery ends
 RESULT_FILES = ('iterations.csv', 'checks.csv', 'picks.csv', 'parts.csv', 'summary.json')
 
 
@@ -54,15 +58,15 @@ class ExperimentManagerNode(Node):
 
     def __init__(self) -> None:
         super().__init__('experiment_manager')
-        worker = self.declare_parameter('worker', '', ParameterDescriptor(
-            description='namespace of the world, validity and feeder_controller to drive, '
-            "relative to this node's; empty: this node's own", read_only=True)).value.strip('/')
-        if worker:
-            try:
-                validate_namespace('/' + worker)
-            except InvalidNamespaceException as exc:
-                raise InvalidArgument('worker', worker, f'is not a valid namespace: '
-                                      f'{exc}') from None
+        workers = self.declare_parameter('workers', ['*'], ParameterDescriptor(
+            description='namespaces of the workers (world, validity and feeder_controller) to '
+            "drive, relative to this node's ('' for its own); ['*']: every worker found under "
+            'this namespace at the start of each run', read_only=True)).value
+        self._workers = [check_worker(w) for w in workers]
+        if '*' in self._workers and len(self._workers) > 1:
+            raise InvalidArgument('workers', workers, "'*' stands alone: discover, or name them")
+        if len(set(self._workers)) < len(self._workers):
+            raise InvalidArgument('workers', workers, 'names a worker twice')
         call_timeout = self.declare_parameter('call_timeout', 600.0, ParameterDescriptor(
             description='longest wait for one call to a node of the worker, s', read_only=True,
             floating_point_range=[FloatingPointRange(from_value=1.0, to_value=86400.0)])).value
@@ -75,20 +79,21 @@ class ExperimentManagerNode(Node):
             description='bytes of messages per MCAP chunk; a killed run loses at most one',
             read_only=True, integer_range=[IntegerRange(from_value=1024,
                                                         to_value=1 << 30)])).value
-        group = ReentrantCallbackGroup()
+        self._group = ReentrantCallbackGroup()
+        self._call_timeout, self._server_timeout = call_timeout, server_timeout
         self._stopping = threading.Event()
+        self._abort = threading.Event()     # set by a run that failed, for its other workers
         self._lock = threading.Lock()
         self._goal = None
         self._progress = self.create_publisher(ExperimentProgress, 'progress', 10)
-        self._backend = GraphBackend(self, worker, group, call_timeout, server_timeout,
-                                     self._cancel_requested)
+        self._backends: dict[str, GraphBackend] = {}
         self._topics = TopicRecorder(f'{self.get_name()}_recorder', self.get_namespace(),
-                                     worker, self.context)
+                                     self.context)
         ActionServer(self, RunExperiment, 'run_experiment', execute_callback=self._run,
-                     cancel_callback=lambda _: CancelResponse.ACCEPT, callback_group=group)
-        self.get_logger().info(f'driving the worker in '
-                               f'{worker or "this namespace"}; call_timeout '
-                               f'{call_timeout:g} s')
+                     cancel_callback=lambda _: CancelResponse.ACCEPT,
+                     callback_group=self._group)
+        names = ', '.join(w or 'this namespace' for w in self._workers)
+        self.get_logger().info(f'workers: {names}; call_timeout {call_timeout:g} s')
 
     def _shutting_down(self) -> bool:
         """destroy_node was called, or a signal already shut the context down under the run."""
@@ -96,7 +101,46 @@ class ExperimentManagerNode(Node):
 
     def _cancel_requested(self) -> bool:
         goal = self._goal
-        return self._shutting_down() or (goal is not None and goal.is_cancel_requested)
+        return (self._shutting_down() or self._abort.is_set()
+                or (goal is not None and goal.is_cancel_requested))
+
+    def _discover(self) -> list[str]:
+        """Namespaces under this node's that hold a validity node's check_parts, relative."""
+        base = self.get_namespace().rstrip('/')
+        suffix = '/check_parts'
+        found = set()
+        for name, types in self.get_service_names_and_types():
+            if name.endswith(suffix) and 'pick_msgs/srv/CheckParts' in types:
+                ns = name[:-len(suffix)]
+                if ns == base or ns.startswith(base + '/'):
+                    found.add(ns[len(base):].strip('/'))
+        return sorted(found)
+
+    def _workers_of_run(self) -> list[GraphBackend]:
+        """The backends of the workers to drive (found now when the parameter says '*')."""
+        workers = self._workers
+        if workers == ['*']:
+            deadline = time.monotonic() + self._server_timeout
+            workers, since = [], time.monotonic()
+            while time.monotonic() < deadline and not self._cancel_requested():
+                now = self._discover()
+                if now != workers:
+                    workers, since = now, time.monotonic()
+                elif workers and time.monotonic() - since > DISCOVERY_SETTLE:
+                    break
+                time.sleep(0.1)
+            if not workers:
+                raise GraphError(RunExperiment.Result.INTERNAL, (
+                    f'no worker found within server_timeout {self._server_timeout:g} s: no '
+                    f'check_parts service under {self.get_namespace()} (are the world, '
+                    'validity and feeder_controller nodes running?)'))
+        for worker in workers:
+            if worker not in self._backends:
+                self._backends[worker] = GraphBackend(
+                    self, worker, self._group, self._call_timeout, self._server_timeout,
+                    self._cancel_requested)
+                self._topics.add(worker)
+        return [self._backends[w] for w in workers]
 
     def _publish_progress(self, p: Progress) -> None:
         msg = ExperimentProgress(header=Header(stamp=self.get_clock().now().to_msg()),
@@ -136,8 +180,18 @@ class ExperimentManagerNode(Node):
             result.results_path = run_dir
             recorder = self._open_recording(run_dir, file, goal.resume)
             result.recording_path = recorder.path
-            self.get_logger().info(f'running {file.path} into {run_dir}')
-            summary = Runner(file, self._backend, writer, self._publish_progress).run()
+            self._abort.clear()
+            backends = self._workers_of_run()
+            self.get_logger().info(f'running {file.path} into {run_dir} on '
+                                   f'{len(backends)} worker(s): '
+                                   f'{", ".join(b.name("") or "." for b in backends)}')
+            runner = Runner(file, backends, writer, self._publish_progress, self._abort)
+            try:
+                summary = runner.run()
+            finally:
+                for k in runner.lost_workers:
+                    self.get_logger().warning(f'worker {backends[k].name("")} was lost during '
+                                              'the run; its iteration ran again on another')
             result.summary_json = json.dumps(summary)
             try:
                 pictures.write(file, run_dir)
@@ -214,9 +268,23 @@ class ExperimentManagerNode(Node):
         else:
             self.get_logger().error('the run did not stop within '
                                     f'{STOP_WAIT:g} s; its recording may be cut off')
-        self._backend.destroy()
+        for backend in self._backends.values():
+            backend.destroy()
         self._topics.destroy()
         super().destroy_node()
+
+
+def check_worker(worker: str) -> str:
+    """A worker namespace of the `workers` parameter, relative ('' for the manager's own),
+    or '*'."""
+    worker = worker.strip('/')
+    if worker in ('', '*'):
+        return worker
+    try:
+        validate_namespace('/' + worker)
+    except InvalidNamespaceException as exc:
+        raise InvalidArgument('workers', worker, f'is not a valid namespace: {exc}') from None
+    return worker
 
 
 def main(args=None) -> None:

@@ -10,8 +10,10 @@ result depends on nothing else, so order, resumption and the worker that ran it 
 Each finished iteration is handed to the sink at once, as rows (see results.py for the columns).
 """
 
-from collections.abc import Callable
+from collections import deque
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+import threading
 import time
 from typing import Protocol
 import zlib
@@ -132,6 +134,7 @@ class Sink(Protocol):
     def iterations(self, experiment_id: str) -> list[dict]: ...
     def picks(self, experiment_id: str) -> list[dict]: ...
     def write_summary(self, summary: dict) -> None: ...
+    def reorder(self, rank: dict[tuple, int]) -> None: ...
 
 
 def count_iterations(file: ExperimentFile) -> int:
@@ -181,36 +184,117 @@ def search_order(order: str, states: PartStates, targets: np.ndarray, seed: int)
     return np.array(sorted(targets.tolist(), key=lambda i: (-z[i], i)), dtype=np.int64)
 
 
-class Runner:
-    """Runs the experiments of a file on a backend, writing each iteration to the sink."""
+class WorkerLost(Exception):
+    """A backend's worker died or stopped answering: its iteration in flight is run again on
+    another worker, and this worker gets no more."""
 
-    def __init__(self, file: ExperimentFile, backend: Backend, sink: Sink,
-                 progress: Callable[[Progress], None] | None = None) -> None:
-        self.file, self.backend, self.sink = file, backend, sink
+
+class Runner:
+    """Runs the experiments of a file over one or more backends (workers), writing each
+    iteration to the sink as it finishes.
+
+    The iterations of an experiment are spread over the workers, each taking the next one
+    planned when it is free; an experiment starts when the one before it has finished (its
+    plan may need that one's metrics). At the end of each experiment the sink puts its rows
+    in plan order, so the results do not depend on how many workers ran them or which.
+    `abort` is set when the run fails, so that the other workers' calls stop.
+    """
+
+    def __init__(self, file: ExperimentFile, backends: Sequence[Backend], sink: Sink,
+                 progress: Callable[[Progress], None] | None = None,
+                 abort: threading.Event | None = None) -> None:
+        if not backends:
+            raise ValueError('a run needs at least one backend')
+        self.file, self.backends, self.sink = file, list(backends), sink
         self._progress = progress or (lambda p: None)
+        self._abort = abort or threading.Event()
+        self._cond = threading.Condition()
+        self._in_flight = 0
+        self._live = list(range(len(self.backends)))
         self._total = count_iterations(file)
         self._done = 0
         self._ran = 0
         self._start = time.monotonic()
 
+    @property
+    def lost_workers(self) -> list[int]:
+        """Indexes of the backends whose worker was lost during the run."""
+        return [k for k in range(len(self.backends)) if k not in self._live]
+
     def run(self) -> dict:
         """Run every experiment in order; returns the summary (also written to the sink)."""
-        self.backend.start(self.file)
+        for backend in self.backends:
+            backend.start(self.file)
         summary: dict = {}
+        rank: dict[tuple, int] = {}
         for exp in self.file.experiments:
-            for u in plan(self.file, exp, summary):
-                if self.sink.is_done(exp.id, u.group, u.iteration):
-                    self._done += 1
-                    continue
-                self._report(exp, f'{exp.id}: {_label(u)}')
-                self.sink.write(self.run_unit(u))
-                self._done += 1
-                self._ran += 1
+            units = plan(self.file, exp, summary)
+            rank.update(((u.experiment.id, u.group, u.iteration), len(rank)) for u in units)
+            todo = deque(u for u in units if not self.sink.is_done(exp.id, u.group, u.iteration))
+            self._done += len(units) - len(todo)
+            self._run_units(exp, todo)
+            self.sink.reorder(rank)
             summary[exp.id] = metrics.summarise(self.file, exp, self.sink.iterations(exp.id),
                                                 self.sink.picks(exp.id), summary)
             self.sink.write_summary(metrics.file_summary(self.file, summary))
         self._report(self.file.experiments[-1], 'done')
         return metrics.file_summary(self.file, summary)
+
+    def _run_units(self, exp: Experiment, todo: deque) -> None:
+        """Run `todo` over the live workers (in this thread when there is one)."""
+        errors: list[BaseException] = []
+        workers = [threading.Thread(target=self._work, args=(k, exp, todo, errors),
+                                    name=f'worker {k}') for k in self._live]
+        if len(workers) == 1:
+            workers[0].run()
+        else:
+            for t in workers:
+                t.start()
+            for t in workers:
+                t.join()
+        if errors:
+            raise errors[0]
+        if todo:
+            raise AssertionError(f'{len(todo)} iterations of {exp.id} were left undone')
+
+    def _work(self, k: int, exp: Experiment, todo: deque, errors: list) -> None:
+        """Worker k's loop: take the next iteration, run it, write it. While others are in
+        flight it waits rather than leave: a lost worker's iteration comes back to the queue."""
+        backend = self.backends[k]
+        while True:
+            with self._cond:
+                while not todo and self._in_flight and not errors:
+                    self._cond.wait()
+                if errors or not todo or self._abort.is_set():
+                    return
+                u = todo.popleft()
+                self._in_flight += 1
+                self._report(exp, f'{exp.id}: {_label(u)}')
+            try:
+                record = self.run_unit(u, backend)
+            except WorkerLost as exc:
+                with self._cond:
+                    todo.appendleft(u)
+                    self._live.remove(k)
+                    if not self._live:
+                        errors.append(exc)
+                        self._abort.set()
+                    self._in_flight -= 1
+                    self._cond.notify_all()
+                return
+            except BaseException as exc:
+                with self._cond:
+                    errors.append(exc)
+                    self._abort.set()
+                    self._in_flight -= 1
+                    self._cond.notify_all()
+                return
+            with self._cond:
+                self.sink.write(record)
+                self._done += 1
+                self._ran += 1
+                self._in_flight -= 1
+                self._cond.notify_all()
 
     def _report(self, exp: Experiment, phase: str) -> None:
         elapsed = time.monotonic() - self._start
@@ -218,13 +302,14 @@ class Runner:
         self._progress(Progress(exp.id, exp.type, phase, self._done, self._total, elapsed, eta))
 
     # ------------------------------------------------------------------------- one iteration
-    def run_unit(self, u: Unit) -> Record:
+    def run_unit(self, u: Unit, backend: Backend) -> Record:
+        """Run one iteration on `backend`; returns its rows."""
         start = time.monotonic()
-        self.backend.reset(u.container, u.seed)
+        backend.reset(u.container, u.seed)
         run = {BIN_STATIC: self._static, TABLE_SWEEP: self._static,
                BIN_EMPTYING: self._emptying, FEEDER_EMPTYING: self._feeder}[u.experiment.type]
         record = Record(iteration={})
-        row = run(u, record)
+        row = run(u, record, backend)
         first = record.checks[0] if record.checks else {}
         x, y, z = u.container.inner_size
         record.iteration = {
@@ -240,8 +325,8 @@ class Runner:
     def _key(self, u: Unit) -> dict:
         return {'experiment': u.experiment.id, 'group': u.group, 'iteration': u.iteration}
 
-    def _check(self, u: Unit, record: Record, states: PartStates, neighbours: bool,
-               vibrations: int = 0) -> tuple[Report | None, np.ndarray]:
+    def _check(self, u: Unit, record: Record, backend: Backend, states: PartStates,
+               neighbours: bool, vibrations: int = 0) -> tuple[Report | None, np.ndarray]:
         """Check the parts inside the container; record the check and every part's row.
         Returns the report (None when no part is inside) and the targets in search order."""
         targets = states.ids[states.inside]
@@ -252,7 +337,7 @@ class Runner:
         report = None
         stages: dict[int, tuple[int, int, int]] = {}
         if len(targets):
-            report = self.backend.check(u.container, states, targets.tolist(), neighbours)
+            report = backend.check(u.container, states, targets.tolist(), neighbours)
             row.update(report.counts)
             row['wall_time'] = report.wall_time
             stages = {r.part_id: (r.stage, r.grasp_index, len(r.valid_tilts))
@@ -290,54 +375,54 @@ class Runner:
         return {'settled': all(r.settled for r in reports),
                 'escaped': len({i for r in reports for i in r.escaped_ids})}
 
-    def _static(self, u: Unit, record: Record) -> dict:
+    def _static(self, u: Unit, record: Record, backend: Backend) -> dict:
         """bin_static (stages 1-3) and table_sweep (all four stages): drop, settle, check."""
-        states, settle = self.backend.drop(u.parts, 'container')
-        self._check(u, record, states, neighbours=u.experiment.type == TABLE_SWEEP)
+        states, settle = backend.drop(u.parts, 'container')
+        self._check(u, record, backend, states, neighbours=u.experiment.type == TABLE_SWEEP)
         return {**self._physics([settle]), 'emptied': False, 'vibrations': 0, 'feeds': 0,
                 'lost': 0, 'stop': ''}
 
-    def _emptying(self, u: Unit, record: Record) -> dict:
+    def _emptying(self, u: Unit, record: Record, backend: Backend) -> dict:
         """bin_emptying: check in search order, remove the first valid part, settle, repeat
         until none is valid or the bin is empty."""
-        states, settle = self.backend.drop(u.parts, 'container')
+        states, settle = backend.drop(u.parts, 'container')
         settles = [settle]
         stop = 'empty'
         while states.inside.any():
-            report, order = self._check(u, record, states, neighbours=True)
+            report, order = self._check(u, record, backend, states, neighbours=True)
             if report.counts['valid'] == 0:
                 stop = 'no valid part'
                 break
             pid = self._pick(u, record, report, order)
-            states, settle = self.backend.remove([pid])
+            states, settle = backend.remove([pid])
             settles.append(settle)
         return {**self._physics(settles), 'emptied': not states.inside.any(), 'vibrations': 0,
                 'feeds': 0, 'lost': int((~states.inside).sum()), 'stop': stop}
 
-    def _feeder(self, u: Unit, record: Record) -> dict:
+    def _feeder(self, u: Unit, record: Record, backend: Backend) -> dict:
         """feeder_emptying: the feeder loads the table up to max* and vibrates; then after each
         check the policy picks, vibrates, or feeds and vibrates, until it stops."""
-        step = self.backend.feed(0, 0, u.feeder)
-        states = self.backend.parts()
+        step = backend.feed(0, 0, u.feeder)
+        states = backend.parts()
         settles: list[SettleReport] = []
         lost = 0
         for _ in range(MAX_FEED_CYCLES):
             outside = states.ids[~states.inside].tolist()
             if outside:     # over the edge: gone from the table, counted as lost
                 lost += len(outside)
-                states, settle = self.backend.remove(outside, settle=False)
-            report, order = self._check(u, record, states, neighbours=True,
+                states, settle = backend.remove(outside, settle=False)
+            report, order = self._check(u, record, backend, states, neighbours=True,
                                         vibrations=step.vibrations)
             valid = report.counts['valid'] if report else 0
-            step = self.backend.feed(valid, int(states.inside.sum()), None)
+            step = backend.feed(valid, int(states.inside.sum()), None)
             if step.decision == PICK:
                 pid = self._pick(u, record, report, order, step.vibrations)
-                states, settle = self.backend.remove([pid])
+                states, settle = backend.remove([pid])
                 settles.append(settle)
             elif step.decision in (STOP_EMPTY, STOP_VIBRATION_LIMIT):
                 break
             else:
-                states = self.backend.parts()
+                states = backend.parts()
         return {**self._physics(settles), 'emptied': step.decision == STOP_EMPTY and lost == 0,
                 'vibrations': step.vibrations, 'feeds': step.feeds, 'lost': lost,
                 'stop': DECISION_NAMES[step.decision]}

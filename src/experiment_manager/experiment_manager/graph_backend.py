@@ -1,9 +1,10 @@
 """The experiment backend over the ROS 2 graph: a worker's `world`, `validity` and
 `feeder_controller` nodes, called by relative names under the worker's namespace.
 
-Calls are made from the thread that runs the experiment and wait on their futures while the
-node's executor spins in other threads. A wait ends with an error, never a hang: when the goal
-is canceled, when the server drops out of the graph (its node died), or after `call_timeout`.
+Calls are made from the thread that runs the worker's iterations and wait on their futures
+while the node's executor spins in other threads. A wait ends with an error, never a hang: when
+the goal is canceled, or with `WorkerGone` when the server drops out of the graph (its node
+died) or gives no answer within `call_timeout` (the runner then runs the iteration elsewhere).
 """
 
 from collections.abc import Callable
@@ -24,7 +25,7 @@ from rclpy.action import ActionClient
 from rclpy.node import Node
 
 from .config import ExperimentFile
-from .experiments import FeedStep
+from .experiments import FeedStep, WorkerLost
 
 POLL = 0.1              # s between checks of a pending call
 GONE_AFTER = 2.0        # s a server must stay absent from the graph before a call fails
@@ -37,6 +38,10 @@ class GraphError(Exception):
     def __init__(self, code: int, message: str) -> None:
         self.code = code
         super().__init__(message)
+
+
+class WorkerGone(GraphError, WorkerLost):
+    """The worker died or stopped answering in the middle of a run."""
 
 
 class GraphBackend:
@@ -57,6 +62,8 @@ class GraphBackend:
         self._drop = ActionClient(node, DropParts, name('drop_parts'), **group)
         self._remove = ActionClient(node, RemoveParts, name('remove_parts'), **group)
         self._feed = ActionClient(node, FeedCycle, name('feed_cycle'), **group)
+        self._clients = (self._reset, self._get, self._check_client, self._drop, self._remove,
+                         self._feed)
         self._file: ExperimentFile | None = None
         self._parts_msg = PartArray()
 
@@ -65,10 +72,11 @@ class GraphBackend:
         return f'{self._ns}/{endpoint}' if self._ns else endpoint
 
     def destroy(self) -> None:
-        for client in (self._reset, self._get, self._check_client):
-            self._node.destroy_client(client)
-        for action in (self._drop, self._remove, self._feed):
-            action.destroy()
+        for client in self._clients:
+            if isinstance(client, ActionClient):
+                client.destroy()
+            else:
+                self._node.destroy_client(client)
 
     # ------------------------------------------------------------------------- waiting
     def _ready(self, client) -> bool:
@@ -80,24 +88,26 @@ class GraphBackend:
         name = client._action_name if isinstance(client, ActionClient) else client.srv_name
         return self._node.resolve_service_name(name)
 
-    def wait_for_servers(self) -> None:
-        """Fail with the missing endpoints' names unless all are there within server_timeout."""
-        clients = (self._reset, self._get, self._check_client, self._drop, self._remove,
-                   self._feed)
+    def wait_for_servers(self, error: type[GraphError] = GraphError) -> None:
+        """Raise `error` with the missing endpoints' names unless all are there within
+        server_timeout."""
         deadline = time.monotonic() + self._server_timeout
         while time.monotonic() < deadline:
-            if all(self._ready(c) for c in clients):
+            if all(self._ready(c) for c in self._clients):
                 return
             if self._canceled():
                 raise GraphError(CheckParts.Response.CANCELED, 'canceled')
             time.sleep(POLL)
-        missing = [self._endpoint(c) for c in clients if not self._ready(c)]
+        missing = [self._endpoint(c) for c in self._clients if not self._ready(c)]
         where = f'namespace {self._ns!r}' if self._ns else "the manager's namespace"
-        raise GraphError(CheckParts.Response.INTERNAL, (
+        raise error(CheckParts.Response.INTERNAL, (
             f'not in the graph after {self._server_timeout:g} s: {", ".join(missing)} (are the '
             f'world, validity and feeder_controller nodes running in {where}?)'))
 
     def _wait(self, future, client, what: str):
+        """The future's result. Every endpoint of the worker must stay in the graph meanwhile:
+        a feed_cycle, say, waits on the world through the feeder_controller, and a world that
+        died would leave it waiting for ever."""
         done = threading.Event()
         future.add_done_callback(lambda _: done.set())
         start = time.monotonic()
@@ -108,29 +118,30 @@ class GraphBackend:
                 future.cancel()
                 raise GraphError(CheckParts.Response.CANCELED, f'canceled during {what}')
             if now - start > self._call_timeout:
-                raise GraphError(CheckParts.Response.INTERNAL, (
+                raise WorkerGone(CheckParts.Response.INTERNAL, (
                     f'{what}: no answer from {self._endpoint(client)} within call_timeout '
                     f'{self._call_timeout:g} s'))
-            if self._ready(client):
+            missing = [c for c in self._clients if not self._ready(c)]
+            if not missing:
                 absent_since = None
             elif absent_since is None:
                 absent_since = now
             elif now - absent_since > GONE_AFTER:
-                raise GraphError(CheckParts.Response.INTERNAL, (
-                    f'{what}: {self._endpoint(client)} left the graph while answering (its '
-                    'node died or was stopped)'))
+                raise WorkerGone(CheckParts.Response.INTERNAL, (
+                    f'{what}: {", ".join(self._endpoint(c) for c in missing)} left the graph '
+                    'while the worker was answering (its node died or was stopped)'))
         return future.result()
 
     def _service(self, client, request, what: str):
         if not self._ready(client):
-            self.wait_for_servers()
+            self.wait_for_servers(WorkerGone)
         response = self._wait(client.call_async(request), client, what)
         self._raise_on_error(response, what)
         return response
 
     def _action(self, client: ActionClient, goal, what: str):
         if not self._ready(client):
-            self.wait_for_servers()
+            self.wait_for_servers(WorkerGone)
         handle = self._wait(client.send_goal_async(goal), client, what)
         if not handle.accepted:
             raise GraphError(CheckParts.Response.INTERNAL, f'{what}: the goal was rejected')

@@ -27,10 +27,12 @@ def executable(package: str, name: str) -> str:
 
 class NodeProcess:
     """A node started as a process, its output in `log_path`. stop() sends SIGINT, then
-    SIGKILL after `timeout`, and returns the exit code."""
+    SIGKILL after `timeout`, and returns the exit code. `label` names it in messages (default:
+    the executable's name)."""
 
-    def __init__(self, package: str, name: str, ros_args: list[str], log_path: str) -> None:
-        self.name = name
+    def __init__(self, package: str, name: str, ros_args: list[str], log_path: str,
+                 label: str = '') -> None:
+        self.name = label or name
         self.command = [executable(package, name), '--ros-args', *ros_args]
         self.log_path = log_path
         with open(log_path, 'wb') as log:

@@ -100,15 +100,18 @@ class ResultsWriter:
             self._write_text('experiment.yaml', experiment_text)
         self._files = {}
         self._writers = {}
-        for name, columns in FILES.items():
-            new = not os.path.exists(self.path(name))
-            f = open(self.path(name), 'a', newline='', encoding='utf-8')
-            self._files[name] = f
-            self._writers[name] = csv.DictWriter(f, columns, extrasaction='raise')
-            if new:
-                self._writers[name].writeheader()
-                f.flush()
+        for name in FILES:
+            self._open(name)
         self._done = {_key(r) for r in self._rows['iterations']}
+
+    def _open(self, name: str) -> None:
+        new = not os.path.exists(self.path(name))
+        f = open(self.path(name), 'a', newline='', encoding='utf-8')
+        self._files[name] = f
+        self._writers[name] = csv.DictWriter(f, FILES[name], extrasaction='raise')
+        if new:
+            self._writers[name].writeheader()
+            f.flush()
 
     def path(self, name: str) -> str:
         return os.path.join(self.directory, name if '.' in name else f'{name}.csv')
@@ -132,20 +135,23 @@ class ResultsWriter:
                                   'differs from the file of the run being resumed: results '
                                   'would mix two experiments')
         done = {_key(r) for r in read_csv(self.path('iterations'))}
-        for name, columns in FILES.items():
+        for name in FILES:
             if not os.path.exists(self.path(name)):
                 continue
             rows = [r for r in read_csv(self.path(name)) if _key(r) in done]
             if name in self._rows:
                 self._rows[name] = rows
-            # Drop the rows of the iteration that was in flight.
-            fd, tmp = tempfile.mkstemp(dir=self.directory, prefix=f'.{name}.')
-            with os.fdopen(fd, 'w', newline='', encoding='utf-8') as f:
-                writer = csv.DictWriter(f, columns)
-                writer.writeheader()
-                writer.writerows(rows)
-            os.chmod(tmp, 0o666 & ~UMASK)
-            os.replace(tmp, self.path(name))
+            self._rewrite(name, rows)   # without the rows of the iterations in flight
+
+    def _rewrite(self, name: str, rows: list[dict]) -> None:
+        """Replace a results file atomically with `rows`."""
+        fd, tmp = tempfile.mkstemp(dir=self.directory, prefix=f'.{name}.')
+        with os.fdopen(fd, 'w', newline='', encoding='utf-8') as f:
+            writer = csv.DictWriter(f, FILES[name])
+            writer.writeheader()
+            writer.writerows(rows)
+        os.chmod(tmp, 0o666 & ~UMASK)
+        os.replace(tmp, self.path(name))
 
     # ------------------------------------------------------------------------- Sink
     def is_done(self, experiment_id: str, group: int, iteration: int) -> bool:
@@ -159,6 +165,32 @@ class ResultsWriter:
         self._rows['iterations'].append(record.iteration)
         self._rows['picks'] += record.picks
         self._done.add(_key(record.iteration))
+
+    def reorder(self, rank: dict[tuple, int]) -> None:
+        """Put the rows in the order of `rank` (iteration key -> position in the plan); keys
+        it lacks go last, in the order they have. Several workers finish iterations out of
+        order; the files of a run are then the same whoever ran what. A no-op when the rows
+        are in order already."""
+        def position(key: tuple, row: int) -> tuple[int, int]:
+            return (rank[key], 0) if key in rank else (len(rank), row)
+
+        keys = {_key(r): i for i, r in enumerate(self._rows['iterations'])}
+        order = [position(k, i) for k, i in keys.items()]
+        if order == sorted(order):
+            return
+        for name in FILES:
+            self._files[name].close()
+            rows = read_text_rows(self.path(name))
+            typed = [(r['experiment'], int(r['group']), int(r['iteration'])) for r in rows]
+            first = {}
+            for i, k in enumerate(typed):
+                first.setdefault(k, i)
+            at = [position(k, first[k]) for k in typed]
+            self._rewrite(name, [r for _, r in sorted(zip(at, rows, strict=True),
+                                                      key=lambda p: p[0])])
+            self._open(name)
+        for name, rows in self._rows.items():
+            self._rows[name] = sorted(rows, key=lambda r: position(_key(r), keys[_key(r)]))
 
     def iterations(self, experiment_id: str) -> list[dict]:
         return [r for r in self._rows['iterations'] if r['experiment'] == experiment_id]

@@ -1,4 +1,4 @@
-"""Recording a worker's topics into a `Recorder`, from raw (still serialized) messages.
+"""Recording workers' topics into a `Recorder`, from raw (still serialized) messages.
 
 The subscriptions live on their own node, spun by their own single-threaded executor in a
 thread: on the manager's multi-threaded executor they slowed the calls it waits on about 9x
@@ -24,24 +24,28 @@ DRAIN_LIMIT = 3.0       # s at most spent waiting for the last messages
 
 
 class TopicRecorder:
-    """Subscribes to the RECORDED topics under `prefix` (a relative namespace) and writes
-    what arrives to the recorder given to start(), until stop()."""
+    """Subscribes to the RECORDED topics of each worker added (a namespace relative to
+    `namespace`) and writes what arrives to the recorder given to start(), until stop()."""
 
-    def __init__(self, name: str, namespace: str, prefix: str, context=None) -> None:
+    def __init__(self, name: str, namespace: str, context=None) -> None:
         self.node = Node(name, namespace=namespace, context=context)
         self._lock = threading.Lock()
         self._recorder: Recorder | None = None
         self._last = 0.0
+        self._since = 0           # ns, system time: when the recording started
+        self._executor = SingleThreadedExecutor(context=context)
+        self._executor.add_node(self.node)
+        self._thread = threading.Thread(target=self._spin, name=name, daemon=True)
+        self._thread.start()
+
+    def add(self, prefix: str) -> None:
+        """Record the topics of the worker under `prefix` ('' for `namespace` itself)."""
         for topic, msg_type in RECORDED:
             relative = f'{prefix}/{topic}' if prefix else topic
             resolved = self.node.resolve_topic_name(relative)
             self.node.create_subscription(msg_type, relative,
                                           self._callback(resolved, type_name(msg_type)), QOS,
                                           raw=True)
-        self._executor = SingleThreadedExecutor(context=context)
-        self._executor.add_node(self.node)
-        self._thread = threading.Thread(target=self._spin, name=name, daemon=True)
-        self._thread.start()
 
     def _spin(self) -> None:
         try:
@@ -50,7 +54,11 @@ class TopicRecorder:
             pass
 
     def _callback(self, topic: str, name: str):
-        def record(data: bytes) -> None:
+        def record(data: bytes, info: dict) -> None:
+            # Not what was published before the recording started: a latched topic's history,
+            # which Fast DDS sends even to this volatile subscription when it first matches.
+            if info['source_timestamp'] < self._since:
+                return
             with self._lock:
                 if self._recorder is not None:
                     self._recorder.write_serialized(topic, name, data)
@@ -65,6 +73,7 @@ class TopicRecorder:
 
     def start(self, recorder: Recorder) -> None:
         with self._lock:
+            self._since = time.time_ns()
             self._recorder = recorder
             self._last = time.monotonic()
 

@@ -15,7 +15,7 @@ def run_small(directory: str, resume: bool = False) -> dict:
     """Run the small file on the cores (LocalBackend) into `directory`; returns the summary."""
     file = config.load(SMALL)
     with LocalBackend() as backend, ResultsWriter(directory, file.text, resume) as writer:
-        return Runner(file, backend, writer).run()
+        return Runner(file, [backend], writer).run()
 
 
 @pytest.fixture(scope='session')

@@ -3,9 +3,17 @@ policy), the results files they leave, resumption, and the metrics."""
 
 import json
 import os
+import threading
+import time
 
 from experiment_manager import config, metrics
-from experiment_manager.experiments import iteration_seed, plan, Runner, search_order
+from experiment_manager.experiments import (
+    iteration_seed,
+    plan,
+    Runner,
+    search_order,
+    WorkerLost,
+)
 from experiment_manager.local_backend import LocalBackend
 from experiment_manager.results import FILES, read_text_rows, ResultsWriter
 from feeder_controller.policy import NAMES
@@ -72,10 +80,10 @@ def test_runs_are_deterministic_and_independent_of_order(small, tmp_path):
             'experiments'][exp.id]
     records = {}
     with LocalBackend() as backend:
-        runner = Runner(file, backend, None)
+        runner = Runner(file, [backend], None)
         backend.start(file)
         for u in reversed(units):
-            records[(u.experiment.id, u.group, u.iteration)] = runner.run_unit(u)
+            records[(u.experiment.id, u.group, u.iteration)] = runner.run_unit(u, backend)
     rows = read(directory, 'iterations')
     for row in rows:
         again = records[(row['experiment'], int(row['group']), int(row['iteration']))]
@@ -101,7 +109,7 @@ def test_an_interrupted_run_resumes_to_the_same_results(small, run_file, tmp_pat
     out = str(tmp_path / 'run')
     with LocalBackend() as backend, StopAfter(out, file.text) as writer:
         with pytest.raises(Interrupt):
-            Runner(file, backend, writer).run()
+            Runner(file, [backend], writer).run()
     assert len(read(out, 'iterations')) == 7        # every finished iteration is on disk
     with pytest.raises(InvalidArgument, match='already holds results'):
         ResultsWriter(out, file.text)
@@ -110,6 +118,79 @@ def test_an_interrupted_run_resumes_to_the_same_results(small, run_file, tmp_pat
     assert run_file(out, resume=True) == summary
     for name in FILES:
         assert read(out, name) == read(directory, name), name
+
+
+class Worker(LocalBackend):
+    """A worker in this process whose resets are slowed by `delay` s, and that dies at its
+    reset number `dies_at` (after the delay)."""
+
+    def __init__(self, delay: float = 0.0, dies_at: int = 0) -> None:
+        super().__init__()
+        self.delay, self.dies_at, self.resets = delay, dies_at, 0
+
+    def reset(self, container, seed) -> None:
+        self.resets += 1
+        time.sleep(self.delay)
+        if self.resets == self.dies_at:
+            raise WorkerLost(f'the worker died at its reset {self.resets}')
+        super().reset(container, seed)
+
+
+class Writer(ResultsWriter):
+    """Keeps the order in which iterations were written."""
+
+    def write(self, record) -> None:
+        self.written = getattr(self, 'written', [])
+        self.written.append([str(record.iteration[k]) for k in ('experiment', 'group',
+                                                                'iteration')])
+        super().write(record)
+
+
+def run_on(workers: list, directory: str) -> tuple[Runner, dict, list]:
+    file = config.load(SMALL)
+    try:
+        with Writer(directory, file.text) as writer:
+            runner = Runner(file, workers, writer)
+            return runner, runner.run(), writer.written
+    finally:
+        for w in workers:
+            w.close()
+
+
+def test_two_workers_give_the_results_of_one_whatever_order_they_finish_in(small, tmp_path):
+    directory, summary = small
+    # The first worker is slowed: iterations finish out of plan order, and the files are put
+    # back in plan order at the end of each experiment.
+    workers = [Worker(delay=0.3), Worker()]
+    runner, got, written = run_on(workers, str(tmp_path / 'two'))
+    assert got == summary and runner.lost_workers == []
+    assert workers[0].resets >= 1 and workers[1].resets > workers[0].resets
+    planned = [[r['experiment'], r['group'], r['iteration']] for r in read(directory,
+                                                                           'iterations')]
+    assert written != planned and sorted(written) == sorted(planned)
+    for name in FILES:
+        assert read(str(tmp_path / 'two'), name) == read(directory, name), name
+
+
+@pytest.mark.parametrize('lost', [
+    Worker(dies_at=3),                 # while the other is busy
+    Worker(delay=2.0, dies_at=1),      # late: the other has run out of work and must wait
+], ids=['busy', 'idle'])
+def test_a_lost_worker_s_iteration_runs_again_on_another(small, tmp_path, lost):
+    directory, summary = small
+    runner, got, _ = run_on([lost, Worker()], str(tmp_path / 'lost'))
+    assert runner.lost_workers == [0] and lost.resets == lost.dies_at
+    assert got == summary
+    for name in FILES:
+        assert read(str(tmp_path / 'lost'), name) == read(directory, name), name
+
+
+def test_the_run_fails_when_every_worker_is_lost_and_keeps_what_finished(tmp_path):
+    workers = [Worker(dies_at=2), Worker(dies_at=3)]
+    with pytest.raises(WorkerLost, match='died at its reset'):
+        run_on(workers, str(tmp_path / 'none'))
+    assert len(read(str(tmp_path / 'none'), 'iterations')) == 3
+    assert threading.active_count() == 1, 'a worker thread outlived the run'
 
 
 def test_an_unwritable_output_directory_is_named(tmp_path):
