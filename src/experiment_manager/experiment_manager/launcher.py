@@ -1,6 +1,7 @@
 """Starting the graph's nodes as processes, from their installed executables (where `ros2 run`
 finds them), each logging to its own file. No rclpy here."""
 
+import ctypes
 import os
 import signal
 import subprocess
@@ -11,6 +12,13 @@ from ament_index_python.packages import get_package_prefix, PackageNotFoundError
 WORKER_NODES = (('pick_sim_world', 'world'), ('pick_validity', 'validity'),
                 ('feeder_controller', 'feeder_controller'))
 MANAGER = ('experiment_manager', 'experiment_manager')
+PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent() -> None:
+    """In the child before exec: get SIGINT when the parent dies, even by SIGKILL, so that a
+    killed `run` leaves no node behind (Linux)."""
+    ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGINT)
 
 
 def executable(package: str, name: str) -> str:
@@ -37,7 +45,8 @@ class NodeProcess:
         self.log_path = log_path
         with open(log_path, 'wb') as log:
             self.process = subprocess.Popen(self.command, stdout=log, stderr=subprocess.STDOUT,
-                                            stdin=subprocess.DEVNULL)
+                                            stdin=subprocess.DEVNULL,
+                                            preexec_fn=_die_with_parent)
 
     @property
     def pid(self) -> int:
