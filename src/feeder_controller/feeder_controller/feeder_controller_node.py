@@ -11,7 +11,7 @@ from pick_msgs.action import DropParts, FeedCycle, Vibrate
 from pick_msgs.msg import FeederState as FeederStateMsg
 from pick_sim_world import conversions as world_conversions
 from pick_sim_world.errors import WorldError
-from pick_sim_world.node_runner import LATCHED, run
+from pick_sim_world.node_runner import LATCHED, RESULT_KEEP, run
 from rcl_interfaces.msg import IntegerRange, ParameterDescriptor
 from rclpy.action import ActionClient, ActionServer
 from rclpy.callback_groups import ReentrantCallbackGroup
@@ -70,7 +70,7 @@ class FeederControllerNode(Node):
         self._drop = ActionClient(self, DropParts, 'drop_parts', callback_group=group)
         self._vibrate = ActionClient(self, Vibrate, 'vibrate', callback_group=group)
         ActionServer(self, FeedCycle, 'feed_cycle', execute_callback=self._feed_cycle,
-                     callback_group=group)
+                     callback_group=group, result_timeout=RESULT_KEEP)
         self._publish_state()
 
     def _state_msg(self) -> FeederStateMsg:

@@ -13,6 +13,12 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from .errors import WorldError
 
+# s an action server keeps a finished goal's result (rclpy's default: 900). Every status
+# message lists each goal kept, and every client decodes every status message: with the default,
+# a feeder run of a thousand goals made the manager spend half its time decoding goal statuses
+# (py-spy). Clients here ask for the result as soon as the goal is accepted.
+RESULT_KEEP = 10.0
+
 # Latched: a late subscriber gets the last message (scene, markers, last report).
 LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL,
                      reliability=ReliabilityPolicy.RELIABLE)

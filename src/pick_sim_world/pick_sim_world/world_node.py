@@ -28,7 +28,7 @@ from . import conversions as conv
 from .config import PhysicsConfig, SceneSpec, Vibration
 from .containers import BIN, ContainerSpec, TRAY
 from .errors import InvalidArgument, WorldError
-from .node_runner import LATCHED, run
+from .node_runner import LATCHED, RESULT_KEEP, run
 from .parts import BUILTIN_MODELS, PartSpec
 from .world import Progress, SettleReport, World
 
@@ -71,7 +71,7 @@ class WorldNode(Node):
             ActionServer(self, action_type, name, execute_callback=execute,
                          goal_callback=lambda _goal: GoalResponse.ACCEPT,
                          cancel_callback=lambda _handle: CancelResponse.ACCEPT,
-                         callback_group=group)
+                         callback_group=group, result_timeout=RESULT_KEEP)
         self._states = self._world.snapshot()
         self._publish(scene_changed=True)
         self.get_logger().info(
