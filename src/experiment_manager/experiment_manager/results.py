@@ -14,6 +14,7 @@ resume, rows of unfinished iterations are dropped from the other files and the f
 are skipped. Floats are written with repr(), which reads back to the same float.
 """
 
+from collections.abc import Callable
 import csv
 import json
 import os
@@ -171,8 +172,8 @@ class ResultsWriter:
         it lacks go last, in the order they have. Several workers finish iterations out of
         order; the files of a run are then the same whoever ran what. A no-op when the rows
         are in order already."""
-        def position(key: tuple, row: int) -> tuple[int, int]:
-            return (rank[key], 0) if key in rank else (len(rank), row)
+        def position(key: tuple, index: int) -> tuple[int, int]:
+            return (rank[key], 0) if key in rank else (len(rank), index)
 
         keys = {_key(r): i for i, r in enumerate(self._rows['iterations'])}
         order = [position(k, i) for k, i in keys.items()]
@@ -180,17 +181,43 @@ class ResultsWriter:
             return
         for name in FILES:
             self._files[name].close()
-            rows = read_text_rows(self.path(name))
-            typed = [(r['experiment'], int(r['group']), int(r['iteration'])) for r in rows]
-            first = {}
-            for i, k in enumerate(typed):
-                first.setdefault(k, i)
-            at = [position(k, first[k]) for k in typed]
-            self._rewrite(name, [r for _, r in sorted(zip(at, rows, strict=True),
-                                                      key=lambda p: p[0])])
+            self._move_blocks(name, position)
             self._open(name)
         for name, rows in self._rows.items():
             self._rows[name] = sorted(rows, key=lambda r: position(_key(r), keys[_key(r)]))
+
+    def _move_blocks(self, name: str, position: Callable[[tuple, int], tuple]) -> None:
+        """Rewrite a results file (atomically) with its blocks of rows, one block per
+        iteration as write() appended it, sorted by position(key, block index). Copies bytes
+        block by block: a file of millions of rows is never held in memory."""
+        path = self.path(name)
+        blocks: list[tuple[tuple, int, int]] = []     # (position, start, end)
+        with open(path, 'rb') as f:
+            header = f.readline()
+            columns = header.decode().rstrip('\r\n').split(',')
+            at = [columns.index(k) for k in KEY]
+            start, key = f.tell(), None
+            while True:
+                offset = f.tell()
+                line = f.readline()
+                fields = line.split(b',', max(at) + 1) if line else None
+                here = ((fields[at[0]].decode(), int(fields[at[1]]), int(fields[at[2]]))
+                        if line else None)
+                if here != key:
+                    if key is not None:
+                        blocks.append((position(key, len(blocks)), start, offset))
+                    start, key = offset, here
+                if not line:
+                    break
+            blocks.sort(key=lambda b: b[0])
+            fd, tmp = tempfile.mkstemp(dir=self.directory, prefix=f'.{name}.')
+            with os.fdopen(fd, 'wb') as out:
+                out.write(header)
+                for _, begin, end in blocks:
+                    f.seek(begin)
+                    out.write(f.read(end - begin))
+        os.chmod(tmp, 0o666 & ~UMASK)
+        os.replace(tmp, path)
 
     def iterations(self, experiment_id: str) -> list[dict]:
         return [r for r in self._rows['iterations'] if r['experiment'] == experiment_id]
