@@ -16,7 +16,7 @@ import time
 
 from experiment_manager import config
 from experiment_manager.experiments import Runner
-from experiment_manager.launcher import executable
+from experiment_manager.launcher import executable, WORKER_NODES
 from experiment_manager.local_backend import LocalBackend
 from experiment_manager.results import FILES, read_text_rows, ResultsWriter
 from graph import unique_namespace
@@ -248,3 +248,50 @@ def test_a_second_goal_is_busy_and_a_killed_last_worker_ends_the_run(tmp_path, c
     assert summary is not None and summary.statistics.message_count > 0
     assert {a.name for a in summary.attachment_indexes} >= {'experiment.yaml', 'iterations.csv'}
     assert not os.path.exists(tmp_path / 'other'), 'the busy goal wrote nothing'
+
+
+def test_a_run_killed_with_sigkill_leaves_no_node_behind(tmp_path, client, private_ros_domain):
+    ns = unique_namespace('exp_orphans')
+    out = tmp_path / 'out'
+
+    def nodes() -> list[str]:
+        return subprocess.run(['pgrep', '-f', f'__ns:={ns}'], capture_output=True,
+                              text=True).stdout.split()
+    run = subprocess.Popen([executable('experiment_manager', 'run'), SMALL, '--output',
+                            str(out), '--namespace', ns, '--workers', '1', '--logs',
+                            str(tmp_path / 'logs')],
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        assert client.wait(first_iteration_done(out), 120.0), 'no iteration finished'
+        assert len(nodes()) == 4        # world, validity, feeder_controller, the manager
+    finally:
+        run.kill()
+        run.wait()
+    assert client.wait(lambda: not nodes(), 30.0), f'left running: {nodes()}'
+
+
+TINY = """id: tiny
+seed: 5
+experiments:
+  - {id: bins, type: bin_static, iterations: 2, parts: 20, bins_mm: [[100, 100, 30]]}
+"""
+
+
+def test_the_manager_finds_the_workers_under_its_namespace(tmp_path, client, start_node):
+    """`ros2 run` style: two workers in sub-namespaces and a manager with its defaults; a
+    namespace with a validity node alone is not a worker."""
+    ns = unique_namespace('exp_find')
+    nodes = [start_node(pkg, exe, '-r', f'__ns:={ns}/{w}') for w in ('cell_a', 'cell_b')
+             for pkg, exe in WORKER_NODES]
+    nodes.append(start_node('pick_validity', 'validity', '-r', f'__ns:={ns}/lone'))
+    manager = start_node('experiment_manager', 'experiment_manager', '-r', f'__ns:={ns}')
+    path = tmp_path / 'tiny.yaml'
+    path.write_text(TINY)
+    action = ActionClient(client.node, RunExperiment, f'{ns}/run_experiment')
+    assert client.wait(action.server_is_ready, 60.0, nodes=(manager,))
+    handle = client.result(action.send_goal_async(RunExperiment.Goal(
+        experiment_file=str(path), output_dir=str(tmp_path / 'out'))))
+    result = client.result(handle.get_result_async(), 300.0).result
+    assert result.error_code == 0, result.error_msg
+    assert len(rows(result.results_path, 'iterations')) == 2
+    assert 'on 2 worker(s): cell_a, cell_b' in manager.output()

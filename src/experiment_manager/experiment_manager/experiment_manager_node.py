@@ -105,15 +105,17 @@ class ExperimentManagerNode(Node):
                 or (goal is not None and goal.is_cancel_requested))
 
     def _discover(self) -> list[str]:
-        """Namespaces under this node's that hold a validity node's check_parts, relative."""
+        """Namespaces under this node's that hold a whole worker (the world's reset_scene, the
+        validity node's check_parts, the feeder's feed_cycle), relative to this node's."""
         base = self.get_namespace().rstrip('/')
-        suffix = '/check_parts'
-        found = set()
-        for name, types in self.get_service_names_and_types():
-            if name.endswith(suffix) and 'pick_msgs/srv/CheckParts' in types:
-                ns = name[:-len(suffix)]
-                if ns == base or ns.startswith(base + '/'):
-                    found.add(ns[len(base):].strip('/'))
+        names = {name for name, _ in self.get_service_names_and_types()}
+        found = []
+        for name in names:
+            if name.endswith('/check_parts') and (name == base + '/check_parts'
+                                                  or name.startswith(base + '/')):
+                ns = name[:-len('/check_parts')]
+                if {f'{ns}/reset_scene', f'{ns}/feed_cycle/_action/send_goal'} <= names:
+                    found.append(ns[len(base):].strip('/'))
         return sorted(found)
 
     def _workers_of_run(self) -> list[GraphBackend]:
@@ -132,8 +134,9 @@ class ExperimentManagerNode(Node):
             if not workers:
                 raise GraphError(RunExperiment.Result.INTERNAL, (
                     f'no worker found within server_timeout {self._server_timeout:g} s: no '
-                    f'check_parts service under {self.get_namespace()} (are the world, '
-                    'validity and feeder_controller nodes running?)'))
+                    f'namespace under {self.get_namespace()} holds reset_scene, check_parts '
+                    'and feed_cycle (are the world, validity and feeder_controller nodes '
+                    'running?)'))
         for worker in workers:
             if worker not in self._backends:
                 self._backends[worker] = GraphBackend(
@@ -184,14 +187,14 @@ class ExperimentManagerNode(Node):
             backends = self._workers_of_run()
             self.get_logger().info(f'running {file.path} into {run_dir} on '
                                    f'{len(backends)} worker(s): '
-                                   f'{", ".join(b.name("") or "." for b in backends)}')
+                                   f'{", ".join(b.worker or "." for b in backends)}')
             runner = Runner(file, backends, writer, self._publish_progress, self._abort)
             try:
                 summary = runner.run()
             finally:
                 for k in runner.lost_workers:
-                    self.get_logger().warning(f'worker {backends[k].name("")} was lost during '
-                                              'the run; its iteration ran again on another')
+                    self.get_logger().warning(f'worker {backends[k].worker or "."} was lost '
+                                              'during the run')
             result.summary_json = json.dumps(summary)
             try:
                 pictures.write(file, run_dir)

@@ -67,6 +67,11 @@ class GraphBackend:
         self._file: ExperimentFile | None = None
         self._parts_msg = PartArray()
 
+    @property
+    def worker(self) -> str:
+        """The worker's namespace, relative ('' for the manager's own)."""
+        return self._ns
+
     def name(self, endpoint: str) -> str:
         """The relative name of a worker endpoint."""
         return f'{self._ns}/{endpoint}' if self._ns else endpoint
