@@ -1,8 +1,11 @@
-"""An experiment file through the graph (the `run` command: four node processes over DDS)
-against the same file on the cores in this process (LocalBackend), in one run: wall times per
-experiment type, the ratio, and whether the result files are identical (they must be).
+"""An experiment file on the cores in this process (LocalBackend), through the graph with one
+worker and with two (the `run` command: node processes over DDS), in one run: wall time per
+iteration and type, the graph's ratio to the cores, the throughput of two workers against
+one, the peak memory of each worker's processes, and whether the result files of the three are
+identical (they must be).
 
-    tools/ws python bench/bench_experiment.py [FILE]   (default: the built-in experiment file)
+    tools/ws python bench/bench_experiment.py [FILE] [--workers 1 2]
+    (default: the built-in experiment file)
 """
 
 import argparse
@@ -12,6 +15,7 @@ import re
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 
 from experiment_manager import config
@@ -26,17 +30,76 @@ def rows(directory: str, name: str, drop: tuple[str, ...] = ()) -> list[dict]:
     return read_text_rows(os.path.join(directory, f'{name}.csv'), drop)
 
 
-def per_type(directory: str) -> dict[str, float]:
-    out: dict[str, float] = collections.defaultdict(float)
+def per_type(directory: str) -> tuple[dict[str, float], dict[str, int]]:
+    """Summed iteration wall time and iteration count per experiment type."""
+    wall: dict[str, float] = collections.defaultdict(float)
+    count: dict[str, int] = collections.defaultdict(int)
     for r in rows(directory, 'iterations'):
-        out[r['type']] += float(r['wall_time'])
-    return out
+        wall[r['type']] += float(r['wall_time'])
+        count[r['type']] += 1
+    return wall, count
+
+
+def run_span(directory: str) -> float:
+    """From the run directory's creation (experiment.yaml) to the last summary: the run's
+    iterations without starting the processes or writing the report."""
+    return (os.path.getmtime(os.path.join(directory, 'summary.json'))
+            - os.path.getmtime(os.path.join(directory, 'experiment.yaml')))
+
+
+class PeakMemory:
+    """Polls the peak resident memory (VmHWM) of the node processes under `namespace`."""
+
+    def __init__(self, namespace: str) -> None:
+        self.namespace, self.peak_kb = namespace, {}
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._poll, daemon=True)
+        self._thread.start()
+
+    def _poll(self) -> None:
+        pattern = re.compile(r'lib/\w+/(\w+) --ros-args -r __ns:=\S*?(/worker_\d+)?(?: |$)')
+        while not self._stop.wait(0.5):
+            for pid in os.listdir('/proc'):
+                try:
+                    cmd = open(f'/proc/{pid}/cmdline', 'rb').read().replace(b'\0', b' ').decode()
+                    if f'__ns:={self.namespace}' not in cmd:
+                        continue
+                    status = open(f'/proc/{pid}/status').read()
+                except (OSError, ValueError):
+                    continue
+                m = pattern.search(cmd)
+                hwm = re.search(r'VmHWM:\s+(\d+)', status)
+                if m and hwm:
+                    key = ((m.group(2) or '').strip('/'), m.group(1))
+                    self.peak_kb[key] = max(self.peak_kb.get(key, 0), int(hwm.group(1)))
+
+    def stop(self) -> dict[tuple[str, str], int]:
+        self._stop.set()
+        self._thread.join()
+        return self.peak_kb
+
+
+def graph(path: str, work: str, workers: int) -> tuple[str, float, dict]:
+    namespace = f'/bench_{os.getpid()}_{workers}'
+    memory = PeakMemory(namespace)
+    start = time.perf_counter()
+    done = subprocess.run([executable('experiment_manager', 'run'), path, '--output',
+                           os.path.join(work, f'graph_{workers}'), '--namespace', namespace,
+                           '--workers', str(workers)], capture_output=True, text=True)
+    wall = time.perf_counter() - start
+    peaks = memory.stop()
+    if done.returncode != 0:
+        sys.exit(f'run --workers {workers} failed:\n{done.stderr}')
+    return re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1), wall, peaks
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('file', nargs='?', default=None)
-    path = os.path.abspath(parser.parse_args().file or default_file())
+    parser.add_argument('--workers', type=int, nargs=2, default=[1, 2], metavar=('A', 'B'),
+                        help='the two worker counts to compare (default 1 2)')
+    args = parser.parse_args()
+    path = os.path.abspath(args.file or default_file())
     file = config.load(path)
     os.environ.setdefault('ROS_DOMAIN_ID', str(150 + os.getpid() % 50))
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
@@ -47,29 +110,37 @@ def main() -> int:
     with LocalBackend() as backend, ResultsWriter(local_dir, file.text) as writer:
         Runner(file, [backend], writer).run()
     local_wall = time.perf_counter() - start
+    a, b = args.workers
+    dir_a, wall_a, mem_a = graph(path, work, a)
+    dir_b, wall_b, mem_b = graph(path, work, b)
 
-    start = time.perf_counter()
-    done = subprocess.run([executable('experiment_manager', 'run'), path, '--output',
-                           os.path.join(work, 'graph'), '--namespace',
-                           f'/bench_{os.getpid()}'], capture_output=True, text=True)
-    graph_wall = time.perf_counter() - start
-    if done.returncode != 0:
-        print(done.stderr, file=sys.stderr)
-        return 1
-    graph_dir = re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1)
-
-    identical = all(rows(graph_dir, name, ('wall_time',)) == rows(local_dir, name, ('wall_time',))
-                    for name in FILES)
-    g, c = per_type(graph_dir), per_type(local_dir)
-    print(f'{file.id}: {sum(1 for _ in rows(local_dir, "iterations"))} iterations')
-    print(f'{"experiment type":<18} {"graph s":>9} {"core s":>9} {"ratio":>7}')
+    identical = all(rows(d, name, ('wall_time',)) == rows(local_dir, name, ('wall_time',))
+                    for d in (dir_a, dir_b) for name in FILES)
+    (g, n), (c, _) = per_type(dir_a), per_type(local_dir)
+    print(f'{file.id}: {sum(n.values())} iterations; wall time per iteration, s')
+    print(f'{"experiment type":<18} {"n":>4} {f"graph, {a} worker(s)":>20} {"cores":>9} '
+          f'{"ratio":>7}')
     for kind in config.TYPES:
         if kind in c:
-            print(f'{kind:<18} {g[kind]:9.2f} {c[kind]:9.2f} {g[kind] / c[kind]:7.2f}')
-    print(f'{"iterations, all":<18} {sum(g.values()):9.2f} {sum(c.values()):9.2f} '
-          f'{sum(g.values()) / sum(c.values()):7.2f}')
-    print(f'{"whole command":<18} {graph_wall:9.2f} {local_wall:9.2f} '
-          f'{graph_wall / local_wall:7.2f}   (graph: starting 4 processes included)')
+            print(f'{kind:<18} {n[kind]:4d} {g[kind] / n[kind]:20.3f} {c[kind] / n[kind]:9.3f} '
+                  f'{g[kind] / c[kind]:7.2f}')
+    print(f'{"all iterations":<18} {sum(n.values()):4d} {sum(g.values()):19.2f}s '
+          f'{sum(c.values()):8.2f}s {sum(g.values()) / sum(c.values()):7.2f}')
+    span_a, span_b = run_span(dir_a), run_span(dir_b)
+    print(f'\nthe run (first iteration to last summary): {a} worker(s) {span_a:.2f} s, '
+          f'{b} worker(s) {span_b:.2f} s: throughput x{span_a / span_b:.2f}')
+    print(f'the whole command: cores {local_wall:.2f} s; graph {a} worker(s) {wall_a:.2f} s, '
+          f'{b} worker(s) {wall_b:.2f} s (starting processes and the report included)')
+    for workers, peaks in ((a, mem_a), (b, mem_b)):
+        per_worker: dict[str, int] = collections.defaultdict(int)
+        for (worker, _), kb in peaks.items():
+            if worker:
+                per_worker[worker] += kb
+        nodes = ', '.join(f'{node} {kb / 1024:.0f}' for (worker, node), kb in sorted(
+            peaks.items()) if worker in ('', 'worker_0'))
+        print(f'peak memory, {workers} worker(s): per worker (3 processes) '
+              + ', '.join(f'{w} {kb / 1024:.0f} MiB' for w, kb in sorted(per_worker.items()))
+              + f'; worker_0 and manager by node (MiB): {nodes}')
     print(f'result files identical (wall times aside): {identical}')
     return 0 if identical else 1
 
