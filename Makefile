@@ -11,12 +11,15 @@ DEPS_STAMP := $(VENV)/.deps-stamp
 BUILD_STAMP := install/.build-stamp
 SOURCES := $(shell find src -type f -not -path '*/__pycache__/*' -not -name '*.pyc' 2>/dev/null)
 PYTEST_ARGS ?=
-RUN_ARGS ?=
+# The paper's test case (README, "The paper's test case"), one iteration per bin, per n and per
+# feeder run; RUN_ARGS="$(TEST_CASE)" runs the full counts, RUN_ARGS="" the built-in small file.
+TEST_CASE := $(addprefix src/experiment_manager/config/test_case/,pth0.yaml pth1.yaml pth2.yaml)
+RUN_ARGS ?= --iterations 1 $(TEST_CASE)
 
 .PHONY: help run test lint bench deps build lock clean
 
 help:
-	@echo 'make run    - run the built-in experiment file through the graph (RUN_ARGS="file.yaml")'
+	@echo "make run    - the paper's test case, reduced, through the graph (RUN_ARGS=\"file.yaml\")"
 	@echo 'make test   - lint and run every test (installs and builds on first use)'
 	@echo 'make bench  - world, validity and vibration benchmarks (figures in the READMEs)'
 	@echo 'make clean  - remove build/, install/, log/ (keeps the venv)'
