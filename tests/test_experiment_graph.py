@@ -177,6 +177,13 @@ experiments:
 """
 
 
+def start_run(file, tmp_path, namespace: str, workers: int, **popen) -> subprocess.Popen:
+    """The `run` command in the background, into tmp_path/out, logs in tmp_path/logs."""
+    return subprocess.Popen([executable('experiment_manager', 'run'), str(file), '--output',
+                             str(tmp_path / 'out'), '--namespace', namespace, '--workers',
+                             str(workers), '--logs', str(tmp_path / 'logs')], **popen)
+
+
 def first_iteration_done(out) -> Callable[[], bool]:
     def done() -> bool:
         found = glob.glob(f'{out}/*/iterations.csv')
@@ -187,13 +194,10 @@ def first_iteration_done(out) -> Callable[[], bool]:
 def test_a_killed_worker_s_iterations_run_on_the_other_with_the_same_results(
         tmp_path, client, core_run, private_ros_domain):
     ns = unique_namespace('exp_lose')
-    out = tmp_path / 'out'
-    run = subprocess.Popen([executable('experiment_manager', 'run'), SMALL, '--output',
-                            str(out), '--namespace', ns, '--workers', '2', '--logs',
-                            str(tmp_path / 'logs')],
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    run = start_run(SMALL, tmp_path, ns, 2, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                    text=True)
     try:
-        assert client.wait(first_iteration_done(out), 120.0), 'no iteration finished'
+        assert client.wait(first_iteration_done(tmp_path / 'out'), 120.0), 'no iteration finished'
         os.kill(_world_pid(ns), signal.SIGKILL)
         stdout, stderr = run.communicate(timeout=600)
     finally:
@@ -219,10 +223,8 @@ def test_a_second_goal_is_busy_and_a_killed_last_worker_ends_the_run(tmp_path, c
     path = tmp_path / 'long.yaml'
     path.write_text(LONG)
     out = tmp_path / 'out'
-    run = subprocess.Popen([executable('experiment_manager', 'run'), str(path), '--output',
-                            str(out), '--namespace', ns, '--workers', '1', '--logs',
-                            str(tmp_path / 'logs')],
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    run = start_run(path, tmp_path, ns, 1, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                    text=True)
     try:
         assert client.wait(first_iteration_done(out), 120.0), 'no iteration finished'
 
@@ -252,17 +254,14 @@ def test_a_second_goal_is_busy_and_a_killed_last_worker_ends_the_run(tmp_path, c
 
 def test_a_run_killed_with_sigkill_leaves_no_node_behind(tmp_path, client, private_ros_domain):
     ns = unique_namespace('exp_orphans')
-    out = tmp_path / 'out'
 
     def nodes() -> list[str]:
         return subprocess.run(['pgrep', '-f', f'__ns:={ns}'], capture_output=True,
                               text=True).stdout.split()
-    run = subprocess.Popen([executable('experiment_manager', 'run'), SMALL, '--output',
-                            str(out), '--namespace', ns, '--workers', '1', '--logs',
-                            str(tmp_path / 'logs')],
-                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    run = start_run(SMALL, tmp_path, ns, 1, stdout=subprocess.DEVNULL,
+                    stderr=subprocess.DEVNULL)
     try:
-        assert client.wait(first_iteration_done(out), 120.0), 'no iteration finished'
+        assert client.wait(first_iteration_done(tmp_path / 'out'), 120.0), 'no iteration finished'
         assert len(nodes()) == 4        # world, validity, feeder_controller, the manager
     finally:
         run.kill()
