@@ -10,9 +10,9 @@ result depends on nothing else, so order, resumption and the worker that ran it 
 Each finished iteration is handed to the sink at once, as rows (see results.py for the columns).
 """
 
-from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+import heapq
 import threading
 import time
 from typing import Protocol
@@ -134,7 +134,7 @@ class Sink(Protocol):
     def iterations(self, experiment_id: str) -> list[dict]: ...
     def picks(self, experiment_id: str) -> list[dict]: ...
     def write_summary(self, summary: dict) -> None: ...
-    def reorder(self, rank: dict[tuple, int]) -> None: ...
+    def reorder(self, rank: dict[tuple, tuple[int, int]]) -> None: ...
 
 
 def count_iterations(file: ExperimentFile) -> int:
@@ -193,11 +193,12 @@ class Runner:
     """Runs the experiments of a file over one or more backends (workers), writing each
     iteration to the sink as it finishes.
 
-    The iterations of an experiment are spread over the workers, each taking the next one
-    planned when it is free; an experiment starts when the one before it has finished (its
-    plan may need that one's metrics). At the end of each experiment the sink puts its rows
-    in plan order, so the results do not depend on how many workers ran them or which.
-    `abort` is set when the run fails, so that the other workers' calls stop.
+    The iterations are spread over the workers, each taking the first ready one in plan order
+    when it is free. An experiment is ready when the experiments it takes its bin or range from
+    have finished (their metrics make its plan); the others run alongside, so a long iteration
+    does not leave the other workers idle. When an experiment finishes, the sink puts the rows
+    in plan order, so the results do not depend on how many workers ran them or which. `abort`
+    is set when the run fails, so that the other workers' calls stop.
     """
 
     def __init__(self, file: ExperimentFile, backends: Sequence[Backend], sink: Sink,
@@ -215,6 +216,12 @@ class Runner:
         self._done = 0
         self._ran = 0
         self._start = time.monotonic()
+        self._summary: dict[str, dict] = {}
+        self._rank: dict[tuple, tuple[int, int]] = {}   # key -> (experiment, plan position)
+        self._ready: list[tuple[tuple[int, int], Unit]] = []    # a heap by rank
+        self._left: dict[str, int] = {}                # planned experiment -> units unwritten
+        self._waiting = list(file.experiments)         # not planned yet
+        self._errors: list[BaseException] = []
 
     @property
     def lost_workers(self) -> list[int]:
@@ -222,29 +229,13 @@ class Runner:
         return [k for k in range(len(self.backends)) if k not in self._live]
 
     def run(self) -> dict:
-        """Run every experiment in order; returns the summary (also written to the sink)."""
+        """Run every experiment; returns the summary (also written to the sink)."""
         for backend in self.backends:
             backend.start(self.file)
-        summary: dict = {}
-        rank: dict[tuple, int] = {}
-        for exp in self.file.experiments:
-            units = plan(self.file, exp, summary)
-            rank.update(((u.experiment.id, u.group, u.iteration), len(rank)) for u in units)
-            todo = deque(u for u in units if not self.sink.is_done(exp.id, u.group, u.iteration))
-            self._done += len(units) - len(todo)
-            self._run_units(exp, todo)
-            self.sink.reorder(rank)
-            summary[exp.id] = metrics.summarise(self.file, exp, self.sink.iterations(exp.id),
-                                                self.sink.picks(exp.id), summary)
-            self.sink.write_summary(metrics.file_summary(self.file, summary))
-        self._report(self.file.experiments[-1], 'done')
-        return metrics.file_summary(self.file, summary)
-
-    def _run_units(self, exp: Experiment, todo: deque) -> None:
-        """Run `todo` over the live workers (in this thread when there is one)."""
-        errors: list[BaseException] = []
-        workers = [threading.Thread(target=self._work, args=(k, exp, todo, errors),
-                                    name=f'worker {k}') for k in self._live]
+        with self._cond:
+            self._guarded(self._release)
+        workers = [threading.Thread(target=self._work, args=(k,), name=f'worker {k}')
+                   for k in self._live]
         if len(workers) == 1:
             workers[0].run()
         else:
@@ -252,49 +243,106 @@ class Runner:
                 t.start()
             for t in workers:
                 t.join()
-        if errors:
-            raise errors[0]
-        if todo:
-            raise AssertionError(f'{len(todo)} iterations of {exp.id} were left undone')
+        if self._errors:
+            raise self._errors[0]
+        if self._waiting or any(self._left.values()):
+            raise AssertionError('the run ended with iterations left undone')
+        self._report(self.file.experiments[-1], 'done')
+        return metrics.file_summary(self.file, self._ordered_summary())
 
-    def _work(self, k: int, exp: Experiment, todo: deque, errors: list) -> None:
-        """Worker k's loop: take the next iteration, run it, write it. While others are in
-        flight it waits rather than leave: a lost worker's iteration comes back to the queue."""
+    def _ordered_summary(self) -> dict:
+        return {e.id: self._summary[e.id] for e in self.file.experiments
+                if e.id in self._summary}
+
+    def _guarded(self, step: Callable[..., None], *args) -> None:
+        """Run a step under the lock; an error stops every worker and ends the run."""
+        try:
+            step(*args)
+        except BaseException as exc:
+            self._errors.append(exc)
+            self._abort.set()
+
+    def _release(self) -> None:
+        """Plan the experiments whose sources have finished (under the lock)."""
+        changed = True
+        while changed:
+            changed = False
+            for exp in list(self._waiting):
+                sources = [s for s in (exp.bin_from, exp.range_from) if s]
+                if exp not in self._waiting or not all(s in self._summary for s in sources):
+                    continue     # planned meanwhile (by the release a _finish made), or not yet
+                self._waiting.remove(exp)
+                index = self.file.experiments.index(exp)
+                units = plan(self.file, exp, self._summary)
+                left = 0
+                for i, u in enumerate(units):
+                    key = (exp.id, u.group, u.iteration)
+                    self._rank[key] = (index, i)
+                    if self.sink.is_done(*key):
+                        self._done += 1
+                    else:
+                        heapq.heappush(self._ready, ((index, i), u))
+                        left += 1
+                self._left[exp.id] = left
+                if not left:
+                    self._finish(exp)
+                changed = True
+
+    def _finish(self, exp: Experiment) -> None:
+        """An experiment's last iteration is written: order the rows, summarise, release the
+        experiments waiting for it (under the lock)."""
+        self.sink.reorder(self._rank)
+        self._summary[exp.id] = metrics.summarise(
+            self.file, exp, self.sink.iterations(exp.id), self.sink.picks(exp.id),
+            self._summary)
+        self.sink.write_summary(metrics.file_summary(self.file, self._ordered_summary()))
+        self._release()
+
+    def _work(self, k: int) -> None:
+        """Worker k's loop: take the first ready iteration, run it, write it. While others are
+        in flight it waits rather than leave: their end may release an experiment, and a lost
+        worker's iteration comes back to the queue."""
         backend = self.backends[k]
         while True:
             with self._cond:
-                while not todo and self._in_flight and not errors:
+                while not self._ready and self._in_flight and not self._errors:
                     self._cond.wait()
-                if errors or not todo or self._abort.is_set():
+                if self._errors or not self._ready or self._abort.is_set():
                     return
-                u = todo.popleft()
+                _, u = heapq.heappop(self._ready)
                 self._in_flight += 1
-                self._report(exp, f'{exp.id}: {_label(u)}')
+                self._report(u.experiment, f'{u.experiment.id}: {_label(u)}')
             try:
                 record = self.run_unit(u, backend)
             except WorkerLost as exc:
                 with self._cond:
-                    todo.appendleft(u)
+                    heapq.heappush(self._ready, (self._rank[_key_of(u)], u))
                     self._live.remove(k)
                     if not self._live:
-                        errors.append(exc)
+                        self._errors.append(exc)
                         self._abort.set()
                     self._in_flight -= 1
                     self._cond.notify_all()
                 return
             except BaseException as exc:
                 with self._cond:
-                    errors.append(exc)
+                    self._errors.append(exc)
                     self._abort.set()
                     self._in_flight -= 1
                     self._cond.notify_all()
                 return
             with self._cond:
-                self.sink.write(record)
-                self._done += 1
-                self._ran += 1
                 self._in_flight -= 1
+                self._guarded(self._written, u, record)
                 self._cond.notify_all()
+
+    def _written(self, u: Unit, record: Record) -> None:
+        self.sink.write(record)
+        self._done += 1
+        self._ran += 1
+        self._left[u.experiment.id] -= 1
+        if not self._left[u.experiment.id]:
+            self._finish(u.experiment)
 
     def _report(self, exp: Experiment, phase: str) -> None:
         elapsed = time.monotonic() - self._start
@@ -431,6 +479,10 @@ class Runner:
 POSE = ('x', 'y', 'z', 'qx', 'qy', 'qz', 'qw')
 GRIPPER_POSE = ('gripper_x', 'gripper_y', 'gripper_z', 'gripper_qx', 'gripper_qy',
                 'gripper_qz', 'gripper_qw')
+
+
+def _key_of(u: Unit) -> tuple[str, int, int]:
+    return u.experiment.id, u.group, u.iteration
 
 
 def _label(u: Unit) -> str:

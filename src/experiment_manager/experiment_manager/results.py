@@ -167,13 +167,13 @@ class ResultsWriter:
         self._rows['picks'] += record.picks
         self._done.add(_key(record.iteration))
 
-    def reorder(self, rank: dict[tuple, int]) -> None:
-        """Put the rows in the order of `rank` (iteration key -> position in the plan); keys
-        it lacks go last, in the order they have. Several workers finish iterations out of
-        order; the files of a run are then the same whoever ran what. A no-op when the rows
-        are in order already."""
-        def position(key: tuple, index: int) -> tuple[int, int]:
-            return (rank[key], 0) if key in rank else (len(rank), index)
+    def reorder(self, rank: dict[tuple, tuple]) -> None:
+        """Put the rows in the order of `rank` (iteration key -> its place in the plan, any
+        sortable value); keys it lacks go last, in the order they have. Several workers finish
+        iterations out of order; the files of a run are then the same whoever ran what. A
+        no-op when the rows are in order already."""
+        def position(key: tuple, index: int) -> tuple:
+            return (0, rank[key]) if key in rank else (1, index)
 
         keys = {_key(r): i for i, r in enumerate(self._rows['iterations'])}
         order = [position(k, i) for k, i in keys.items()]

@@ -160,7 +160,7 @@ def run_on(workers: list, directory: str) -> tuple[Runner, dict, list]:
 def test_two_workers_give_the_results_of_one_whatever_order_they_finish_in(small, tmp_path):
     directory, summary = small
     # The first worker is slowed: iterations finish out of plan order, and the files are put
-    # back in plan order at the end of each experiment.
+    # back in plan order as each experiment finishes.
     workers = [Worker(delay=0.3), Worker()]
     runner, got, written = run_on(workers, str(tmp_path / 'two'))
     assert got == summary and runner.lost_workers == []
@@ -168,6 +168,10 @@ def test_two_workers_give_the_results_of_one_whatever_order_they_finish_in(small
     planned = [[r['experiment'], r['group'], r['iteration']] for r in read(directory,
                                                                            'iterations')]
     assert written != planned and sorted(written) == sorted(planned)
+    # The sweep needs no earlier metrics: it ran while the bins finished, before the emptying
+    # (which needs the best bin) could start.
+    experiments = [w[0] for w in written]
+    assert experiments.index('sweep') < experiments.index('emptying')
     for name in FILES:
         assert read(str(tmp_path / 'two'), name) == read(directory, name), name
 
