@@ -44,6 +44,39 @@ class WorkerGone(GraphError, WorkerLost):
     """The worker died or stopped answering in the middle of a run."""
 
 
+class LockedActionClient(ActionClient):
+    """An ActionClient whose requests may be sent from one thread while another spins it.
+
+    rclpy 7.1.6 sends a goal (or result, or cancel) request, then registers its future. When
+    the executor thread takes the answer in between, it finds no future, logs "Ignoring
+    unexpected goal response" and the request waits for ever (seen here: one goal in a few
+    hundred with two workers; rclpy's service Client has a lock for this, its ActionClient
+    not). Here sending and registering hold a lock, and handling an answer first takes that
+    lock, so an answer is handled only after its request is registered.
+    """
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self._send_lock = threading.Lock()
+
+    def send_goal_async(self, *args, **kwargs):
+        with self._send_lock:
+            return super().send_goal_async(*args, **kwargs)
+
+    def _get_result_async(self, *args, **kwargs):
+        with self._send_lock:
+            return super()._get_result_async(*args, **kwargs)
+
+    def _cancel_goal_async(self, *args, **kwargs):
+        with self._send_lock:
+            return super()._cancel_goal_async(*args, **kwargs)
+
+    async def execute(self, taken_data):
+        with self._send_lock:   # an answer taken now belongs to a request sent and registered
+            pass
+        return await super().execute(taken_data)
+
+
 class GraphBackend:
     """Implements experiments.Backend with service and action calls to one worker."""
 
@@ -59,9 +92,9 @@ class GraphBackend:
         self._reset = node.create_client(ResetScene, name('reset_scene'), **group)
         self._get = node.create_client(GetParts, name('get_parts'), **group)
         self._check_client = node.create_client(CheckParts, name('check_parts'), **group)
-        self._drop = ActionClient(node, DropParts, name('drop_parts'), **group)
-        self._remove = ActionClient(node, RemoveParts, name('remove_parts'), **group)
-        self._feed = ActionClient(node, FeedCycle, name('feed_cycle'), **group)
+        self._drop = LockedActionClient(node, DropParts, name('drop_parts'), **group)
+        self._remove = LockedActionClient(node, RemoveParts, name('remove_parts'), **group)
+        self._feed = LockedActionClient(node, FeedCycle, name('feed_cycle'), **group)
         self._clients = (self._reset, self._get, self._check_client, self._drop, self._remove,
                          self._feed)
         self._file: ExperimentFile | None = None

@@ -1,0 +1,74 @@
+"""The race of rclpy's ActionClient when a goal is sent from one thread while another spins it:
+the answer can be handled before the request's future is registered, and the goal then waits
+for ever. The window is widened here by a send that pauses after the request is out; the plain
+ActionClient loses the answer (rclpy 7.1.6; when an rclpy update fixes it, that case fails and
+LockedActionClient can go), the manager's LockedActionClient does not."""
+
+import threading
+import time
+
+from experiment_manager.graph_backend import LockedActionClient
+from pick_msgs.action import DropParts
+import pytest
+import rclpy
+from rclpy.action import ActionClient, ActionServer
+from rclpy.context import Context
+from rclpy.executors import MultiThreadedExecutor
+from rclpy.node import Node
+
+
+class SlowToRegister:
+    """The client's handle, pausing after each goal request is sent: the answer arrives and is
+    taken by the spinning thread before send_goal_async registers the request."""
+
+    def __init__(self, handle) -> None:
+        self._handle = handle
+
+    def send_goal_request(self, request):
+        sequence = self._handle.send_goal_request(request)
+        time.sleep(0.3)
+        return sequence
+
+    def __getattr__(self, name):
+        return getattr(self._handle, name)
+
+    def __enter__(self):
+        return self._handle.__enter__()
+
+    def __exit__(self, *exc):
+        return self._handle.__exit__(*exc)
+
+
+@pytest.mark.parametrize('client_type, answered', [(ActionClient, False),
+                                                   (LockedActionClient, True)])
+def test_a_goal_sent_while_another_thread_spins_gets_its_answer(client_type, answered,
+                                                                private_ros_domain):
+    context = Context()
+    rclpy.init(context=context)
+    node = Node('action_race', context=context)
+    executor = MultiThreadedExecutor(context=context)
+    executor.add_node(node)
+
+    def execute(goal_handle):
+        goal_handle.succeed()
+        return DropParts.Result()
+    server = ActionServer(node, DropParts, 'race_drop', execute_callback=execute)
+    client = client_type(node, DropParts, 'race_drop')
+    spinner = threading.Thread(target=executor.spin, daemon=True)
+    spinner.start()
+    try:
+        assert client.wait_for_server(timeout_sec=10.0)
+        client._client_handle = SlowToRegister(client._client_handle)
+        future = client.send_goal_async(DropParts.Goal(count=1))
+        deadline = time.monotonic() + 3.0
+        while not future.done() and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert future.done() == answered
+    finally:
+        client._client_handle = getattr(client._client_handle, '_handle',
+                                        client._client_handle)
+        executor.shutdown(timeout_sec=2.0)
+        client.destroy()
+        server.destroy()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
