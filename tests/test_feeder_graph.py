@@ -1,5 +1,7 @@
 """The real `feeder_controller` commanding the real `world` (a tray) over DDS."""
 
+import time
+
 from graph import NodeProcess, stop_all, unique_namespace
 from pick_msgs.action import FeedCycle, RemoveParts
 from pick_msgs.msg import FeederState
@@ -88,3 +90,32 @@ def test_impossible_counts_and_bad_ranges_are_refused(client, nodes):
     world_error = feeder.cycle(restart=True, parts_on_table=0, instance=5)
     assert world_error.error_code == FeedCycle.Result.UNKNOWN_INSTANCE
     assert 'world drop_parts: instances: 5 does not exist' in world_error.error_msg
+
+
+def test_a_world_that_dies_mid_cycle_gets_an_error_answer_not_a_hang(client):
+    ns = unique_namespace('cell_f_dies')
+    world = NodeProcess('pick_sim_world', 'world', [
+        '-r', f'__ns:={ns}', '-p', 'container.kind:=tray', '-p', 'publish_markers:=false'])
+    feeder = NodeProcess('feeder_controller', 'feeder_controller', ['-r', f'__ns:={ns}'])
+    try:
+        cycle = ActionClient(client.node, FeedCycle, f'{ns}/feed_cycle')
+        assert client.wait(cycle.server_is_ready, 60.0, (world, feeder))
+        # A big feed: the world is still dropping when it is killed.
+        handle = client.result(cycle.send_goal_async(FeedCycle.Goal(
+            restart=True, feeder_parts=1000, min_count=700, max_count=700)))
+        result_future = handle.get_result_async()
+        assert not client.wait(result_future.done, 1.0)
+        world.process.kill()
+        killed = time.monotonic()
+        # A killed node leaves the graph when its DDS lease ends (Fast DDS: 20 s), then 2 s.
+        result = client.result(result_future, 60.0).result
+        print(f'the feeder answered {time.monotonic() - killed:.1f} s after the kill')
+        assert result.error_code == FeedCycle.Result.INTERNAL
+        assert "'drop_parts' left the graph while answering" in result.error_msg
+        again = client.result(client.result(cycle.send_goal_async(FeedCycle.Goal(
+            valid_parts=0, parts_on_table=0))).get_result_async(), 30.0).result
+        assert again.error_code == FeedCycle.Result.INTERNAL     # not BUSY: the lock is free
+        assert 'is the world node running there?' in again.error_msg
+    finally:
+        world.stop()
+        assert feeder.stop() == 0, feeder.output()

@@ -203,9 +203,10 @@ def main(argv: list[str] | None = None) -> int:
     node = Node('experiment_cli')
     client = ActionClient(node, RunExperiment, 'run_experiment')
     bar = ProgressBar()
+    watched = list(procs)      # the processes not reported dead yet
     try:
         for goal in goals:
-            code = _run(node, client, goal, procs, bar)
+            code = _run(node, client, goal, procs, watched, bar)
             if code:
                 return code
         return 0
@@ -233,33 +234,40 @@ def _spin_until(node: Node, done, procs: list[NodeProcess], timeout: float) -> N
     return None
 
 
-def _run(node: Node, client: ActionClient, goal, procs: list[NodeProcess], bar) -> int:
+def _report_dead(node: Node, done, manager: NodeProcess, watched: list[NodeProcess],
+                 timeout: float, bar) -> bool:
+    """Spin until done() or timeout, reporting each process of `watched` that dies (and
+    dropping it from the list). False when the manager died."""
+    while (dead := _spin_until(node, done, watched, timeout)):
+        watched.remove(dead)
+        bar.close()
+        print(f'run: {dead.describe_exit()}:\n{dead.output(20)}', file=sys.stderr)
+        if dead is manager:
+            return False
+        print('run: its worker is lost; the manager runs its iterations on the others',
+              file=sys.stderr)
+    return True
+
+
+def _run(node: Node, client: ActionClient, goal, procs: list[NodeProcess],
+         watched: list[NodeProcess], bar) -> int:
     print(f'run: {goal.experiment_file}', file=sys.stderr)
-    dead = _spin_until(node, client.server_is_ready, procs, START_TIMEOUT)
-    if dead is not None or not client.server_is_ready():
-        why = dead.describe_exit() + '\n' + dead.output(20) if dead else (
-            f'run_experiment did not appear within {START_TIMEOUT:g} s')
-        print(f'run: the graph did not start: {why}', file=sys.stderr)
+    manager = procs[-1]
+    if not _report_dead(node, client.server_is_ready, manager, watched, START_TIMEOUT, bar) \
+            or not client.server_is_ready():
+        print(f'run: the experiment manager did not start (run_experiment did not appear '
+              f'within {START_TIMEOUT:g} s)', file=sys.stderr)
         return 1
     send = client.send_goal_async(goal, feedback_callback=lambda f: bar.update(f.feedback.progress))
-    _spin_until(node, send.done, procs, START_TIMEOUT)
+    _spin_until(node, send.done, [manager], START_TIMEOUT)
     handle = send.result()
     if handle is None or not handle.accepted:
         print('run: the experiment manager did not accept the goal', file=sys.stderr)
         return 1
     result_future = handle.get_result_async()
-    manager = procs[-1]
-    watched = [p for p in procs if p.running()]
     try:
-        while (dead := _spin_until(node, result_future.done, watched, float('inf'))):
-            watched.remove(dead)
-            bar.close()
-            print(f'run: {dead.describe_exit()} during the run:\n{dead.output(20)}',
-                  file=sys.stderr)
-            if dead is manager:
-                return 1
-            print('run: its worker is lost; the manager runs its iterations on the others',
-                  file=sys.stderr)
+        if not _report_dead(node, result_future.done, manager, watched, float('inf'), bar):
+            return 1
     except KeyboardInterrupt:
         handle.cancel_goal_async()
         _spin_until(node, result_future.done, [manager], STOP_TIMEOUT)

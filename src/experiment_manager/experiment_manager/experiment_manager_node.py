@@ -194,7 +194,7 @@ class ExperimentManagerNode(Node):
             finally:
                 for k in runner.lost_workers:
                     self.get_logger().warning(f'worker {backends[k].worker or "."} was lost '
-                                              'during the run')
+                                              '(missing at the start, or during the run)')
             result.summary_json = json.dumps(summary)
             try:
                 pictures.write(file, run_dir)

@@ -225,13 +225,21 @@ class Runner:
 
     @property
     def lost_workers(self) -> list[int]:
-        """Indexes of the backends whose worker was lost during the run."""
+        """Indexes of the backends whose worker was missing at the start or lost since."""
         return [k for k in range(len(self.backends)) if k not in self._live]
 
     def run(self) -> dict:
-        """Run every experiment; returns the summary (also written to the sink)."""
-        for backend in self.backends:
-            backend.start(self.file)
+        """Run every experiment; returns the summary (also written to the sink). A worker
+        missing at the start is left out; the run fails when all are."""
+        missing = []
+        for k, backend in enumerate(self.backends):
+            try:
+                backend.start(self.file)
+            except WorkerLost as exc:
+                missing.append(exc)
+                self._live.remove(k)
+        if not self._live:
+            raise missing[0]
         with self._cond:
             self._guarded(self._release)
         workers = [threading.Thread(target=self._work, args=(k,), name=f'worker {k}')

@@ -201,7 +201,7 @@ class GraphBackend:
         self._file = file
         self._part_msg = world_conv.part_spec_to_msg(file.part)
         self._setup = validity_conv.Setup(file.gripper, file.grasps, file.place, file.check)
-        self.wait_for_servers()
+        self.wait_for_servers(WorkerGone)
 
     def reset(self, container: ContainerSpec, seed: int) -> None:
         request = ResetScene.Request(container=world_conv.container_to_msg(container),

@@ -124,9 +124,14 @@ class Worker(LocalBackend):
     """A worker in this process whose resets are slowed by `delay` s, and that dies at its
     reset number `dies_at` (after the delay)."""
 
-    def __init__(self, delay: float = 0.0, dies_at: int = 0) -> None:
+    def __init__(self, delay: float = 0.0, dies_at: int = 0, missing: bool = False) -> None:
         super().__init__()
-        self.delay, self.dies_at, self.resets = delay, dies_at, 0
+        self.delay, self.dies_at, self.resets, self.missing = delay, dies_at, 0, missing
+
+    def start(self, file) -> None:
+        if self.missing:
+            raise WorkerLost('the worker is not there')
+        super().start(file)
 
     def reset(self, container, seed) -> None:
         self.resets += 1
@@ -179,7 +184,8 @@ def test_two_workers_give_the_results_of_one_whatever_order_they_finish_in(small
 @pytest.mark.parametrize('lost', [
     Worker(dies_at=3),                 # while the other is busy
     Worker(delay=2.0, dies_at=1),      # late: the other has run out of work and must wait
-], ids=['busy', 'idle'])
+    Worker(missing=True),              # missing at the start: left out
+], ids=['busy', 'idle', 'missing'])
 def test_a_lost_worker_s_iteration_runs_again_on_another(small, tmp_path, lost):
     directory, summary = small
     runner, got, _ = run_on([lost, Worker()], str(tmp_path / 'lost'))
@@ -195,6 +201,8 @@ def test_the_run_fails_when_every_worker_is_lost_and_keeps_what_finished(tmp_pat
         run_on(workers, str(tmp_path / 'none'))
     assert len(read(str(tmp_path / 'none'), 'iterations')) == 3
     assert threading.active_count() == 1, 'a worker thread outlived the run'
+    with pytest.raises(WorkerLost, match='not there'):
+        run_on([Worker(missing=True), Worker(missing=True)], str(tmp_path / 'absent'))
 
 
 def test_an_unwritable_output_directory_is_named(tmp_path):

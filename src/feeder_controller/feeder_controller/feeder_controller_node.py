@@ -6,6 +6,7 @@ namespace it commands that worker's world. One goal at a time: another is answer
 """
 
 import threading
+import time
 
 from pick_msgs.action import DropParts, FeedCycle, Vibrate
 from pick_msgs.msg import FeederState as FeederStateMsg
@@ -35,6 +36,8 @@ STATES = {-1: FeederStateMsg.STATE_IDLE, PICK: FeederStateMsg.STATE_PICKING,
           STOP_EMPTY: FeederStateMsg.STATE_DONE_EMPTY,
           STOP_VIBRATION_LIMIT: FeederStateMsg.STATE_DONE_VIBRATION_LIMIT}
 SERVER_WAIT = 5.0   # s to wait for the world's action server before answering an error
+GONE_AFTER = 2.0    # s the world's action server may be absent while a goal is in flight
+WATCH_PERIOD = 0.5  # s between checks that it is still there
 
 
 class WorldCommandError(Exception):
@@ -71,6 +74,9 @@ class FeederControllerNode(Node):
         self._vibrate = ActionClient(self, Vibrate, 'vibrate', callback_group=group)
         ActionServer(self, FeedCycle, 'feed_cycle', execute_callback=self._feed_cycle,
                      callback_group=group, result_timeout=RESULT_KEEP)
+        # The world call in flight: (future, client, name, since when its server is absent).
+        self._in_flight: list = []
+        self.create_timer(WATCH_PERIOD, self._watch, callback_group=group)
         self._publish_state()
 
     def _state_msg(self) -> FeederStateMsg:
@@ -91,13 +97,36 @@ class FeederControllerNode(Node):
             raise WorldCommandError(FeedCycle.Result.INTERNAL, (
                 f'the world action {name!r} in namespace {self.get_namespace()!r} did not '
                 f'answer within {SERVER_WAIT:g} s: is the world node running there?'))
-        handle = await client.send_goal_async(goal)
+        handle = await self._watched(client.send_goal_async(goal), client, name)
         if not handle.accepted:
             raise WorldCommandError(FeedCycle.Result.INTERNAL, f'the world rejected {name}')
-        result = (await handle.get_result_async()).result
+        result = (await self._watched(handle.get_result_async(), client, name)).result
         if result.error_code != world_conversions.ERROR_NONE:
             raise WorldCommandError(result.error_code, f'world {name}: {result.error_msg}')
         return result
+
+    def _watched(self, future, client: ActionClient, name: str):
+        """`future`, failed by _watch with WorldCommandError if the world's server leaves the
+        graph before it completes (a world that died never answers)."""
+        self._in_flight = [future, client, name, None]
+        return future
+
+    def _watch(self) -> None:
+        if not self._in_flight:
+            return
+        future, client, name, absent_since = self._in_flight
+        now = time.monotonic()
+        if future.done():
+            self._in_flight = []
+        elif client.server_is_ready():
+            self._in_flight[3] = None
+        elif absent_since is None:
+            self._in_flight[3] = now
+        elif now - absent_since > GONE_AFTER:
+            self._in_flight = []
+            future.set_exception(WorldCommandError(FeedCycle.Result.INTERNAL, (
+                f'the world action {name!r} left the graph while answering (its node died or '
+                'was stopped)')))
 
     async def _feed_cycle(self, goal_handle) -> FeedCycle.Result:
         goal = goal_handle.request
