@@ -49,10 +49,11 @@ class LockedActionClient(ActionClient):
 
     rclpy 7.1.6 sends a goal (or result, or cancel) request, then registers its future. When
     the executor thread takes the answer in between, it finds no future, logs "Ignoring
-    unexpected goal response" and the request waits for ever (seen here: one goal in a few
-    hundred with two workers; rclpy's service Client has a lock for this, its ActionClient
-    not). Here sending and registering hold a lock, and handling an answer first takes that
-    lock, so an answer is handled only after its request is registered.
+    unexpected goal response" and the request waits for ever (seen here: a lost remove_parts
+    answer stalled a two-worker run for call_timeout; rclpy's service Client has a lock for
+    this, its ActionClient not). Here sending and registering hold a lock, and handling an
+    answer first takes that lock, so an answer is handled only after its request is
+    registered.
     """
 
     def __init__(self, *args, **kwargs) -> None:
@@ -126,8 +127,8 @@ class GraphBackend:
         name = client._action_name if isinstance(client, ActionClient) else client.srv_name
         return self._node.resolve_service_name(name)
 
-    def wait_for_servers(self, error: type[GraphError] = GraphError) -> None:
-        """Raise `error` with the missing endpoints' names unless all are there within
+    def wait_for_servers(self) -> None:
+        """Raise WorkerGone with the missing endpoints' names unless all are there within
         server_timeout."""
         deadline = time.monotonic() + self._server_timeout
         while time.monotonic() < deadline:
@@ -138,7 +139,7 @@ class GraphBackend:
             time.sleep(POLL)
         missing = [self._endpoint(c) for c in self._clients if not self._ready(c)]
         where = f'namespace {self._ns!r}' if self._ns else "the manager's namespace"
-        raise error(CheckParts.Response.INTERNAL, (
+        raise WorkerGone(CheckParts.Response.INTERNAL, (
             f'not in the graph after {self._server_timeout:g} s: {", ".join(missing)} (are the '
             f'world, validity and feeder_controller nodes running in {where}?)'))
 
@@ -172,14 +173,14 @@ class GraphBackend:
 
     def _service(self, client, request, what: str):
         if not self._ready(client):
-            self.wait_for_servers(WorkerGone)
+            self.wait_for_servers()
         response = self._wait(client.call_async(request), client, what)
         self._raise_on_error(response, what)
         return response
 
     def _action(self, client: ActionClient, goal, what: str):
         if not self._ready(client):
-            self.wait_for_servers(WorkerGone)
+            self.wait_for_servers()
         handle = self._wait(client.send_goal_async(goal), client, what)
         if not handle.accepted:
             raise GraphError(CheckParts.Response.INTERNAL, f'{what}: the goal was rejected')
@@ -201,7 +202,7 @@ class GraphBackend:
         self._file = file
         self._part_msg = world_conv.part_spec_to_msg(file.part)
         self._setup = validity_conv.Setup(file.gripper, file.grasps, file.place, file.check)
-        self.wait_for_servers(WorkerGone)
+        self.wait_for_servers()
 
     def reset(self, container: ContainerSpec, seed: int) -> None:
         request = ResetScene.Request(container=world_conv.container_to_msg(container),

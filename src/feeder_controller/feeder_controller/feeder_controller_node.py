@@ -5,6 +5,7 @@ world's `drop_parts` (feeder zone) and `vibrate` actions by relative names, so i
 namespace it commands that worker's world. One goal at a time: another is answered BUSY.
 """
 
+from dataclasses import dataclass
 import threading
 import time
 
@@ -18,6 +19,7 @@ from rclpy.action import ActionClient, ActionServer
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
+from rclpy.task import Future
 from std_msgs.msg import Header
 
 from .policy import (
@@ -48,6 +50,16 @@ class WorldCommandError(Exception):
         super().__init__(message)
 
 
+@dataclass
+class WorldCall:
+    """The call to the world in flight, and since when (monotonic s) its server is absent."""
+
+    future: Future
+    client: ActionClient
+    name: str
+    absent_since: float | None = None
+
+
 class FeederControllerNode(Node):
     """Translates feed_cycle goals into policy steps and world actions."""
 
@@ -74,8 +86,7 @@ class FeederControllerNode(Node):
         self._vibrate = ActionClient(self, Vibrate, 'vibrate', callback_group=group)
         ActionServer(self, FeedCycle, 'feed_cycle', execute_callback=self._feed_cycle,
                      callback_group=group, result_timeout=RESULT_KEEP)
-        # The world call in flight: (future, client, name, since when its server is absent).
-        self._in_flight: list = []
+        self._in_flight: WorldCall | None = None
         self.create_timer(WATCH_PERIOD, self._watch, callback_group=group)
         self._publish_state()
 
@@ -108,25 +119,24 @@ class FeederControllerNode(Node):
     def _watched(self, future, client: ActionClient, name: str):
         """`future`, failed by _watch with WorldCommandError if the world's server leaves the
         graph before it completes (a world that died never answers)."""
-        self._in_flight = [future, client, name, None]
+        self._in_flight = WorldCall(future, client, name)
         return future
 
     def _watch(self) -> None:
-        if not self._in_flight:
+        call, now = self._in_flight, time.monotonic()
+        if call is None:
             return
-        future, client, name, absent_since = self._in_flight
-        now = time.monotonic()
-        if future.done():
-            self._in_flight = []
-        elif client.server_is_ready():
-            self._in_flight[3] = None
-        elif absent_since is None:
-            self._in_flight[3] = now
-        elif now - absent_since > GONE_AFTER:
-            self._in_flight = []
-            future.set_exception(WorldCommandError(FeedCycle.Result.INTERNAL, (
-                f'the world action {name!r} left the graph while answering (its node died or '
-                'was stopped)')))
+        if call.future.done():
+            self._in_flight = None
+        elif call.client.server_is_ready():
+            call.absent_since = None
+        elif call.absent_since is None:
+            call.absent_since = now
+        elif now - call.absent_since > GONE_AFTER:
+            self._in_flight = None
+            call.future.set_exception(WorldCommandError(FeedCycle.Result.INTERNAL, (
+                f'the world action {call.name!r} left the graph while answering (its node '
+                'died or was stopped)')))
 
     async def _feed_cycle(self, goal_handle) -> FeedCycle.Result:
         goal = goal_handle.request
