@@ -127,17 +127,21 @@ class GraphBackend:
         name = client._action_name if isinstance(client, ActionClient) else client.srv_name
         return self._node.resolve_service_name(name)
 
+    def _missing(self) -> list:
+        """The worker's clients whose server is not in the graph now."""
+        return [c for c in self._clients if not self._ready(c)]
+
     def wait_for_servers(self) -> None:
         """Raise WorkerGone with the missing endpoints' names unless all are there within
         server_timeout."""
         deadline = time.monotonic() + self._server_timeout
         while time.monotonic() < deadline:
-            if all(self._ready(c) for c in self._clients):
+            if not self._missing():
                 return
             if self._canceled():
                 raise GraphError(CheckParts.Response.CANCELED, 'canceled')
             time.sleep(POLL)
-        missing = [self._endpoint(c) for c in self._clients if not self._ready(c)]
+        missing = [self._endpoint(c) for c in self._missing()]
         where = f'namespace {self._ns!r}' if self._ns else "the manager's namespace"
         raise WorkerGone(CheckParts.Response.INTERNAL, (
             f'not in the graph after {self._server_timeout:g} s: {", ".join(missing)} (are the '
@@ -160,7 +164,7 @@ class GraphBackend:
                 raise WorkerGone(CheckParts.Response.INTERNAL, (
                     f'{what}: no answer from {self._endpoint(client)} within call_timeout '
                     f'{self._call_timeout:g} s'))
-            missing = [c for c in self._clients if not self._ready(c)]
+            missing = self._missing()
             if not missing:
                 absent_since = None
             elif absent_since is None:
@@ -192,10 +196,18 @@ class GraphBackend:
         self._raise_on_error(result, what)
         return result
 
-    @staticmethod
-    def _raise_on_error(answer, what: str) -> None:
-        if answer.error_code != world_conv.ERROR_NONE:
-            raise GraphError(answer.error_code, f'{what}: {answer.error_msg}')
+    def _raise_on_error(self, answer, what: str) -> None:
+        """Raise the server's error. An INTERNAL error while endpoints of the worker are gone
+        (the feeder_controller answers so when the world it waits on died) means the worker
+        is lost, not the run: WorkerGone, and the iteration runs elsewhere."""
+        if answer.error_code == world_conv.ERROR_NONE:
+            return
+        missing = self._missing() if answer.error_code == CheckParts.Response.INTERNAL else []
+        if missing:
+            raise WorkerGone(answer.error_code, (
+                f'{what}: {answer.error_msg} ({", ".join(self._endpoint(c) for c in missing)} '
+                'left the graph)'))
+        raise GraphError(answer.error_code, f'{what}: {answer.error_msg}')
 
     # ------------------------------------------------------------------------- Backend
     def start(self, file: ExperimentFile) -> None:
