@@ -288,6 +288,13 @@ def test_the_manager_finds_the_workers_under_its_namespace(tmp_path, client, sta
     path.write_text(TINY)
     action = ActionClient(client.node, RunExperiment, f'{ns}/run_experiment')
     assert client.wait(action.server_is_ready, 60.0, nodes=(manager,))
+    # Discovery takes the workers there at the start of the run: wait until both are up.
+    def workers_up() -> bool:
+        names = {n for n, _ in client.node.get_service_names_and_types()}
+        return all({f'{ns}/{w}/reset_scene', f'{ns}/{w}/check_parts',
+                    f'{ns}/{w}/feed_cycle/_action/send_goal'} <= names
+                   for w in ('cell_a', 'cell_b'))
+    assert client.wait(workers_up, 60.0, nodes=tuple(nodes))
     handle = client.result(action.send_goal_async(RunExperiment.Goal(
         experiment_file=str(path), output_dir=str(tmp_path / 'out'))))
     result = client.result(handle.get_result_async(), 300.0).result
