@@ -38,7 +38,7 @@ from .results import ResultsWriter
 from .topic_recorder import TopicRecorder
 
 STOP_WAIT = 15.0        # s a shutdown waits for the run to close its files
-DISCOVERY_SETTLE = 1.0  # s the worker list must stay the same before discovery ends
+DISCOVERY_SETTLE = 3.0  # s the worker list must stay the same before discovery ends
 RESULT_FILES = ('iterations.csv', 'checks.csv', 'picks.csv', 'parts.csv', 'summary.json')
 
 
