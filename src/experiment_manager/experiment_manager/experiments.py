@@ -30,6 +30,7 @@ from feeder_controller.policy import (
 import numpy as np
 from pick_sim_world.config import MAX_SEED
 from pick_sim_world.containers import ContainerSpec
+from pick_sim_world.errors import PhysicsFault
 from pick_sim_world.world import PartStates, SettleReport
 from pick_validity.validity import Report, STAGE_NONE
 
@@ -365,7 +366,11 @@ class Runner:
         run = {BIN_STATIC: self._static, TABLE_SWEEP: self._static,
                BIN_EMPTYING: self._emptying, FEEDER_EMPTYING: self._feeder}[u.experiment.type]
         record = Record(iteration={})
-        row = run(u, record, backend)
+        try:
+            row = run(u, record, backend)
+        except PhysicsFault as exc:    # its seed would fault again: marked, not run again
+            row = {'settled': False, 'escaped': 0, 'emptied': False, 'vibrations': 0,
+                   'feeds': 0, 'lost': 0, 'stop': f'{metrics.PHYSICS_FAULT}: {exc}'}
         first = record.checks[0] if record.checks else {}
         x, y, z = u.container.inner_size
         record.iteration = {
@@ -375,7 +380,7 @@ class Runner:
             **{k: first.get(k, 0) for k in ('checked', 'candidates', 'placeable',
                                              'container_free', 'valid')},
             'checks': len(record.checks), 'picks': len(record.picks),
-            **row, 'wall_time': time.monotonic() - start}
+            **row, 'fault': faults(row), 'wall_time': time.monotonic() - start}
         return record
 
     def _key(self, u: Unit) -> dict:
@@ -482,6 +487,18 @@ class Runner:
         return {**self._physics(settles), 'emptied': step.decision == STOP_EMPTY and lost == 0,
                 'vibrations': step.vibrations, 'feeds': step.feeds, 'lost': lost,
                 'stop': DECISION_NAMES[step.decision]}
+
+
+def faults(row: dict) -> str:
+    """The physics faults of an iteration, '+'-joined ('' for none): `physics_fault` (NaN
+    state; the iteration stopped there and gives no figures), `unsettled` (a settle hit its
+    cap with more than the moving fraction of parts still moving), `escaped` (parts left the
+    container). The last two are results, flagged; metrics.py counts all three."""
+    if row['stop'].startswith(metrics.PHYSICS_FAULT):
+        return metrics.PHYSICS_FAULT
+    return '+'.join(name for name, bad in ((metrics.UNSETTLED, not row['settled']),
+                                           (metrics.ESCAPED, row['escaped'] or row['lost']))
+                    if bad)
 
 
 POSE = ('x', 'y', 'z', 'qx', 'qy', 'qz', 'qw')

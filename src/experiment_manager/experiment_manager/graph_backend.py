@@ -18,6 +18,7 @@ from pick_msgs.msg import PartArray
 from pick_msgs.srv import CheckParts, GetParts, ResetScene
 from pick_sim_world import conversions as world_conv
 from pick_sim_world.containers import ContainerSpec
+from pick_sim_world.errors import PhysicsFault
 from pick_sim_world.world import PartStates, SettleReport
 from pick_validity import conversions as validity_conv
 from pick_validity.validity import Report
@@ -42,6 +43,10 @@ class GraphError(Exception):
 
 class WorkerGone(GraphError, WorkerLost):
     """The worker died or stopped answering in the middle of a run."""
+
+
+class GraphPhysicsFault(GraphError, PhysicsFault):
+    """The world answered PHYSICS_FAULT (NaN state): the runner marks the iteration."""
 
 
 class LockedActionClient(ActionClient):
@@ -207,6 +212,8 @@ class GraphBackend:
             raise WorkerGone(answer.error_code, (
                 f'{what}: {answer.error_msg} ({", ".join(self._endpoint(c) for c in missing)} '
                 'left the graph)'))
+        if answer.error_code == world_conv.ERROR_PHYSICS_FAULT:
+            raise GraphPhysicsFault(answer.error_code, f'{what}: {answer.error_msg}')
         raise GraphError(answer.error_code, f'{what}: {answer.error_msg}')
 
     # ------------------------------------------------------------------------- Backend

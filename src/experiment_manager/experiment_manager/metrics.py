@@ -12,6 +12,10 @@ import numpy as np
 
 from .config import BIN_EMPTYING, BIN_STATIC, Experiment, ExperimentFile, TABLE_SWEEP
 
+# The physics faults an iteration is flagged with (experiments.faults).
+PHYSICS_FAULT, UNSETTLED, ESCAPED = 'physics_fault', 'unsettled', 'escaped'
+FAULTS = (PHYSICS_FAULT, UNSETTLED, ESCAPED)
+
 FIT_ORDER = 4
 
 
@@ -106,10 +110,23 @@ def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
             'minutes_per_vibration_allowed': per_vibration}
 
 
+def fault_counts(rows: list[dict]) -> dict:
+    """How many iterations each physics fault flagged (experiments.faults), and which."""
+    flagged = [r for r in rows if r['fault']]
+    return {**{name: sum(name in r['fault'].split('+') for r in rows) for name in FAULTS},
+            'flagged': [{'group': r['group'], 'iteration': r['iteration'],
+                         'fault': r['fault']} for r in flagged]}
+
+
 def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: list[dict],
               earlier: dict | None = None) -> dict:
     """The metrics of one experiment. `earlier`: the summaries of the experiments before it
-    (for feeder_emptying's range taken from a table_sweep)."""
+    (for feeder_emptying's range taken from a table_sweep). Iterations that ended in a physics
+    fault have no figures and are left out; every flagged iteration is listed in `faults`."""
+    faults = fault_counts(rows)
+    faulted = {(r['group'], r['iteration']) for r in rows if r['fault'] == PHYSICS_FAULT}
+    rows = [r for r in rows if (r['group'], r['iteration']) not in faulted]
+    picks = [p for p in picks if (p['group'], p['iteration']) not in faulted]
     if exp.type == BIN_STATIC:
         out = bin_static(exp, rows)
     elif exp.type == BIN_EMPTYING:
@@ -119,7 +136,7 @@ def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: li
     else:
         low_high = exp.optimal_range or (earlier or {})[exp.range_from]['optimal_range']
         out = feeder_emptying(file, exp, rows, low_high)
-    return {'type': exp.type, **out}
+    return {'type': exp.type, **out, 'faults': faults}
 
 
 def file_summary(file: ExperimentFile, summaries: dict) -> dict:

@@ -76,6 +76,7 @@ def verdicts(summary: dict, spec: dict) -> list[dict]:
                    f'mean {_fmt(s["removed"]["mean"])}, max {_fmt(s["removed"]["max"])} '
                    f'of {s["parts"]}']
         ok = s['iterations'] > 0 and s['emptied'] == s['iterations']
+        reasons += _fault_reason(s)
         if s['parts'] < capacity:
             ok = False
             reasons.append(f'the bin was filled with {s["parts"]} parts, fewer than the '
@@ -99,6 +100,7 @@ def verdicts(summary: dict, spec: dict) -> list[dict]:
         if s['lost']:
             reasons.append(f'{s["lost"]} parts fell off the table')
         ok = s['iterations'] > 0 and s['emptied'] == s['iterations']
+        reasons += _fault_reason(s)
         if s['parts'] < capacity:
             ok = False
             reasons.append(f'the feeder held {s["parts"]} parts, fewer than the {capacity} a '
@@ -163,6 +165,30 @@ def plot_sweep(summary: dict, path: str) -> bool:
     _finish(fig, ax, path, f'{summary["id"]}: vibrating table analysis (figure 15)',
             'parts on the table', 'valid parts')
     return True
+
+
+def _fault_reason(s: dict) -> list[str]:
+    f = s['faults']
+    if not f['flagged']:
+        return []
+    return [f'{len(f["flagged"])} iteration(s) flagged: ' + ', '.join(
+        f'{k} {f[k]}' for k in ('physics_fault', 'unsettled', 'escaped') if f[k])
+        + ' (see Physics faults)']
+
+
+def _faults(summary: dict) -> list[str]:
+    """Iterations flagged per experiment: a NaN state (left out of the figures), a settle
+    that hit its cap with parts still moving, parts that left the container (both counted)."""
+    rows = [[f'`{exp_id}`', len(s['faults']['flagged']), s['faults']['physics_fault'],
+             s['faults']['unsettled'], s['faults']['escaped']]
+            for exp_id, s in summary['experiments'].items() if s['faults']['flagged']]
+    if not rows:
+        return ['No iteration was flagged: every settle ended within its cap, no part left its '
+                'container, no physics state became NaN.']
+    return _table(['experiment', 'iterations flagged', 'physics fault (NaN; left out of the '
+                   'figures)', 'unsettled at the cap (counted)', 'parts escaped (counted)'],
+                  rows) + ['', 'Each flagged iteration has its fault in the `fault` column of '
+                           '`iterations.csv`.']
 
 
 def _table(header: list[str], rows: list[list]) -> list[str]:
@@ -251,6 +277,7 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
         lines += ['', f'Time per vibration the refill interval allows: '
                   f'{_fmt(s["minutes_per_vibration_allowed"])} min. Parts lost over the edge: '
                   f'{s["lost"]}.']
+    lines += ['', '## Physics faults', ''] + _faults(summary)
     if pictures:
         lines += ['', '## Pictures']
         for name, caption in pictures.items():

@@ -31,7 +31,7 @@ ITERATION_COLUMNS = (
     'experiment', 'type', 'group', 'iteration', 'seed', 'container_x', 'container_y',
     'container_z', 'parts', 'checked', 'candidates', 'placeable', 'container_free', 'valid',
     'checks', 'picks', 'settled', 'escaped', 'emptied', 'vibrations', 'feeds', 'lost', 'stop',
-    'wall_time')
+    'fault', 'wall_time')
 CHECK_COLUMNS = (*KEY, 'check', 'parts_on_table', 'checked', 'candidates', 'placeable',
                  'container_free', 'valid', 'picked_id', 'searches', 'vibrations', 'wall_time')
 PART_COLUMNS = (*KEY, 'check', 'part_id', *POSE, 'inside', 'stage', 'grasp', 'tilts')
@@ -39,7 +39,7 @@ PICK_COLUMNS = (*KEY, 'pick', 'check', 'part_id', 'searches', 'vibrations', 'gra
                 *GRIPPER_POSE)
 FILES = {'iterations': ITERATION_COLUMNS, 'checks': CHECK_COLUMNS, 'parts': PART_COLUMNS,
          'picks': PICK_COLUMNS}
-TEXT = {'experiment', 'type', 'stop'}
+TEXT = {'experiment', 'type', 'stop', 'fault'}
 FLOAT = {'container_x', 'container_y', 'container_z', 'wall_time', *POSE, *GRIPPER_POSE}
 BOOL = {'settled', 'emptied', 'inside'}
 

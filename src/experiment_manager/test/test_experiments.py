@@ -2,12 +2,14 @@
 policy), the results files they leave, resumption, and the metrics."""
 
 import json
+import math
 import os
 import threading
 import time
 
 from experiment_manager import config, metrics
 from experiment_manager.experiments import (
+    faults,
     iteration_seed,
     plan,
     Runner,
@@ -18,6 +20,7 @@ from experiment_manager.local_backend import LocalBackend
 from experiment_manager.results import FILES, read_text_rows, ResultsWriter
 from feeder_controller.policy import NAMES
 import numpy as np
+import pybullet as pb
 from pick_sim_world.errors import InvalidArgument
 from pick_sim_world.world import PartStates
 import pytest
@@ -121,12 +124,24 @@ def test_an_interrupted_run_resumes_to_the_same_results(small, run_file, tmp_pat
 
 
 class Worker(LocalBackend):
-    """A worker in this process whose resets are slowed by `delay` s, and that dies at its
-    reset number `dies_at` (after the delay)."""
+    """A worker in this process whose resets are slowed by `delay` s, that dies at its
+    reset number `dies_at` (after the delay), and whose physics turns NaN in the drop after
+    its reset number `nan_at` (a NaN velocity given to PyBullet, which then steps to NaN)."""
 
-    def __init__(self, delay: float = 0.0, dies_at: int = 0, missing: bool = False) -> None:
+    def __init__(self, delay: float = 0.0, dies_at: int = 0, missing: bool = False,
+                 nan_at: int = 0) -> None:
         super().__init__()
         self.delay, self.dies_at, self.resets, self.missing = delay, dies_at, 0, missing
+        self.nan_at = nan_at
+
+    def drop(self, count, zone):
+        if self.resets != self.nan_at:
+            return super().drop(count, zone)
+        world = self._world
+        ids, _ = world.drop(count, zone=zone)
+        pb.resetBaseVelocity(world._bodies[ids[0]], [math.nan, 0, 0], [0, 0, 0],
+                             physicsClientId=world._client)
+        return world.snapshot(), world.settle()
 
     def start(self, file) -> None:
         if self.missing:
@@ -203,6 +218,37 @@ def test_the_run_fails_when_every_worker_is_lost_and_keeps_what_finished(tmp_pat
     assert threading.active_count() == 1, 'a worker thread outlived the run'
     with pytest.raises(WorkerLost, match='not there'):
         run_on([Worker(missing=True), Worker(missing=True)], str(tmp_path / 'absent'))
+
+
+def test_a_physics_fault_is_marked_left_out_of_the_figures_and_the_run_goes_on(small,
+                                                                                 tmp_path):
+    directory, summary = small
+    _, got, _ = run_on([Worker(nan_at=2)], str(tmp_path / 'nan'))
+    rows = read(str(tmp_path / 'nan'), 'iterations')
+    expected = read(directory, 'iterations')
+    assert len(rows) == len(expected) == 14
+    faulted = rows.pop(1)
+    assert faulted['fault'] == 'physics_fault' and faulted['checks'] == '0'
+    assert faulted['stop'].startswith('physics_fault: parts [0, ') and 'non-finite' in faulted['stop']
+    assert rows == expected[:1] + expected[2:]   # the others are untouched by the fault
+    bins = got['experiments']['bins']
+    assert bins['faults']['physics_fault'] == 1
+    assert bins['faults']['flagged'] == [{'group': 0, 'iteration': 1,
+                                          'fault': 'physics_fault'}]
+    assert [b['iterations'] for b in bins['bins']] == [1, 2]
+    assert summary['experiments']['bins']['faults'] == {
+        'physics_fault': 0, 'unsettled': 0, 'escaped': 0, 'flagged': []}
+
+
+def test_unsettled_and_escaped_iterations_are_flagged():
+    row = {'stop': 'empty', 'settled': True, 'escaped': 0, 'lost': 0}
+    assert faults(row) == ''
+    assert faults({**row, 'settled': False}) == 'unsettled'
+    assert faults({**row, 'settled': False, 'lost': 2}) == 'unsettled+escaped'
+    assert faults({**row, 'escaped': 1}) == 'escaped'
+    counts = metrics.fault_counts([{'group': 0, 'iteration': i, 'fault': f} for i, f in
+                                   enumerate(['', 'unsettled+escaped', 'escaped'])])
+    assert (counts['unsettled'], counts['escaped'], len(counts['flagged'])) == (1, 2, 2)
 
 
 def test_an_unwritable_output_directory_is_named(tmp_path):

@@ -32,12 +32,13 @@ def test_a_run_gets_its_report_files(run_dir):
     text = open(os.path.join(run_dir, 'report.md')).read()
     page = open(path).read()
     for heading in ('## Verdict', '## Static bins', '## Bin emptying', '## Vibrating table sweep',
-                    '## Feeder emptying'):
+                    '## Feeder emptying', '## Physics faults'):
         assert heading in text
         assert f'<h2>{heading[3:]}' in page
     separators = [line for line in text.splitlines() if line.startswith('| --- |')]
     assert page.count('<table>') == len(separators) == 4 and 'fig15_table.png' in page
     assert 'paper' not in text.split('## Verdict')[1]      # id `small`: no paper numbers
+    assert 'No iteration was flagged' in text
 
 
 def test_verdicts_follow_the_emptied_runs_and_the_capacity(run_dir):
@@ -60,12 +61,16 @@ def test_the_papers_numbers_stand_beside_ours_for_its_test_case(run_dir, tmp_pat
     shutil.copytree(run_dir, tmp_path / 'run')
     s = copy.deepcopy(_summary(run_dir))
     s['id'] = 'pth1'
+    s['experiments']['feeder']['faults'].update(physics_fault=1, flagged=[
+        {'group': 0, 'iteration': 0, 'fault': 'physics_fault'}])
     (tmp_path / 'run' / 'summary.json').write_text(json.dumps(s))
     report.write(str(tmp_path / 'run'))
     text = (tmp_path / 'run' / 'report.md').read_text()
     assert '| paper | 40 | 480 | 0 | 2.7 | 0 | 6 | 1.67 |' in text
     assert '| paper | 50 | 480 | 17-27 | 50 | 167 |' in text
     assert 'paper: n* = 22, 17-27' in text
+    assert '| `feeder` | 1 | 1 | 0 | 0 |' in text
+    assert '1 iteration(s) flagged: physics_fault 1 (see Physics faults)' in text
 
 
 def test_pictures_re_simulate_the_recorded_iteration(run_dir):
