@@ -34,7 +34,7 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from . import config
-from .launcher import MANAGER, NodeProcess, WORKER_NODES
+from .launcher import MANAGER, NodeProcess, READS_MESHES, WORKER_NODES
 
 MAX_WORKERS = 64
 START_TIMEOUT = 60.0    # s for the manager's action server to appear
@@ -119,19 +119,33 @@ def _interrupt(signum, frame) -> None:
     raise KeyboardInterrupt
 
 
-def _start_graph(namespace: str, log_dir: str, workers: int) -> list[NodeProcess]:
-    """The workers' nodes, then the manager (last)."""
+def _dirs(name: str, paths) -> list[str]:
+    """`-p name:=[...]` for a string array parameter (JSON is YAML), or nothing when empty
+    (rcl refuses an empty list)."""
+    paths = sorted(set(paths))
+    return ['-p', f'{name}:={json.dumps(paths)}'] if paths else []
+
+
+def _start_graph(namespace: str, log_dir: str, workers: int,
+                 goals: list[tuple[RunExperiment.Goal, str]]) -> list[NodeProcess]:
+    """The workers' nodes, then the manager (last). Each may read and write only where the
+    goals need: their files' and meshes' directories, and their output directories."""
     ns = '/' + namespace.strip('/') if namespace.strip('/') else ''
     names = [f'worker_{k}' for k in range(workers)]
+    meshes = [os.path.dirname(mesh) for _, mesh in goals if mesh]
     procs = []
     for worker in names:
-        procs += [NodeProcess(pkg, exe, ['-r', f'__ns:={ns}/{worker}'],
+        procs += [NodeProcess(pkg, exe, ['-r', f'__ns:={ns}/{worker}', *(
+                                  _dirs('mesh_dirs', meshes) if exe in READS_MESHES else [])],
                               os.path.join(log_dir, f'{worker}.{exe}.log'), f'{worker}/{exe}')
                   for pkg, exe in WORKER_NODES]
     pkg, exe = MANAGER
-    procs.append(NodeProcess(pkg, exe, ['-r', f'__ns:={ns or "/"}', '-p',
-                                        f'workers:=[{", ".join(names)}]'],
-                             os.path.join(log_dir, f'{exe}.log')))
+    files = [os.path.dirname(g.experiment_file) for g, _ in goals]
+    procs.append(NodeProcess(pkg, exe, [
+        '-r', f'__ns:={ns or "/"}', '-p', f'workers:=[{", ".join(names)}]',
+        *_dirs('experiment_dirs', files + meshes),
+        *_dirs('output_dirs', [g.output_dir for g, _ in goals])],
+        os.path.join(log_dir, f'{exe}.log')))
     return procs
 
 
@@ -161,8 +175,9 @@ def _summary_lines(summary: dict) -> list[str]:
     return lines
 
 
-def _goals(args: argparse.Namespace) -> list[RunExperiment.Goal]:
-    """A goal per file, every file checked first. Raises InvalidArgument naming the file."""
+def _goals(args: argparse.Namespace) -> list[tuple[RunExperiment.Goal, str]]:
+    """A goal per file with the file's mesh ('' for none), every file checked first. Raises
+    InvalidArgument naming the file."""
     goals = []
     for path in [os.path.abspath(p) for p in args.experiment_files or [default_file()]]:
         try:
@@ -175,8 +190,8 @@ def _goals(args: argparse.Namespace) -> list[RunExperiment.Goal]:
         except InvalidArgument as exc:
             raise InvalidArgument(f'{path}: {exc.field}', exc.value, exc.rule) from None
         output = os.path.abspath(args.resume or args.output or file.output_dir)
-        goals.append(RunExperiment.Goal(experiment_file=path, resume=bool(args.resume),
-                                        output_dir=output))
+        goals.append((RunExperiment.Goal(experiment_file=path, resume=bool(args.resume),
+                                         output_dir=output), file.part.mesh_path))
     return goals
 
 
@@ -191,7 +206,7 @@ def main(argv: list[str] | None = None) -> int:
     os.makedirs(log_dir, exist_ok=True)
     print(f'run: {len(goals)} experiment file(s); node logs in {log_dir}', file=sys.stderr)
     try:
-        procs = _start_graph(args.namespace, log_dir, args.workers)
+        procs = _start_graph(args.namespace, log_dir, args.workers, goals)
     except FileNotFoundError as exc:
         print(f'run: {exc}', file=sys.stderr)
         return 2
@@ -205,7 +220,7 @@ def main(argv: list[str] | None = None) -> int:
     bar = ProgressBar()
     watched = list(procs)      # the processes not reported dead yet
     try:
-        for goal in goals:
+        for goal, _ in goals:
             code = _run(node, client, goal, procs, watched, bar)
             if code:
                 return code

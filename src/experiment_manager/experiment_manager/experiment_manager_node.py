@@ -16,12 +16,18 @@ import threading
 import time
 import traceback
 
+from ament_index_python.packages import get_package_share_directory
 from pick_msgs.action import RunExperiment
 from pick_msgs.msg import ExperimentProgress
 from pick_sim_world import conversions as world_conv
-from pick_sim_world.errors import InvalidArgument, WorldError
+from pick_sim_world.errors import check_inside, InvalidArgument, WorldError
 from pick_sim_world.node_runner import run
-from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from rcl_interfaces.msg import (
+    FloatingPointRange,
+    IntegerRange,
+    ParameterDescriptor,
+    ParameterType,
+)
 from rclpy.action import ActionServer, CancelResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.exceptions import InvalidNamespaceException
@@ -39,6 +45,7 @@ from .topic_recorder import TopicRecorder
 
 STOP_WAIT = 15.0        # s a shutdown waits for the run to close its files
 DISCOVERY_SETTLE = 3.0  # s the worker list must stay the same before discovery ends
+BUILTIN_FILES = os.path.join(get_package_share_directory('experiment_manager'), 'config')
 RESULT_FILES = ('iterations.csv', 'checks.csv', 'picks.csv', 'parts.csv', 'summary.json')
 
 
@@ -79,6 +86,16 @@ class ExperimentManagerNode(Node):
             description='bytes of messages per MCAP chunk; a killed run loses at most one',
             read_only=True, integer_range=[IntegerRange(from_value=1024,
                                                         to_value=1 << 30)])).value
+        def dirs(name: str, default: list[str], text: str) -> list[str]:
+            return self.declare_parameter(name, default, ParameterDescriptor(
+                description=text, read_only=True,
+                type=ParameterType.PARAMETER_STRING_ARRAY)).value
+
+        self._experiment_dirs = dirs('experiment_dirs', ['.', BUILTIN_FILES], (
+            'directories whose experiment files (and the meshes they name) goals may name; '
+            "'.' is the node's working directory"))
+        self._output_dirs = dirs('output_dirs', ['.'], 'directories under which goals may '
+                                 'write run directories')
         self._group = ReentrantCallbackGroup()
         self._call_timeout, self._server_timeout = call_timeout, server_timeout
         self._stopping = threading.Event()
@@ -171,7 +188,12 @@ class ExperimentManagerNode(Node):
         writer = recorder = None
         try:
             goal = goal_handle.request
+            check_inside('experiment_file', goal.experiment_file, self._experiment_dirs,
+                         'experiment_dirs')
             file = config.load(goal.experiment_file)
+            if file.part.mesh_path:
+                check_inside('part.mesh', file.part.mesh_path, self._experiment_dirs,
+                             'experiment_dirs')
             if goal.resume:
                 if not goal.output_dir:
                     raise InvalidArgument('output_dir', '', 'must name the run '
@@ -179,6 +201,7 @@ class ExperimentManagerNode(Node):
                 run_dir = os.path.abspath(os.path.expanduser(goal.output_dir))
             else:
                 run_dir = run_directory(goal.output_dir or file.output_dir, file.id)
+            check_inside('output_dir', run_dir, self._output_dirs, 'output_dirs')
             writer = ResultsWriter(run_dir, file.text, goal.resume)
             result.results_path = run_dir
             recorder = self._open_recording(run_dir, file, goal.resume)

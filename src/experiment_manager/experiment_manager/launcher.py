@@ -12,6 +12,7 @@ from ament_index_python.packages import get_package_prefix, PackageNotFoundError
 WORKER_NODES = (('pick_sim_world', 'world'), ('pick_validity', 'validity'),
                 ('feeder_controller', 'feeder_controller'))
 MANAGER = ('experiment_manager', 'experiment_manager')
+READS_MESHES = {'world', 'validity'}    # the worker nodes with a `mesh_dirs` parameter
 PR_SET_PDEATHSIG = 1
 
 

@@ -9,7 +9,7 @@ ros2 action send_goal --feedback /run_experiment pick_msgs/action/RunExperiment 
 (the `run` executable does the same without ros2 launch: it starts these processes itself).
 """
 
-from experiment_manager.launcher import MANAGER, WORKER_NODES
+from experiment_manager.launcher import MANAGER, READS_MESHES, WORKER_NODES
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
@@ -20,8 +20,11 @@ def _nodes(context) -> list[Node]:
     namespace = LaunchConfiguration('namespace').perform(context).rstrip('/')
     workers = [f'worker_{k}' for k in range(int(LaunchConfiguration('workers')
                                                 .perform(context)))]
+    meshes = [d for d in LaunchConfiguration('mesh_dirs').perform(context).split(':') if d]
     nodes = [Node(package=package, executable=name, name=name,
-                  namespace=f'{namespace}/{worker}', output='screen')
+                  namespace=f'{namespace}/{worker}', output='screen',
+                  parameters=[{'mesh_dirs': meshes}] if meshes and name in READS_MESHES
+                  else [])
              for worker in workers for package, name in WORKER_NODES]
     package, name = MANAGER
     nodes.append(Node(package=package, executable=name, name=name, namespace=namespace or '/',
@@ -41,5 +44,8 @@ def generate_launch_description() -> LaunchDescription:
                               description='number of workers to start'),
         DeclareLaunchArgument('call_timeout', default_value='600.0',
                               description='longest wait for one call to a worker node, s'),
+        DeclareLaunchArgument('mesh_dirs', default_value='',
+                              description="':'-separated directories of the mesh files that "
+                              'experiment files name (the workers read nothing else)'),
         OpaqueFunction(function=_nodes),
     ])

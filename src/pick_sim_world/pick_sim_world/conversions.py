@@ -19,6 +19,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 from . import containers
 from .containers import ContainerSpec
 from .errors import (
+    check_inside,
     check_number,
     InvalidArgument,
     PhysicsFault,
@@ -90,8 +91,12 @@ def container_to_msg(spec: ContainerSpec) -> ContainerGeometry:
 
 
 # ----------------------------------------------------------------------------- parts
-def part_spec_from_msg(msg: PartModel) -> PartSpec:
-    """A PartSpec from a message. 0 in mass, scale or a friction field means the default."""
+def part_spec_from_msg(msg: PartModel, mesh_dirs: Sequence[str] = ()) -> PartSpec:
+    """A PartSpec from a message. 0 in mass, scale or a friction field means the default.
+    A mesh file must lie in one of `mesh_dirs` (the node's parameter of that name): a request
+    cannot make a node read elsewhere."""
+    if msg.mesh_path:
+        check_inside('part_model.mesh_path', msg.mesh_path, mesh_dirs, 'mesh_dirs')
     names, values = list(msg.dimension_names), list(msg.dimension_values)
     if len(names) != len(values):
         raise InvalidArgument('part_model.dimension_values', len(values),

@@ -4,8 +4,9 @@ Every value is checked here before it reaches PyBullet: PyBullet accepts NaN sil
 state becomes NaN. The node turns these exceptions into an error code and a message.
 """
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 import math
+import os
 
 
 class WorldError(Exception):
@@ -81,3 +82,19 @@ def check_vector(field: str, values: Iterable[float], length: int, *,
         raise InvalidArgument(field, items, f'must have {length} elements')
     return tuple(check_number(f'{field}[{i}]', v, low=low, high=high, low_open=low_open)
                  for i, v in enumerate(items))
+
+
+def check_inside(field: str, path: str, roots: Sequence[str], parameter: str) -> str:
+    """The real path of `path` (relative to the working directory, symlinks and '..'
+    resolved) if it lies inside one of `roots` (directories, resolved the same way), the
+    places a node was given by its `parameter`. Raises InvalidArgument naming the field, the
+    path and the places otherwise. Nothing is read, so a path outside gets the same answer
+    whether it exists or not."""
+    real = os.path.realpath(path)
+    for root in roots:
+        top = os.path.realpath(root)
+        if os.path.commonpath([real, top]) == top:
+            return real
+    where = ', '.join(repr(r) for r in roots) if roots else 'none'
+    raise InvalidArgument(field, path, f'is outside the directories this node may use '
+                                       f'({parameter}: {where})')

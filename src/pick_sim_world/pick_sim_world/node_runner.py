@@ -5,10 +5,12 @@ shuts down cleanly on Ctrl-C or SIGINT (the Jazzy way: ros2/demos `qos_overrides
 from collections.abc import Callable
 import sys
 
+from rcl_interfaces.msg import ParameterDescriptor, ParameterType
 import rclpy
 from rclpy.exceptions import ParameterException
 from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from .errors import WorldError
@@ -22,6 +24,15 @@ RESULT_KEEP = 10.0
 # Latched: a late subscriber gets the last message (scene, markers, last report).
 LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL,
                      reliability=ReliabilityPolicy.RELIABLE)
+
+
+def declare_mesh_dirs(node: Node) -> list[str]:
+    """The read-only `mesh_dirs` parameter of the nodes that load meshes named in requests:
+    the directories those files may lie in (none by default)."""
+    return node.declare_parameter('mesh_dirs', Parameter.Type.STRING_ARRAY, ParameterDescriptor(
+        description='directories whose mesh files requests may name (part_model.mesh_path); '
+        'unset: none. The part.mesh_path parameter is not limited by it', read_only=True,
+        type=ParameterType.PARAMETER_STRING_ARRAY)).value or []
 
 
 def run(name: str, make_node: Callable[[], Node],

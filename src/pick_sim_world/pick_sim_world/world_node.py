@@ -28,7 +28,7 @@ from . import conversions as conv
 from .config import PhysicsConfig, SceneSpec, Vibration
 from .containers import BIN, ContainerSpec, TRAY
 from .errors import InvalidArgument, WorldError
-from .node_runner import LATCHED, RESULT_KEEP, run
+from .node_runner import declare_mesh_dirs, LATCHED, RESULT_KEEP, run
 from .parts import BUILTIN_MODELS, PartSpec
 from .world import Progress, SettleReport, World
 
@@ -168,6 +168,7 @@ class WorldNode(Node):
                          1e-3, 60.0))
         self._publish_markers = get('publish_markers', True, 'publish `markers` after each '
                                     'operation')
+        self._mesh_dirs = declare_mesh_dirs(self)
         return scene, physics, vibration
 
     # ----------------------------------------------------------------------------- publish
@@ -212,7 +213,8 @@ class WorldNode(Node):
             else:
                 self._world.reset(SceneSpec(
                     conv.container_from_msg(request.container),
-                    conv.part_spec_from_msg(request.part_model), request.instance_count,
+                    conv.part_spec_from_msg(request.part_model, self._mesh_dirs),
+                    request.instance_count,
                     request.seed))
 
         if self._guarded(reset, response):

@@ -1,12 +1,14 @@
 """Property tests: any value in a scene, drop or vibration either works or is refused with
 InvalidArgument naming the field; nothing else escapes, and the world stays usable."""
 
+import re
+
 from hypothesis import given, HealthCheck, settings
 from hypothesis import strategies as st
 import numpy as np
 from pick_sim_world.config import SceneSpec, Vibration
 from pick_sim_world.containers import ContainerSpec
-from pick_sim_world.errors import InvalidArgument, UnknownInstance
+from pick_sim_world.errors import check_inside, InvalidArgument, UnknownInstance
 from pick_sim_world.parts import PartSpec
 from pick_sim_world.world import World
 import pytest
@@ -69,3 +71,23 @@ def test_any_vibration_works_or_names_the_field(world, amplitude, frequency, dur
     except UnknownInstance as exc:
         assert 'instances:' in str(exc)
     _still_works(world)
+
+
+def test_a_path_outside_the_given_directories_is_refused_before_anything_is_read(tmp_path):
+    allowed, outside = tmp_path / 'meshes', tmp_path / 'other'
+    allowed.mkdir()
+    outside.mkdir()
+    (allowed / 'part.stl').write_text('solid x\nendsolid x\n')
+    (allowed / 'link.stl').symlink_to(outside / 'secret.stl')
+    (allowed / 'sub').symlink_to(outside, target_is_directory=True)
+    roots = [str(allowed)]
+    assert check_inside('f', str(allowed / 'part.stl'), roots, 'p') == str(allowed / 'part.stl')
+    assert check_inside('f', str(allowed / 'new' / 'x'), roots, 'p')   # need not exist
+    for path in (outside / 'secret.stl', allowed / '..' / 'other' / 'secret.stl',
+                 allowed / 'link.stl', allowed / 'sub' / 'secret.stl', '/etc/passwd',
+                 str(allowed) + '_twin/part.stl', 'relative/part.stl'):
+        with pytest.raises(InvalidArgument, match=re.escape(
+                f"f: '{path}' is outside the directories this node may use (p: '{allowed}')")):
+            check_inside('f', str(path), roots, 'p')
+    with pytest.raises(InvalidArgument, match=r'\(p: none\)'):
+        check_inside('f', str(allowed / 'part.stl'), [], 'p')

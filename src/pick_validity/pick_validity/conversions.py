@@ -1,6 +1,7 @@
 """The one place that maps check_parts requests and ValidityReport messages to and from the
 validity core. Container, part-model and part conversions are pick_sim_world's, reused."""
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from builtin_interfaces.msg import Time
@@ -30,13 +31,15 @@ class Setup:
     config: CheckConfig
 
 
-def request_to_core(request: CheckParts.Request) -> tuple[ContainerSpec, PartSpec, list[int],
-                                                         object, list[int] | None]:
-    """Container, part spec, ids, poses (N, 7) and targets (None for all) of a request."""
+def request_to_core(request: CheckParts.Request, mesh_dirs: Sequence[str]
+                    ) -> tuple[ContainerSpec, PartSpec, list[int], object, list[int] | None]:
+    """Container, part spec, ids, poses (N, 7) and targets (None for all) of a request; a
+    mesh file must lie in one of `mesh_dirs`."""
     ids, _, poses = world_conversions.parts_to_arrays(request.parts)
     targets = [int(t) for t in request.target_ids] or None
     return (world_conversions.container_from_msg(request.container),
-            world_conversions.part_spec_from_msg(request.part_model), ids.tolist(), poses,
+            world_conversions.part_spec_from_msg(request.part_model, mesh_dirs), ids.tolist(),
+            poses,
             targets)
 
 

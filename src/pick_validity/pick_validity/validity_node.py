@@ -12,7 +12,7 @@ from pick_msgs.msg import PartModel, ValidityReport
 from pick_msgs.srv import CheckParts
 from pick_sim_world import conversions as world_conversions
 from pick_sim_world.errors import WorldError
-from pick_sim_world.node_runner import LATCHED, run
+from pick_sim_world.node_runner import declare_mesh_dirs, LATCHED, run
 from pick_sim_world.parts import build_part
 from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor
 from rclpy.node import Node
@@ -85,6 +85,7 @@ class ValidityNode(Node):
             tilt_min=get('check.tilt_min', c.tilt_min, 'rad', -math.pi / 2, math.pi / 2),
             tilt_max=get('check.tilt_max', c.tilt_max, 'rad', -math.pi / 2, math.pi / 2),
             tilt_step=get('check.tilt_step', c.tilt_step, 'rad', 1e-3, math.pi))
+        self._mesh_dirs = declare_mesh_dirs(self)
         return gripper, tuple(grasps), place, config
 
     def _validator_for(self, spec, setup: conv.Setup) -> Validator:
@@ -103,7 +104,8 @@ class ValidityNode(Node):
     def _check_parts(self, request: CheckParts.Request,
                      response: CheckParts.Response) -> CheckParts.Response:
         try:
-            container, spec, ids, poses, targets = conv.request_to_core(request)
+            container, spec, ids, poses, targets = conv.request_to_core(request,
+                                                                        self._mesh_dirs)
             validator = self._validator_for(
                 spec, conv.setup_from_request(request, self._defaults))
             report = validator.check(container, ids, poses, targets, request.check_neighbours)
