@@ -3,8 +3,18 @@
 from collections.abc import Callable, Iterator
 import os
 
+from fuzz import TRIED
 from graph import Client, NodeProcess
 import pytest
+
+
+def pytest_terminal_summary(terminalreporter) -> None:
+    """The requests the fuzz tests sent, per endpoint, by the error code of the answer."""
+    if TRIED:
+        terminalreporter.section('requests fuzzed per endpoint')
+        for endpoint, codes in TRIED.items():
+            terminalreporter.write_line(f'{endpoint}: {sum(codes.values())} ('
+                                        + ', '.join(f'{c} {n}' for c, n in codes.items()) + ')')
 
 
 @pytest.fixture(scope='session', autouse=True)

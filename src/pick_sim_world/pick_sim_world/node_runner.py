@@ -8,6 +8,7 @@ import sys
 from rcl_interfaces.msg import ParameterDescriptor, ParameterType
 import rclpy
 from rclpy.exceptions import ParameterException
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -49,6 +50,10 @@ def run(name: str, make_node: Callable[[], Node],
         node = make_node()
     except (WorldError, ParameterException) as exc:
         print(f'{name}: bad configuration: {exc}', file=sys.stderr)
+        rclpy.try_shutdown()
+        sys.exit(2)
+    except _rclpy.RCLError as exc:  # rcl refused the node, e.g. ROS_SECURITY_* it cannot honour
+        print(f'{name}: could not start: {exc}', file=sys.stderr)
         rclpy.try_shutdown()
         sys.exit(2)
     try:
