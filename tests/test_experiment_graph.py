@@ -177,11 +177,12 @@ experiments:
 """
 
 
-def start_run(file, tmp_path, namespace: str, workers: int, **popen) -> subprocess.Popen:
+def start_run(file, tmp_path, namespace: str, workers: int, *args: str,
+              **popen) -> subprocess.Popen:
     """The `run` command in the background, into tmp_path/out, logs in tmp_path/logs."""
     return subprocess.Popen([executable('experiment_manager', 'run'), str(file), '--output',
                              str(tmp_path / 'out'), '--namespace', namespace, '--workers',
-                             str(workers), '--logs', str(tmp_path / 'logs')], **popen)
+                             str(workers), '--logs', str(tmp_path / 'logs'), *args], **popen)
 
 
 def first_iteration_done(out) -> Callable[[], bool]:
@@ -205,16 +206,36 @@ def test_a_killed_worker_s_iterations_run_on_the_other_with_the_same_results(
             run.kill()
     assert run.returncode == 0, stderr
     assert re.search(r'worker_0/world \(pid \d+\) was killed by signal 9', stderr), stderr
-    assert 'its worker is lost' in stderr
+    assert 'worker_0/world started again (1 of 3)' in stderr
+    run_dir = re.search(r'^results:\s+(\S+)', stdout, re.M).group(1)
+    for name in FILES:
+        assert rows(run_dir, name) == rows(core_run, name), name
+
+
+def test_a_lone_worker_whose_world_is_killed_is_started_again_and_finishes_the_run(
+        tmp_path, client, core_run, private_ros_domain):
+    """One worker: the run can finish only if the restarted world is taken back."""
+    ns = unique_namespace('exp_back')
+    run = start_run(SMALL, tmp_path, ns, 1, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                    text=True)
+    try:
+        assert client.wait(first_iteration_done(tmp_path / 'out'), 120.0), 'no iteration finished'
+        os.kill(_world_pid(ns), signal.SIGKILL)
+        stdout, stderr = run.communicate(timeout=600)
+    finally:
+        if run.poll() is None:
+            run.kill()
+    assert run.returncode == 0, stderr
+    assert 'worker_0/world started again (1 of 3)' in stderr
+    assert 'worker worker_0 was lost and came back' in open(
+        tmp_path / 'logs' / 'experiment_manager.log').read()
     run_dir = re.search(r'^results:\s+(\S+)', stdout, re.M).group(1)
     for name in FILES:
         assert rows(run_dir, name) == rows(core_run, name), name
 
 
 def _world_pid(namespace: str) -> int:
-    found = subprocess.run(['pgrep', '-f', f'lib/pick_sim_world/world --ros-args -r '
-                            f'__ns:={namespace}/worker_0'], capture_output=True, text=True)
-    return int(found.stdout.split()[0])
+    return _pid(f'{namespace}/worker_0', 'lib/pick_sim_world/world')
 
 
 def test_a_second_goal_is_busy_and_a_killed_last_worker_ends_the_run(tmp_path, client,
@@ -223,8 +244,8 @@ def test_a_second_goal_is_busy_and_a_killed_last_worker_ends_the_run(tmp_path, c
     path = tmp_path / 'long.yaml'
     path.write_text(LONG)
     out = tmp_path / 'out'
-    run = start_run(path, tmp_path, ns, 1, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                    text=True)
+    run = start_run(path, tmp_path, ns, 1, '--respawns', '0', stdout=subprocess.PIPE,
+                    stderr=subprocess.PIPE, text=True)
     try:
         assert client.wait(first_iteration_done(out), 120.0), 'no iteration finished'
 
@@ -250,6 +271,74 @@ def test_a_second_goal_is_busy_and_a_killed_last_worker_ends_the_run(tmp_path, c
     assert summary is not None and summary.statistics.message_count > 0
     assert {a.name for a in summary.attachment_indexes} >= {'experiment.yaml', 'iterations.csv'}
     assert not os.path.exists(tmp_path / 'other'), 'the busy goal wrote nothing'
+
+
+def _pid(namespace: str, executable_path: str) -> int:
+    found = subprocess.run(['pgrep', '-f', f'{executable_path} --ros-args -r __ns:={namespace}'],
+                           capture_output=True, text=True)
+    return int(found.stdout.split()[0])
+
+
+def _interrupted(tmp_path, client, stop: Callable[[subprocess.Popen, str], None]
+                 ) -> tuple[str, subprocess.CompletedProcess]:
+    """Start `run` on the small file with one worker, let one iteration finish, call
+    stop(run, namespace), then resume the run directory in a new graph. Returns the run
+    directory and the resumed run's output."""
+    ns = unique_namespace('exp_stop')
+    run = start_run(SMALL, tmp_path, ns, 1, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                    text=True)
+    try:
+        assert client.wait(first_iteration_done(tmp_path / 'out'), 120.0), 'no iteration finished'
+        stop(run, ns)
+        run.communicate(timeout=120)
+    finally:
+        if run.poll() is None:
+            run.kill()
+    run_dir = glob.glob(f'{tmp_path}/out/small_*')[0]
+    assert 1 <= len(rows(run_dir, 'iterations')) < 14
+    resumed = run_command('--resume', run_dir, '--namespace', unique_namespace('exp_resume'),
+                          '--logs', str(tmp_path / 'logs_resume'), '--workers', '2')
+    assert resumed.returncode == 0, resumed.stderr
+    return run_dir, resumed
+
+
+def test_a_run_stopped_with_sigint_closes_its_files_and_resumes_to_the_same_results(
+        tmp_path, client, core_run, private_ros_domain):
+    def interrupt(run: subprocess.Popen, ns: str) -> None:
+        run.send_signal(signal.SIGINT)
+        assert run.wait(120) == 130
+    run_dir, _ = _interrupted(tmp_path, client, interrupt)
+    with open(os.path.join(run_dir, 'recording.mcap'), 'rb') as f:
+        summary = make_reader(f).get_summary()      # closed: it has a summary
+    assert summary.statistics.message_count > 0
+    assert {a.name for a in summary.attachment_indexes} >= {'experiment.yaml', 'iterations.csv'}
+    assert os.path.exists(os.path.join(run_dir, 'recording_2.mcap'))   # the resumed part
+    for name in FILES:
+        assert rows(run_dir, name) == rows(core_run, name), name
+
+
+def test_a_killed_manager_s_recording_is_recovered_and_its_run_resumed(
+        tmp_path, client, core_run, private_ros_domain):
+    def kill_manager(run: subprocess.Popen, ns: str) -> None:
+        os.kill(_pid(ns, 'lib/experiment_manager/experiment_manager'), signal.SIGKILL)
+        assert run.wait(120) == 1
+    run_dir, _ = _interrupted(tmp_path, client, kill_manager)
+    cut = os.path.join(run_dir, 'recording.mcap')
+    info = subprocess.run([executable('experiment_manager', 'replay'), cut, '--info'],
+                          capture_output=True, text=True, timeout=60)
+    assert info.returncode == 2 and f'replay {cut} --recover OUT.mcap' in info.stderr
+    out = str(tmp_path / 'recovered.mcap')
+    done = subprocess.run([executable('experiment_manager', 'replay'), cut, '--recover', out],
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    messages = int(re.search(r'(\d+) messages', done.stderr).group(1))
+    with open(out, 'rb') as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        assert reader.get_summary().statistics.message_count == messages > 0
+        assert sum(1 for _ in reader.iter_decoded_messages()) == messages
+        assert 'experiment.yaml' in {a.name for a in reader.iter_attachments()}
+    for name in FILES:
+        assert rows(run_dir, name) == rows(core_run, name), name
 
 
 def test_a_run_killed_with_sigkill_leaves_no_node_behind(tmp_path, client, private_ros_domain):
@@ -283,7 +372,8 @@ def test_the_manager_finds_the_workers_under_its_namespace(tmp_path, client, sta
     nodes = [start_node(pkg, exe, '-r', f'__ns:={ns}/{w}') for w in ('cell_a', 'cell_b')
              for pkg, exe in WORKER_NODES]
     nodes.append(start_node('pick_validity', 'validity', '-r', f'__ns:={ns}/lone'))
-    manager = start_node('experiment_manager', 'experiment_manager', '-r', f'__ns:={ns}')
+    manager = start_node('experiment_manager', 'experiment_manager', '-r', f'__ns:={ns}', '-p',
+                         f'experiment_dirs:=["{tmp_path}"]', '-p', f'output_dirs:=["{tmp_path}"]')
     path = tmp_path / 'tiny.yaml'
     path.write_text(TINY)
     action = ActionClient(client.node, RunExperiment, f'{ns}/run_experiment')

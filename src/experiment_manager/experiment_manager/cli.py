@@ -1,16 +1,18 @@
 """`run`: bring up the graph on this machine and run experiment files through it.
 
     run [EXPERIMENT_FILE ...] [--output DIR | --resume RUN_DIR] [--iterations N]
-        [--workers N] [--namespace NS] [--logs DIR]
+        [--workers N] [--respawns N] [--namespace NS] [--logs DIR]
 
 Starts N workers (`world`, `validity` and `feeder_controller` under <NS>/worker_<k>, default: a
 worker per CPU) and `experiment_manager` under <NS> as separate processes (DDS between them, as
 on a cell), sends `run_experiment` for each file in turn, shows a progress bar, and prints where
-the results and the recording are. A worker node that dies is reported; the manager runs its
-iteration again on another worker, and the run fails only when no worker is left.
-Without a file it runs the built-in default (`share/experiment_manager/config/
-default_experiment.yaml`). --iterations N caps every experiment at N iterations (a quick look
-at a long study; the run directory keeps the file that ran).
+the results and the recording are. A worker node that dies is reported and started again (up to
+--respawns times); the manager runs the iteration it lost again and takes the worker back, and
+the run fails only when no worker is left. Each node may read and write only where the goals
+need (mesh_dirs, experiment_dirs, output_dirs). Without a file it runs the built-in default
+(`share/experiment_manager/config/default_experiment.yaml`), or with --resume the file the run
+directory keeps. --iterations N caps every experiment at N iterations (a quick look at a long
+study; the run directory keeps the file that ran).
 
 Exit codes: 0 done; 1 the run failed (the message says why; finished iterations are kept);
 2 bad input (the experiment file, an option); 130 interrupted (Ctrl-C: the run is canceled and
@@ -18,6 +20,7 @@ its files closed).
 """
 
 import argparse
+import collections
 import json
 import os
 import signal
@@ -38,6 +41,7 @@ from .launcher import MANAGER, NodeProcess, READS_MESHES, WORKER_NODES
 
 MAX_WORKERS = 64
 START_TIMEOUT = 60.0    # s for the manager's action server to appear
+RESPAWNS = 3            # times a worker node that died is started again, per run
 STOP_TIMEOUT = 30.0     # s for a canceled run to close its files
 
 
@@ -94,7 +98,8 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     where.add_argument('--output', help="directory for the run's directory (default: the "
                        "file's output_dir)")
     where.add_argument('--resume', metavar='RUN_DIR',
-                       help='finish the interrupted run in RUN_DIR (same experiment file)')
+                       help='finish the interrupted run in RUN_DIR (with the file it keeps, '
+                       'RUN_DIR/experiment.yaml, unless a file is given: it must be the same)')
     parser.add_argument('--namespace', default='/',
                         help='namespace of the graph (default /): worker k runs in '
                         '<namespace>/worker_<k>')
@@ -103,6 +108,9 @@ def _parse(argv: list[str]) -> argparse.Namespace:
                         'worker per CPU, at most 8)')
     parser.add_argument('--iterations', type=int, metavar='N',
                         help='cap every experiment at N iterations')
+    parser.add_argument('--respawns', type=int, metavar='N', default=RESPAWNS,
+                        help=f'times a worker node that died is started again (default '
+                        f'{RESPAWNS}; 0: never, and the manager does not wait for it)')
     parser.add_argument('--logs', help="directory for the nodes' logs (default: a temporary "
                         'directory, printed)')
     args = parser.parse_args(argv)
@@ -110,6 +118,8 @@ def _parse(argv: list[str]) -> argparse.Namespace:
         parser.error('--resume finishes one run: give one experiment file')
     if args.iterations is not None and args.resume:
         parser.error('--resume runs the file of the run directory: no --iterations')
+    if not 0 <= args.respawns <= 100:
+        parser.error(f'--respawns {args.respawns} must be within [0, 100]')
     if not 1 <= args.workers <= MAX_WORKERS:
         parser.error(f'--workers {args.workers} must be within [1, {MAX_WORKERS}]')
     return args
@@ -127,7 +137,8 @@ def _dirs(name: str, paths) -> list[str]:
 
 
 def _start_graph(namespace: str, log_dir: str, workers: int,
-                 goals: list[tuple[RunExperiment.Goal, str]]) -> list[NodeProcess]:
+                 goals: list[tuple[RunExperiment.Goal, str]], respawns: int
+                 ) -> list[NodeProcess]:
     """The workers' nodes, then the manager (last). Each may read and write only where the
     goals need: their files' and meshes' directories, and their output directories."""
     ns = '/' + namespace.strip('/') if namespace.strip('/') else ''
@@ -143,6 +154,7 @@ def _start_graph(namespace: str, log_dir: str, workers: int,
     files = [os.path.dirname(g.experiment_file) for g, _ in goals]
     procs.append(NodeProcess(pkg, exe, [
         '-r', f'__ns:={ns or "/"}', '-p', f'workers:=[{", ".join(names)}]',
+        *([] if respawns else ['-p', 'rejoin_timeout:=0.0']),
         *_dirs('experiment_dirs', files + meshes),
         *_dirs('output_dirs', [g.output_dir for g, _ in goals])],
         os.path.join(log_dir, f'{exe}.log')))
@@ -179,7 +191,9 @@ def _goals(args: argparse.Namespace) -> list[tuple[RunExperiment.Goal, str]]:
     """A goal per file with the file's mesh ('' for none), every file checked first. Raises
     InvalidArgument naming the file."""
     goals = []
-    for path in [os.path.abspath(p) for p in args.experiment_files or [default_file()]]:
+    files = args.experiment_files or [os.path.join(args.resume, 'experiment.yaml')
+                                      if args.resume else default_file()]
+    for path in [os.path.abspath(p) for p in files]:
         try:
             file = config.load(path)
             if args.iterations is not None:
@@ -206,7 +220,7 @@ def main(argv: list[str] | None = None) -> int:
     os.makedirs(log_dir, exist_ok=True)
     print(f'run: {len(goals)} experiment file(s); node logs in {log_dir}', file=sys.stderr)
     try:
-        procs = _start_graph(args.namespace, log_dir, args.workers, goals)
+        procs = _start_graph(args.namespace, log_dir, args.workers, goals, args.respawns)
     except FileNotFoundError as exc:
         print(f'run: {exc}', file=sys.stderr)
         return 2
@@ -218,10 +232,10 @@ def main(argv: list[str] | None = None) -> int:
     node = Node('experiment_cli')
     client = ActionClient(node, RunExperiment, 'run_experiment')
     bar = ProgressBar()
-    watched = list(procs)      # the processes not reported dead yet
+    graph = Graph(procs, args.respawns)
     try:
         for goal, _ in goals:
-            code = _run(node, client, goal, procs, watched, bar)
+            code = _run(node, client, goal, graph, bar)
             if code:
                 return code
         return 0
@@ -234,7 +248,7 @@ def main(argv: list[str] | None = None) -> int:
         client.destroy()
         node.destroy_node()
         rclpy.try_shutdown()
-        for p in procs:   # SIGINT: the manager cancels its run and closes its files
+        for p in graph.procs:   # SIGINT: the manager cancels its run and closes its files
             p.stop()
 
 
@@ -249,26 +263,53 @@ def _spin_until(node: Node, done, procs: list[NodeProcess], timeout: float) -> N
     return None
 
 
-def _report_dead(node: Node, done, manager: NodeProcess, watched: list[NodeProcess],
-                 timeout: float, bar) -> bool:
-    """Spin until done() or timeout, reporting each process of `watched` that dies (and
-    dropping it from the list). False when the manager died."""
-    while (dead := _spin_until(node, done, watched, timeout)):
-        watched.remove(dead)
+class Graph:
+    """The node processes of `run`: the workers' nodes, then the manager (last); those not
+    given up as dead (`watched`), and how often each was started again."""
+
+    def __init__(self, procs: list[NodeProcess], limit: int) -> None:
+        self.procs, self.watched, self.limit = procs, list(procs), limit
+        self.respawns: collections.Counter = collections.Counter()
+
+    @property
+    def manager(self) -> NodeProcess:
+        return self.procs[-1]
+
+    def replace(self, dead: NodeProcess) -> NodeProcess | None:
+        """Start a dead worker node again (`limit` times per run and node); None when it
+        may not be, and then it is no longer watched."""
+        if self.respawns[dead.name] >= self.limit:
+            self.watched.remove(dead)
+            return None
+        self.respawns[dead.name] += 1
+        new = dead.respawn()
+        self.procs[self.procs.index(dead)] = self.watched[self.watched.index(dead)] = new
+        return new
+
+
+def _report_dead(node: Node, done, graph: Graph, timeout: float, bar) -> bool:
+    """Spin until done() or timeout, reporting each watched process that dies. A worker
+    node is started again (the manager runs the iteration it lost again and takes the worker
+    back). False when the manager died."""
+    while (dead := _spin_until(node, done, graph.watched, timeout)):
         bar.close()
         print(f'run: {dead.describe_exit()}:\n{dead.output(20)}', file=sys.stderr)
-        if dead is manager:
+        if dead is graph.manager:
             return False
-        print('run: its worker is lost; the manager runs its iterations on the others',
-              file=sys.stderr)
+        if graph.replace(dead):
+            print(f'run: {dead.name} started again ({graph.respawns[dead.name]} of '
+                  f'{graph.limit}); its iteration runs again, on it or another worker',
+                  file=sys.stderr)
+        else:
+            print('run: its worker is lost; the manager runs its iterations on the others',
+                  file=sys.stderr)
     return True
 
 
-def _run(node: Node, client: ActionClient, goal, procs: list[NodeProcess],
-         watched: list[NodeProcess], bar) -> int:
+def _run(node: Node, client: ActionClient, goal, graph: Graph, bar) -> int:
     print(f'run: {goal.experiment_file}', file=sys.stderr)
-    manager = procs[-1]
-    if not _report_dead(node, client.server_is_ready, manager, watched, START_TIMEOUT, bar) \
+    manager = graph.manager
+    if not _report_dead(node, client.server_is_ready, graph, START_TIMEOUT, bar) \
             or not client.server_is_ready():
         print(f'run: the experiment manager did not start (run_experiment did not appear '
               f'within {START_TIMEOUT:g} s)', file=sys.stderr)
@@ -281,7 +322,7 @@ def _run(node: Node, client: ActionClient, goal, procs: list[NodeProcess],
         return 1
     result_future = handle.get_result_async()
     try:
-        if not _report_dead(node, result_future.done, manager, watched, float('inf'), bar):
+        if not _report_dead(node, result_future.done, graph, float('inf'), bar):
             return 1
     except KeyboardInterrupt:
         handle.cancel_goal_async()

@@ -81,6 +81,10 @@ class ExperimentManagerNode(Node):
             description="longest wait for the worker's services and actions at the start of a "
             'run, s', read_only=True,
             floating_point_range=[FloatingPointRange(from_value=0.1, to_value=3600.0)])).value
+        self._rejoin_timeout = self.declare_parameter('rejoin_timeout', 60.0, ParameterDescriptor(
+            description='longest wait for a lost worker to come back (its nodes restarted, as '
+            '`run` does) before the run goes on without it, s; 0: do not wait', read_only=True,
+            floating_point_range=[FloatingPointRange(from_value=0.0, to_value=3600.0)])).value
         self._chunk_size = self.declare_parameter('recording.chunk_size', 1 << 20,
                                                   ParameterDescriptor(
             description='bytes of messages per MCAP chunk; a killed run loses at most one',
@@ -158,7 +162,7 @@ class ExperimentManagerNode(Node):
             if worker not in self._backends:
                 self._backends[worker] = GraphBackend(
                     self, worker, self._group, self._call_timeout, self._server_timeout,
-                    self._cancel_requested)
+                    self._cancel_requested, self._rejoin_timeout)
                 self._topics.add(worker)
         return [self._backends[w] for w in workers]
 
@@ -174,6 +178,7 @@ class ExperimentManagerNode(Node):
         if self._goal is not None:
             self._goal.publish_feedback(RunExperiment.Feedback(progress=msg))
         self._topics.write(self._progress.topic_name, msg)
+        self._topics.flush()   # once per iteration: a killed manager's recording keeps the rest
 
     # ------------------------------------------------------------------------- the action
     def _run(self, goal_handle) -> RunExperiment.Result:
@@ -218,6 +223,9 @@ class ExperimentManagerNode(Node):
                 for k in runner.lost_workers:
                     self.get_logger().warning(f'worker {backends[k].worker or "."} was lost '
                                               '(missing at the start, or during the run)')
+                for k in runner.rejoined:
+                    self.get_logger().warning(f'worker {backends[k].worker or "."} was lost '
+                                              'and came back')
             result.summary_json = json.dumps(summary)
             try:
                 pictures.write(file, run_dir)
@@ -271,6 +279,7 @@ class ExperimentManagerNode(Node):
                                   'experiment_file': file.path, 'run_directory': run_dir,
                                   'resumed': str(bool(resume)),
                                   'node': self.get_fully_qualified_name()})
+        recorder.flush()
         self._topics.start(recorder)
         return recorder
 

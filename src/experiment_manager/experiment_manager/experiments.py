@@ -93,6 +93,10 @@ class Backend(Protocol):
     def feed(self, valid: int, on_table: int, restart: FeederConfig | None) -> FeedStep:
         """One feeder policy step (restart: load the feeder first)."""
 
+    def rejoin(self, stop: Callable[[], bool]) -> bool:
+        """After WorkerLost: wait for the worker to come back; False if it does not (in the
+        backend's own time) or once stop() holds."""
+
 
 @dataclass(frozen=True)
 class Unit:
@@ -187,7 +191,7 @@ def search_order(order: str, states: PartStates, targets: np.ndarray, seed: int)
 
 class WorkerLost(Exception):
     """A backend's worker died or stopped answering: its iteration in flight is run again on
-    another worker, and this worker gets no more."""
+    another worker, and this worker gets more only if it comes back (Backend.rejoin)."""
 
 
 class Runner:
@@ -212,6 +216,7 @@ class Runner:
         self._abort = abort or threading.Event()
         self._cond = threading.Condition()
         self._in_flight = 0
+        self._rejoining = 0
         self._live = list(range(len(self.backends)))
         self._total = count_iterations(file)
         self._done = 0
@@ -223,6 +228,7 @@ class Runner:
         self._left: dict[str, int] = {}                # planned experiment -> units unwritten
         self._waiting = list(file.experiments)         # not planned yet
         self._errors: list[BaseException] = []
+        self.rejoined: list[int] = []     # indexes of the backends that came back, in order
 
     @property
     def lost_workers(self) -> list[int]:
@@ -327,10 +333,19 @@ class Runner:
                 with self._cond:
                     heapq.heappush(self._ready, (self._rank[_key_of(u)], u))
                     self._live.remove(k)
-                    if not self._live:
+                    self._rejoining += 1
+                    self._in_flight -= 1
+                    self._cond.notify_all()
+                back = backend.rejoin(self._over)
+                with self._cond:
+                    self._rejoining -= 1
+                    if back and not self._over():
+                        self._live.append(k)
+                        self.rejoined.append(k)
+                        continue
+                    if not self._live and not self._rejoining and not self._errors:
                         self._errors.append(exc)
                         self._abort.set()
-                    self._in_flight -= 1
                     self._cond.notify_all()
                 return
             except BaseException as exc:
@@ -344,6 +359,11 @@ class Runner:
                 self._in_flight -= 1
                 self._guarded(self._written, u, record)
                 self._cond.notify_all()
+
+    def _over(self) -> bool:
+        """The run has failed, or has nothing left to run: a lost worker stops waiting."""
+        return bool(self._errors) or self._abort.is_set() or not (
+            self._ready or self._in_flight or self._waiting)
 
     def _written(self, u: Unit, record: Record) -> None:
         self.sink.write(record)

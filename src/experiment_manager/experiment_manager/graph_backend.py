@@ -87,8 +87,10 @@ class GraphBackend:
     """Implements experiments.Backend with service and action calls to one worker."""
 
     def __init__(self, node: Node, worker: str, callback_group, call_timeout: float,
-                 server_timeout: float, canceled: Callable[[], bool]) -> None:
+                 server_timeout: float, canceled: Callable[[], bool],
+                 rejoin_timeout: float = 0.0) -> None:
         self._node = node
+        self._rejoin_timeout = rejoin_timeout
         self._ns = worker.strip('/')
         self._call_timeout = call_timeout
         self._server_timeout = server_timeout
@@ -136,6 +138,35 @@ class GraphBackend:
         """The worker's clients whose server is not in the graph now."""
         return [c for c in self._clients if not self._ready(c)]
 
+    def _server_ids(self, client) -> frozenset[bytes]:
+        """The DDS ids of the endpoints serving a client: the action's status publisher, the
+        service's reply writer (ROS 2's rr/<name>Reply topic). A restarted node serves under
+        new ids, so a call to the node that died is seen to be lost although the name is
+        served again."""
+        if isinstance(client, ActionClient):
+            infos = self._node.get_publishers_info_by_topic(
+                f'{self._endpoint(client)}/_action/status')
+        else:
+            infos = self._node.get_publishers_info_by_topic(
+                f'rr{self._endpoint(client)}Reply', no_mangle=True)
+        return frozenset(bytes(i.endpoint_gid) for i in infos)
+
+    def _lost(self, serving: dict) -> list:
+        """The worker's clients none of whose servers in `serving` (client -> ids, taken when
+        a call began) is in the graph now."""
+        return [c for c in self._clients
+                if not (serving[c] & self._server_ids(c) if serving[c] else self._ready(c))]
+
+    def rejoin(self, stop: Callable[[], bool]) -> bool:
+        """Wait for a lost worker to come back (its nodes restarted: every endpoint served
+        again) for at most rejoin_timeout; False if it does not, or when stop() holds."""
+        deadline = time.monotonic() + self._rejoin_timeout
+        while time.monotonic() < deadline and not stop():
+            if not self._missing():
+                return True
+            time.sleep(POLL)
+        return False
+
     def wait_for_servers(self) -> None:
         """Raise WorkerGone with the missing endpoints' names unless all are there within
         server_timeout."""
@@ -160,6 +191,7 @@ class GraphBackend:
         future.add_done_callback(lambda _: done.set())
         start = time.monotonic()
         absent_since = None
+        serving = {c: self._server_ids(c) for c in self._clients}
         while not done.wait(POLL):
             now = time.monotonic()
             if self._canceled():
@@ -169,7 +201,7 @@ class GraphBackend:
                 raise WorkerGone(CheckParts.Response.INTERNAL, (
                     f'{what}: no answer from {self._endpoint(client)} within call_timeout '
                     f'{self._call_timeout:g} s'))
-            missing = self._missing()
+            missing = self._lost(serving)
             if not missing:
                 absent_since = None
             elif absent_since is None:
@@ -177,7 +209,7 @@ class GraphBackend:
             elif now - absent_since > GONE_AFTER:
                 raise WorkerGone(CheckParts.Response.INTERNAL, (
                     f'{what}: {", ".join(self._endpoint(c) for c in missing)} left the graph '
-                    'while the worker was answering (its node died or was stopped)'))
+                    'while the worker was answering (its node died, was stopped or restarted)'))
         return future.result()
 
     def _service(self, client, request, what: str):

@@ -40,14 +40,19 @@ class NodeProcess:
     the executable's name)."""
 
     def __init__(self, package: str, name: str, ros_args: list[str], log_path: str,
-                 label: str = '') -> None:
+                 label: str = '', append: bool = False) -> None:
         self.name = label or name
+        self._args = (package, name, ros_args, log_path, label)
         self.command = [executable(package, name), '--ros-args', *ros_args]
         self.log_path = log_path
-        with open(log_path, 'wb') as log:
+        with open(log_path, 'ab' if append else 'wb') as log:
             self.process = subprocess.Popen(self.command, stdout=log, stderr=subprocess.STDOUT,
                                             stdin=subprocess.DEVNULL,
                                             preexec_fn=_die_with_parent)
+
+    def respawn(self) -> 'NodeProcess':
+        """The same node started again, its output appended to the same log."""
+        return NodeProcess(*self._args, append=True)
 
     @property
     def pid(self) -> int:

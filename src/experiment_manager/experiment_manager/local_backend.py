@@ -63,6 +63,10 @@ class LocalBackend:
         s = policy.state
         return FeedStep(step.decision, step.feed, s.vibrations, s.feeds, s.in_feeder)
 
+    def rejoin(self, stop) -> bool:
+        """Cores in this process do not come back once lost."""
+        return False
+
     def close(self) -> None:
         if self._world is not None:
             self._world.close()

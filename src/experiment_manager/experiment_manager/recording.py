@@ -2,17 +2,22 @@
 CDR payloads from rclpy.serialization, so that `ros2 bag play`, Foxglove and independent readers
 (mcap-ros2-support, rosbags) open the file.
 
-Messages are written to zstd-compressed chunks (no per-message flush); `close()` writes the
-summary and index. A file cut off before `close()` (SIGKILL) keeps every complete chunk, which
-a streaming reader reads (tested).
+Messages are written to zstd-compressed chunks (no per-message flush; the manager flushes once
+per iteration); `close()` writes the summary and index. A file cut off before `close()`
+(SIGKILL) keeps every complete chunk, which a streaming reader reads; `recover` copies them into
+a closed file (`replay CUT --recover OUT`).
 """
 
 from collections.abc import Iterator
 import os
 import re
+import struct
 import time
 
 from ament_index_python.packages import get_package_share_directory
+from mcap.exceptions import McapError
+from mcap.records import Attachment, Channel, Header, Message, Metadata, Schema
+from mcap.stream_reader import StreamReader
 from mcap.writer import CompressionType, Writer
 from rclpy.serialization import serialize_message
 
@@ -126,6 +131,11 @@ class Recorder:
     def metadata(self, name: str, data: dict[str, str]) -> None:
         self._writer.add_metadata(name=name, data=data)
 
+    def flush(self) -> None:
+        """End the chunk being gathered and hand everything written so far to the OS: a
+        process killed after this loses nothing recorded before it."""
+        self._writer.flush()
+
     def close(self) -> None:
         """Write the summary and index and close the file. Idempotent."""
         if not self._file.closed:
@@ -137,3 +147,49 @@ class Recorder:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def recover(source: str, target: str) -> dict[str, int]:
+    """Copy every complete record of a recording into a new file, closed with its summary and
+    indexes: what a manager killed before close() leaves becomes a file every reader opens.
+    Returns the counts copied, and `torn` 1 when the source ended inside a record (0 when it
+    was whole). Raises McapError when the source does not start as an MCAP file."""
+    counts = dict.fromkeys(('schemas', 'channels', 'messages', 'attachments', 'metadata',
+                            'torn'), 0)
+    schemas: dict[int, int] = {}
+    channels: dict[int, int] = {}
+    with open(source, 'rb') as f, open(target, 'wb') as out:
+        writer = None
+        try:
+            for record in StreamReader(f, validate_crcs=True).records:
+                if isinstance(record, Header):
+                    writer = Writer(out, compression=CompressionType.ZSTD)
+                    writer.start(profile=record.profile, library=record.library)
+                elif isinstance(record, Schema):
+                    schemas[record.id] = writer.register_schema(record.name, record.encoding,
+                                                                record.data)
+                    counts['schemas'] += 1
+                elif isinstance(record, Channel):
+                    channels[record.id] = writer.register_channel(
+                        record.topic, record.message_encoding, schemas.get(record.schema_id, 0),
+                        record.metadata)
+                    counts['channels'] += 1
+                elif isinstance(record, Message):
+                    writer.add_message(channels[record.channel_id], record.log_time,
+                                       record.data, record.publish_time, record.sequence)
+                    counts['messages'] += 1
+                elif isinstance(record, Attachment):
+                    writer.add_attachment(record.create_time, record.log_time, record.name,
+                                          record.media_type, record.data)
+                    counts['attachments'] += 1
+                elif isinstance(record, Metadata):
+                    writer.add_metadata(record.name, record.metadata)
+                    counts['metadata'] += 1
+        except (McapError, struct.error):   # the tear: a record cut off (or its CRC wrong)
+            if writer is None:
+                raise McapError(f'{source} does not start as an MCAP file') from None
+            counts['torn'] = 1
+        if writer is None:
+            raise McapError(f'{source} does not start as an MCAP file')
+        writer.finish()
+    return counts

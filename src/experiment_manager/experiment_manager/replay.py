@@ -1,16 +1,20 @@
 """`replay`: republish a run's MCAP recording on the graph, for review without `ros2 bag`.
 
     replay RECORDING.mcap [--rate R] [--topics T ...] [--prefix NS] [--info]
+    replay RECORDING.mcap --recover OUT.mcap
 
 Messages go out on their recorded topics (under --prefix, if given) with the recorded spacing
 divided by the rate; `scene` and `markers` are latched (transient local) as the world publishes
 them. --info lists the topics, types, message counts and attachments, and exits. Payloads are
 published as recorded (CDR, no decode), so any type in the file replays if its package is
-installed.
+installed. --recover copies every complete record of a recording cut off before it was closed
+(its manager was killed) into a closed file that every reader opens, and exits.
 """
 
 import argparse
 import importlib
+import os
+import struct
 import sys
 import time
 
@@ -21,6 +25,8 @@ import rclpy
 from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+from .recording import recover
 
 LATCHED_TOPICS = ('scene', 'markers')
 STREAM = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
@@ -45,7 +51,12 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     parser.add_argument('--prefix', default='',
                         help='namespace put in front of every topic (default: none)')
     parser.add_argument('--info', action='store_true', help='list the content and exit')
+    parser.add_argument('--recover', metavar='OUT',
+                        help='copy the complete records of a cut-off recording into OUT (a '
+                        'closed MCAP file) and exit')
     args = parser.parse_args(argv)
+    if args.recover and os.path.abspath(args.recover) == os.path.abspath(args.recording):
+        parser.error('--recover writes a new file: OUT must differ from RECORDING')
     if not 0.001 <= args.rate <= 1000.0:
         parser.error(f'--rate: {args.rate:g} must be within [0.001, 1000]')
     return args
@@ -55,10 +66,13 @@ def info(path: str) -> str:
     """Topics, types and counts, attachments and metadata of a recording (like
     `ros2 bag info`)."""
     with open(path, 'rb') as f:
-        summary = make_reader(f).get_summary()
+        try:
+            summary = make_reader(f).get_summary()
+        except (McapError, struct.error):   # no footer to find the summary from
+            summary = None
     if summary is None:
         raise McapError(f'{path} has no summary section (cut off before it was closed? '
-                        'see README, "Recovering a recording")')
+                        f'recover it: replay {path} --recover OUT.mcap)')
     counts = summary.statistics.channel_message_counts if summary.statistics else {}
     lines = [f'{path}: {summary.statistics.message_count if summary.statistics else "?"} '
              'messages']
@@ -78,6 +92,13 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.info:
             print(info(args.recording))
+            return 0
+        if args.recover:
+            counts = recover(args.recording, args.recover)
+            print(f'replay: {args.recover}: ' + ', '.join(
+                f'{n} {k}' for k, n in counts.items() if k != 'torn')
+                + ('; the source ended inside a record (the rest is lost)' if counts['torn']
+                   else '; the source was whole'), file=sys.stderr)
             return 0
         f = open(args.recording, 'rb')
     except (OSError, McapError) as exc:

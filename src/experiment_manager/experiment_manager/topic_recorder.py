@@ -71,6 +71,12 @@ class TopicRecorder:
             if self._recorder is not None:
                 self._recorder.write(topic, msg)
 
+    def flush(self) -> None:
+        """Hand what was recorded so far to the OS (Recorder.flush)."""
+        with self._lock:
+            if self._recorder is not None:
+                self._recorder.flush()
+
     def start(self, recorder: Recorder) -> None:
         with self._lock:
             self._since = time.time_ns()

@@ -130,10 +130,21 @@ class Worker(LocalBackend):
     its reset number `nan_at` (a NaN velocity given to PyBullet, which then steps to NaN)."""
 
     def __init__(self, delay: float = 0.0, dies_at: int = 0, missing: bool = False,
-                 nan_at: int = 0) -> None:
+                 nan_at: int = 0, back_after: float | None = None) -> None:
         super().__init__()
         self.delay, self.dies_at, self.resets, self.missing = delay, dies_at, 0, missing
-        self.nan_at = nan_at
+        self.nan_at, self.back_after = nan_at, back_after
+
+    def rejoin(self, stop) -> bool:
+        """Back after `back_after` s (its nodes restarted), unless the run is over first."""
+        if self.back_after is None:
+            return False
+        deadline = time.monotonic() + self.back_after
+        while time.monotonic() < deadline:
+            if stop():
+                return False
+            time.sleep(0.01)
+        return True
 
     def drop(self, count, zone):
         if self.resets != self.nan_at:
@@ -209,6 +220,19 @@ def test_a_lost_worker_s_iteration_runs_again_on_another(small, tmp_path, lost):
     assert got == summary
     for name in FILES:
         assert read(str(tmp_path / 'lost'), name) == read(directory, name), name
+
+
+@pytest.mark.parametrize('others', [0, 1], ids=['alone', 'beside another'])
+def test_a_lost_worker_that_comes_back_gets_iterations_again(small, tmp_path, others):
+    directory, summary = small
+    back = Worker(delay=0.05, dies_at=2, back_after=0.3)
+    runner, got, _ = run_on([back] + [Worker(delay=0.05) for _ in range(others)],
+                            str(tmp_path / 'back'))
+    assert runner.rejoined == [0] and runner.lost_workers == []
+    assert back.resets > 2, 'it ran iterations after coming back'
+    assert got == summary
+    for name in FILES:
+        assert read(str(tmp_path / 'back'), name) == read(directory, name), name
 
 
 def test_the_run_fails_when_every_worker_is_lost_and_keeps_what_finished(tmp_path):

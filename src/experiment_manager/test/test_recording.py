@@ -4,9 +4,9 @@ the schema text in the file alone (it never imports our message classes)."""
 import struct
 
 from builtin_interfaces.msg import Time
-from experiment_manager.recording import msg_definition, Recorder, SEPARATOR
+from experiment_manager.recording import msg_definition, Recorder, recover, SEPARATOR
 from geometry_msgs.msg import Vector3
-from mcap.exceptions import EndOfFile
+from mcap.exceptions import EndOfFile, McapError
 from mcap.reader import make_reader
 from mcap.records import Message
 from mcap.stream_reader import StreamReader
@@ -94,10 +94,14 @@ def test_a_recording_cut_off_before_close_keeps_its_complete_chunks(tmp_path):
     struct.error when the tear is inside a length field)."""
     path = tmp_path / 'cut.mcap'
     rec = Recorder(str(path), chunk_size=16 * 1024)
+    rec.attach('experiment.yaml', b'id: cut\n', 'application/yaml')
+    rec.metadata('run', {'experiment_id': 'cut'})
     for k in range(3000):
         rec.write('/p', Vector3(x=float(k)), k)
     rec._file.flush()
     data = path.read_bytes()        # the bytes the OS holds when the process is killed
+    rec.flush()                     # what the manager does after each iteration
+    flushed = path.read_bytes()
     rec.close()
     cut = tmp_path / 'cut_copy.mcap'
     cut.write_bytes(data[:-7])
@@ -108,3 +112,22 @@ def test_a_recording_cut_off_before_close_keeps_its_complete_chunks(tmp_path):
                 xs.append(deserialize_message(record.data, Vector3).x)
     assert 0 < len(xs) < 3000, 'complete chunks are readable, the open one is lost'
     assert xs == [float(k) for k in range(len(xs))]
+
+    # recover() makes of it a closed file that a seeking reader opens, with every complete
+    # message, the attachment and the metadata; a whole file comes out whole.
+    counts = recover(str(cut), str(tmp_path / 'recovered.mcap'))
+    assert counts == {'schemas': 1, 'channels': 1, 'messages': len(xs), 'attachments': 1,
+                      'metadata': 1, 'torn': 1}
+    with open(tmp_path / 'recovered.mcap', 'rb') as f:
+        reader = make_reader(f)
+        assert reader.get_summary().statistics.message_count == len(xs)
+        assert [deserialize_message(m.data, Vector3).x for _, _, m in
+                reader.iter_messages()] == xs
+        assert [a.data for a in reader.iter_attachments()] == [b'id: cut\n']
+        assert [m.metadata for m in reader.iter_metadata()] == [{'experiment_id': 'cut'}]
+    (tmp_path / 'flushed.mcap').write_bytes(flushed)     # killed after a flush: nothing lost
+    assert recover(str(tmp_path / 'flushed.mcap'), str(tmp_path / 'all.mcap'))['messages'] == 3000
+    assert recover(str(path), str(tmp_path / 'whole.mcap'))['messages'] == 3000
+    (tmp_path / 'not.mcap').write_bytes(b'id: not a recording\n')
+    with pytest.raises(McapError, match='does not start as an MCAP file'):
+        recover(str(tmp_path / 'not.mcap'), str(tmp_path / 'x.mcap'))

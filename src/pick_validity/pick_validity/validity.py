@@ -61,6 +61,7 @@ STAGE_NONE, STAGE_CANDIDACY, STAGE_PLACEABILITY, STAGE_CONTAINER, STAGE_NEIGHBOU
     STAGE_VALID = range(6)
 QUATERNION_TOLERANCE = 1e-3   # |norm - 1| accepted (and normalised); larger is refused
 MAX_PARTS = 20000
+MAX_POSITION = 10.0           # m from the instance frame; a container is at most 2 m wide
 
 
 @dataclass
@@ -122,6 +123,11 @@ def check_poses(ids: Sequence[int], poses: np.ndarray) -> np.ndarray:
         i = int(bad[0])
         raise InvalidArgument(f'parts[{i}] (id {ids[i]}).pose', poses[i].tolist(),
                               'must be finite (no NaN or inf)')
+    bad = np.flatnonzero((np.abs(poses[:, :3]) > MAX_POSITION).any(axis=1))
+    if len(bad):     # found by fuzzing: 1e154 overflowed in the neighbour search
+        i = int(bad[0])
+        raise InvalidArgument(f'parts[{i}] (id {ids[i]}).pose.position', poses[i, :3].tolist(),
+                              f'must be within {MAX_POSITION:g} m of the instance frame')
     norms = np.linalg.norm(poses[:, 3:], axis=1)
     bad = np.flatnonzero(np.abs(norms - 1.0) > QUATERNION_TOLERANCE)
     if len(bad):

@@ -171,6 +171,8 @@ def test_mesh_parts_are_checked_with_their_hulls(tmp_path):
     ([[0, 0, 0, 0, 0, math.inf, 1]], r'parts\[0\] \(id 5\).pose: .* must be finite'),
     ([[0, 0, 0, 0, 0, 0, 0.5]], r'parts\[0\] \(id 5\).pose.orientation: .* has norm 0.5'),
     ([[0, 0, 0, 0, 0, 0, 0]], r'has norm 0'),
+    ([[1.3e154, 0, 0, 0, 0, 0, 1]], r'parts\[0\] \(id 5\).pose.position: .* must be within '
+                                    r'10 m of the instance frame'),     # found by fuzzing
     (np.zeros((1, 5)), r'parts: \(1, 5\) must be \(1, 7\) poses'),
 ])
 def test_bad_poses_are_refused_before_fcl(poses, rule):
