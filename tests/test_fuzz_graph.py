@@ -58,6 +58,11 @@ def places(tmp_path_factory):
     for name in ('meshes', 'experiments', 'out'):
         (root / name).mkdir()
     trimesh.creation.box((0.01, 0.005, 0.003)).export(str(root / 'meshes' / 'block.stl'))
+    # Degenerate geometry that must never reach PyBullet or FCL (an empty BVH crashes it).
+    trimesh.Trimesh([[0, 0, 0], [0.01, 0, 0], [0, 0.01, 0]], [[0, 1, 2]]).export(
+        str(root / 'meshes' / 'flat.stl'))
+    (root / 'meshes' / 'empty.stl').write_text('solid empty\nendsolid empty\n')
+    (root / 'meshes' / 'garbage.stl').write_bytes(bytes(range(256)) * 4)
     (root / 'experiments' / 'tiny.yaml').write_text(yaml.safe_dump(TINY))
     (root / 'secret.yaml').write_text(yaml.safe_dump(TINY))     # outside every directory
     return root
@@ -163,6 +168,14 @@ def test_reset_scene(cell, places):
         cell.call('reset_scene', request, fuzzed=True)
 
     fuzz()
+    for name in ('flat.stl', 'empty.stl', 'garbage.stl'):
+        mesh.part_model.mesh_path = str(places / 'meshes' / name)
+        assert cell.call('reset_scene', mesh).error_code == ResetScene.Response.INVALID_ARGUMENT
+        answer = cell.call('check_parts', CheckParts.Request(
+            container=tray(), part_model=mesh.part_model, parts=cell.fresh(1)))
+        assert answer.error_code == CheckParts.Response.INVALID_ARGUMENT, answer.error_msg
+        assert f"part.mesh_path: '{mesh.part_model.mesh_path}'" in answer.error_msg
+    mesh.part_model.mesh_path = str(places / 'meshes' / 'block.stl')
     assert cell.call('reset_scene', mesh).error_code == 0     # a mesh inside mesh_dirs
     outside = cell.call('reset_scene', ResetScene.Request(
         container=tray(), part_model=PartModel(name='mesh', mass=0.001, mesh_path=str(
