@@ -92,10 +92,13 @@ def test_impossible_counts_and_bad_ranges_are_refused(client, nodes):
     assert 'world drop_parts: instances: 5 does not exist' in world_error.error_msg
 
 
-def test_a_world_that_dies_mid_cycle_gets_an_error_answer_not_a_hang(client):
+@pytest.mark.parametrize('restarted', [False, True], ids=['gone', 'started again'])
+def test_a_world_that_dies_mid_cycle_gets_an_error_answer_not_a_hang(client, restarted):
+    """Also when a new world serves the same names at once (as `run` restarts it): the goal
+    went to the dead one, which never answers."""
     ns = unique_namespace('cell_f_dies')
-    world = NodeProcess('pick_sim_world', 'world', [
-        '-r', f'__ns:={ns}', '-p', 'container.kind:=tray', '-p', 'publish_markers:=false'])
+    args = ['-r', f'__ns:={ns}', '-p', 'container.kind:=tray', '-p', 'publish_markers:=false']
+    world = NodeProcess('pick_sim_world', 'world', args)
     feeder = NodeProcess('feeder_controller', 'feeder_controller', ['-r', f'__ns:={ns}'])
     try:
         cycle = ActionClient(client.node, FeedCycle, f'{ns}/feed_cycle')
@@ -107,15 +110,21 @@ def test_a_world_that_dies_mid_cycle_gets_an_error_answer_not_a_hang(client):
         assert not client.wait(result_future.done, 1.0)
         world.process.kill()
         killed = time.monotonic()
+        if restarted:
+            world = NodeProcess('pick_sim_world', 'world', args)
         # A killed node leaves the graph when its DDS lease ends (Fast DDS: 20 s), then 2 s.
         result = client.result(result_future, 60.0).result
         print(f'the feeder answered {time.monotonic() - killed:.1f} s after the kill')
         assert result.error_code == FeedCycle.Result.INTERNAL
         assert "'drop_parts' left the graph while answering" in result.error_msg
         again = client.result(client.result(cycle.send_goal_async(FeedCycle.Goal(
-            valid_parts=0, parts_on_table=0))).get_result_async(), 30.0).result
-        assert again.error_code == FeedCycle.Result.INTERNAL     # not BUSY: the lock is free
-        assert 'is the world node running there?' in again.error_msg
+            restart=True, feeder_parts=10, min_count=2, max_count=4))).get_result_async(),
+            60.0).result
+        if restarted:
+            assert again.error_code == FeedCycle.Result.NONE, again.error_msg
+        else:
+            assert again.error_code == FeedCycle.Result.INTERNAL    # not BUSY: the lock is free
+            assert 'is the world node running there?' in again.error_msg
     finally:
         world.stop()
         assert feeder.stop() == 0, feeder.output()

@@ -19,6 +19,7 @@ from pick_msgs.srv import CheckParts, GetParts, ResetScene
 from pick_sim_world import conversions as world_conv
 from pick_sim_world.containers import ContainerSpec
 from pick_sim_world.errors import PhysicsFault
+from pick_sim_world.node_runner import server_ids
 from pick_sim_world.world import PartStates, SettleReport
 from pick_validity import conversions as validity_conv
 from pick_validity.validity import Report
@@ -138,24 +139,12 @@ class GraphBackend:
         """The worker's clients whose server is not in the graph now."""
         return [c for c in self._clients if not self._ready(c)]
 
-    def _server_ids(self, client) -> frozenset[bytes]:
-        """The DDS ids of the endpoints serving a client: the action's status publisher, the
-        service's reply writer (ROS 2's rr/<name>Reply topic). A restarted node serves under
-        new ids, so a call to the node that died is seen to be lost although the name is
-        served again."""
-        if isinstance(client, ActionClient):
-            infos = self._node.get_publishers_info_by_topic(
-                f'{self._endpoint(client)}/_action/status')
-        else:
-            infos = self._node.get_publishers_info_by_topic(
-                f'rr{self._endpoint(client)}Reply', no_mangle=True)
-        return frozenset(bytes(i.endpoint_gid) for i in infos)
-
     def _lost(self, serving: dict) -> list:
-        """The worker's clients none of whose servers in `serving` (client -> ids, taken when
-        a call began) is in the graph now."""
-        return [c for c in self._clients
-                if not (serving[c] & self._server_ids(c) if serving[c] else self._ready(c))]
+        """The worker's clients none of whose servers in `serving` (client -> server_ids,
+        taken when a call began) is in the graph now: their node died, even if it has been
+        started again since."""
+        return [c for c in self._clients if not (
+            serving[c] & server_ids(self._node, c) if serving[c] else self._ready(c))]
 
     def rejoin(self, stop: Callable[[], bool]) -> bool:
         """Wait for a lost worker to come back (its nodes restarted: every endpoint served
@@ -191,7 +180,7 @@ class GraphBackend:
         future.add_done_callback(lambda _: done.set())
         start = time.monotonic()
         absent_since = None
-        serving = {c: self._server_ids(c) for c in self._clients}
+        serving = {c: server_ids(self._node, c) for c in self._clients}
         while not done.wait(POLL):
             now = time.monotonic()
             if self._canceled():

@@ -13,7 +13,7 @@ from pick_msgs.action import DropParts, FeedCycle, Vibrate
 from pick_msgs.msg import FeederState as FeederStateMsg
 from pick_sim_world import conversions as world_conversions
 from pick_sim_world.errors import WorldError
-from pick_sim_world.node_runner import LATCHED, RESULT_KEEP, run
+from pick_sim_world.node_runner import LATCHED, RESULT_KEEP, run, server_ids
 from rcl_interfaces.msg import IntegerRange, ParameterDescriptor
 from rclpy.action import ActionClient, ActionServer
 from rclpy.callback_groups import ReentrantCallbackGroup
@@ -52,11 +52,13 @@ class WorldCommandError(Exception):
 
 @dataclass
 class WorldCall:
-    """The call to the world in flight, and since when (monotonic s) its server is absent."""
+    """The call to the world in flight, the ids of the server that took it, and since when
+    (monotonic s) that server is absent."""
 
     future: Future
     client: ActionClient
     name: str
+    serving: frozenset[bytes]
     absent_since: float | None = None
 
 
@@ -119,7 +121,7 @@ class FeederControllerNode(Node):
     def _watched(self, future, client: ActionClient, name: str):
         """`future`, failed by _watch with WorldCommandError if the world's server leaves the
         graph before it completes (a world that died never answers)."""
-        self._in_flight = WorldCall(future, client, name)
+        self._in_flight = WorldCall(future, client, name, server_ids(self, client))
         return future
 
     def _watch(self) -> None:
@@ -128,7 +130,8 @@ class FeederControllerNode(Node):
             return
         if call.future.done():
             self._in_flight = None
-        elif call.client.server_is_ready():
+        elif (call.serving & server_ids(self, call.client) if call.serving
+              else call.client.server_is_ready()):   # the world that took it, not a new one
             call.absent_since = None
         elif call.absent_since is None:
             call.absent_since = now

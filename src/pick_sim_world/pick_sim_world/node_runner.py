@@ -7,6 +7,7 @@ import sys
 
 from rcl_interfaces.msg import ParameterDescriptor, ParameterType
 import rclpy
+from rclpy.action import ActionClient
 from rclpy.exceptions import ParameterException
 from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
@@ -25,6 +26,19 @@ RESULT_KEEP = 10.0
 # Latched: a late subscriber gets the last message (scene, markers, last report).
 LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL,
                      reliability=ReliabilityPolicy.RELIABLE)
+
+
+def server_ids(node: Node, client) -> frozenset[bytes]:
+    """The DDS ids of the endpoints that serve a client: an action's status publisher, a
+    service's reply writer (ROS 2's rr/<name>Reply topic). A node started again serves under
+    new ids, so a call to the one that died is seen lost although the name is served again."""
+    if isinstance(client, ActionClient):
+        infos = node.get_publishers_info_by_topic(
+            node.resolve_service_name(client._action_name) + '/_action/status')
+    else:
+        infos = node.get_publishers_info_by_topic(
+            f'rr{node.resolve_service_name(client.srv_name)}Reply', no_mangle=True)
+    return frozenset(bytes(i.endpoint_gid) for i in infos)
 
 
 def declare_mesh_dirs(node: Node) -> list[str]:
