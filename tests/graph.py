@@ -10,7 +10,9 @@ import tempfile
 import time
 
 from experiment_manager import launcher
+from experiment_manager.graph_backend import MATCH_GRACE
 import rclpy
+from rclpy.action import ActionClient
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -74,6 +76,18 @@ class Client:
                                          f'{proc.process.returncode}:\n{proc.output()}')
             return predicate()
         return wait_for(done, timeout, self.spin_once)
+
+    def wait_for_servers(self, *clients, timeout: float = 60.0,
+                         nodes: tuple[NodeProcess, ...] = ()) -> bool:
+        """Wait until every client (service or action) sees its server, then MATCH_GRACE
+        more, as the experiment manager does: the servers must match our reply readers too."""
+        def ready() -> bool:
+            return all(c.server_is_ready() if isinstance(c, ActionClient)
+                       else c.service_is_ready() for c in clients)
+        if not self.wait(ready, timeout, nodes):
+            return False
+        until = time.monotonic() + MATCH_GRACE
+        return self.wait(lambda: time.monotonic() >= until, MATCH_GRACE + 1.0, nodes)
 
     def result(self, future, timeout: float = 60.0):
         assert self.wait(future.done, timeout), f'no answer within {timeout} s'

@@ -235,7 +235,7 @@ def test_a_second_goal_is_busy_and_a_killed_last_worker_ends_the_run(tmp_path, c
         assert client.wait(first_iteration_done(out), 120.0), 'no iteration finished'
 
         manager = ActionClient(client.node, RunExperiment, f'{ns}/run_experiment')
-        assert client.wait(manager.server_is_ready, 30.0)
+        assert client.wait_for_servers(manager)
         handle = client.result(manager.send_goal_async(RunExperiment.Goal(
             experiment_file=str(path), output_dir=str(tmp_path / 'other'))))
         busy = client.result(handle.get_result_async()).result
@@ -362,7 +362,7 @@ def test_the_manager_finds_the_workers_under_its_namespace(tmp_path, client, sta
     path = tmp_path / 'tiny.yaml'
     path.write_text(TINY)
     action = ActionClient(client.node, RunExperiment, f'{ns}/run_experiment')
-    assert client.wait(action.server_is_ready, 60.0, nodes=(manager,))
+    assert client.wait_for_servers(action, nodes=(manager,))
     # Discovery takes the workers there at the start of the run: wait until both are up.
     def workers_up() -> bool:
         names = {n for n, _ in client.node.get_service_names_and_types()}

@@ -33,9 +33,8 @@ class Feeder:
         self.states = []
         client.node.create_subscription(FeederState, f'{NS}/feeder/state', self.states.append,
                                         LATCHED)
-        assert client.wait(lambda: self.cycle_client.server_is_ready()
-                           and self.remove_client.server_is_ready()
-                           and self.parts_client.service_is_ready(), 60.0, nodes)
+        assert client.wait_for_servers(self.cycle_client, self.remove_client,
+                                       self.parts_client, nodes=nodes)
 
     def _run(self, client, goal):
         handle = self.c.result(client.send_goal_async(goal))
@@ -102,7 +101,7 @@ def test_a_world_that_dies_mid_cycle_gets_an_error_answer_not_a_hang(client, res
     feeder = NodeProcess('feeder_controller', 'feeder_controller', ['-r', f'__ns:={ns}'])
     try:
         cycle = ActionClient(client.node, FeedCycle, f'{ns}/feed_cycle')
-        assert client.wait(cycle.server_is_ready, 60.0, (world, feeder))
+        assert client.wait_for_servers(cycle, nodes=(world, feeder))
         # A big feed: the world is still dropping when it is killed.
         handle = client.result(cycle.send_goal_async(FeedCycle.Goal(
             restart=True, feeder_parts=1000, min_count=700, max_count=700)))

@@ -96,9 +96,8 @@ class Endpoints:
         self.actions = {name: ActionClient(node, t, f'{NS}/{name}') for name, t in (
             ('w/drop_parts', DropParts), ('w/vibrate', Vibrate), ('w/remove_parts', RemoveParts),
             ('w/feed_cycle', FeedCycle), ('run_experiment', RunExperiment))}
-        assert client.wait(lambda: all(s.service_is_ready() for s in self.services.values())
-                           and all(a.server_is_ready() for a in self.actions.values()), 60.0,
-                           self.nodes), 'the nodes did not come up'
+        assert client.wait_for_servers(*self.services.values(), *self.actions.values(),
+                                       nodes=self.nodes), 'the nodes did not come up'
 
     def _checked(self, endpoint: str, answer, request, fuzzed: bool) -> object:
         if fuzzed:

@@ -38,14 +38,14 @@ def settled(nodes):
     client = Client()
     try:
         drop = ActionClient(client.node, DropParts, f'{NS}/drop_parts')
-        assert client.wait(drop.server_is_ready, 60.0, nodes)
+        assert client.wait_for_servers(drop, nodes=nodes)
         handle = client.result(drop.send_goal_async(DropParts.Goal(count=120)))
         result = client.result(handle.get_result_async(), 120.0).result
         assert result.error_code == 0, result.error_msg
         scenes = []
         client.node.create_subscription(Scene, f'{NS}/scene', scenes.append, LATCHED)
         get_parts = client.node.create_client(GetParts, f'{NS}/get_parts')
-        assert client.wait(lambda: scenes and get_parts.service_is_ready(), 30.0)
+        assert client.wait_for_servers(get_parts) and client.wait(lambda: scenes, 30.0)
         parts = client.result(get_parts.call_async(GetParts.Request())).parts.parts
         yield scenes[-1], parts
     finally:
@@ -62,7 +62,7 @@ def _request(scene, parts, **fields) -> CheckParts.Request:
 def check(client, nodes):
     """Call check_parts: request -> response."""
     service = client.node.create_client(CheckParts, f'{NS}/check_parts')
-    assert client.wait(service.service_is_ready, 60.0, nodes), 'validity did not come up'
+    assert client.wait_for_servers(service, nodes=nodes), 'validity did not come up'
     return lambda request: client.result(service.call_async(request))
 
 

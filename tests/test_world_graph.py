@@ -40,10 +40,9 @@ class Cell:
         self.reset_srv = node.create_client(ResetScene, f'{NS}/reset_scene')
         self.actions = {t: ActionClient(node, t, f'{NS}/{name}') for t, name in (
             (DropParts, 'drop_parts'), (Vibrate, 'vibrate'), (RemoveParts, 'remove_parts'))}
-        assert client.wait(lambda: self.get_parts_srv.service_is_ready()
-                           and self.reset_srv.service_is_ready()
-                           and all(a.server_is_ready() for a in self.actions.values()), 60.0,
-                           (world,)), 'the world node did not come up'
+        assert client.wait_for_servers(self.get_parts_srv, self.reset_srv,
+                                       *self.actions.values(), nodes=(world,)), \
+            'the world node did not come up'
 
     def call(self, client, request):
         return self.c.result(client.call_async(request))

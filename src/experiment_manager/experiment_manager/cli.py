@@ -37,6 +37,7 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from . import config
+from .graph_backend import MATCH_GRACE
 from .launcher import MANAGER, NodeProcess, READS_MESHES, WORKER_NODES
 
 MAX_WORKERS = 64
@@ -314,6 +315,7 @@ def _run(node: Node, client: ActionClient, goal, graph: Graph, bar) -> int:
         print(f'run: the experiment manager did not start (run_experiment did not appear '
               f'within {START_TIMEOUT:g} s)', file=sys.stderr)
         return 1
+    _spin_until(node, lambda: False, [manager], MATCH_GRACE)   # the manager must see us too
     send = client.send_goal_async(goal, feedback_callback=lambda f: bar.update(f.feedback.progress))
     _spin_until(node, send.done, [manager], START_TIMEOUT)
     handle = send.result()

@@ -31,6 +31,11 @@ from .experiments import FeedStep, WorkerLost
 
 POLL = 0.1              # s between checks of a pending call
 GONE_AFTER = 2.0        # s a server must stay absent from the graph before a call fails
+# s between seeing a worker's servers and calling them. Discovery is not symmetric: the client
+# sees the server before the server has matched the client's reply reader, and rmw_fastrtps
+# drops a reply whose reader is not matched within 100 ms (ros2/rmw_fastrtps#467). A likely
+# cause of a first goal seen unanswered here, under load.
+MATCH_GRACE = 1.0
 
 
 class GraphError(Exception):
@@ -108,6 +113,7 @@ class GraphBackend:
                          self._feed)
         self._file: ExperimentFile | None = None
         self._parts_msg = PartArray()
+        self._seen: float | None = None     # when every server was first seen (monotonic s)
 
     @property
     def worker(self) -> str:
@@ -152,6 +158,7 @@ class GraphBackend:
         deadline = time.monotonic() + self._rejoin_timeout
         while time.monotonic() < deadline and not stop():
             if not self._missing():
+                time.sleep(MATCH_GRACE)
                 return True
             time.sleep(POLL)
         return False
@@ -162,6 +169,9 @@ class GraphBackend:
         deadline = time.monotonic() + self._server_timeout
         while time.monotonic() < deadline:
             if not self._missing():
+                if self._seen is None:
+                    self._seen = time.monotonic()
+                time.sleep(max(0.0, self._seen + MATCH_GRACE - time.monotonic()))
                 return
             if self._canceled():
                 raise GraphError(CheckParts.Response.CANCELED, 'canceled')
