@@ -36,7 +36,8 @@ CODES = {GetParts.Response.NONE: 'NONE', GetParts.Response.INVALID_ARGUMENT: 'IN
          GetParts.Response.UNKNOWN_PART: 'UNKNOWN_PART', GetParts.Response.BUSY: 'BUSY',
          GetParts.Response.PHYSICS_FAULT: 'PHYSICS_FAULT',
          GetParts.Response.CANCELED: 'CANCELED', INTERNAL: 'INTERNAL'}
-GIVE_UP = 30.0       # s an accepted goal may run before it is canceled (a valid, long one)
+GIVE_UP = 10.0       # s an accepted goal may run before it is canceled (a valid, long one)
+ANSWER_WAIT = 60.0   # s for a service's answer (a service cannot be canceled)
 TINY = {'id': 'tiny', 'seed': 3, 'part': {'model': 'radial_capacitor'},
         'experiments': [{'id': 'bins', 'type': 'bin_static', 'iterations': 1, 'parts': 4,
                          'bins_mm': [[60, 60, 20]]}]}
@@ -112,7 +113,7 @@ class Endpoints:
 
     def call(self, name: str, request, fuzzed: bool = False) -> object:
         future = self.services[name].call_async(request)
-        assert self.c.wait(future.done, GIVE_UP, self.nodes), (name, 'no answer', request)
+        assert self.c.wait(future.done, ANSWER_WAIT, self.nodes), (name, 'no answer', request)
         return self._checked(name, future.result(), request, fuzzed)
 
     def run(self, name: str, goal, fuzzed: bool = False) -> object:
