@@ -287,10 +287,11 @@ def _interrupted(tmp_path, client, stop: Callable[[subprocess.Popen, str], None]
     return run_dir, resumed
 
 
-def test_a_run_stopped_with_sigint_closes_its_files_and_resumes_to_the_same_results(
-        tmp_path, client, core_run, private_ros_domain):
+@pytest.mark.parametrize('signum', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
+def test_a_stopped_run_closes_its_files_and_resumes_to_the_same_results(
+        tmp_path, client, core_run, private_ros_domain, signum):
     def interrupt(run: subprocess.Popen, ns: str) -> None:
-        run.send_signal(signal.SIGINT)
+        run.send_signal(signum)
         assert run.wait(120) == 130
     run_dir, _ = _interrupted(tmp_path, client, interrupt)
     with open(os.path.join(run_dir, 'recording.mcap'), 'rb') as f:
