@@ -204,7 +204,8 @@ def _goals(args: argparse.Namespace) -> list[tuple[RunExperiment.Goal, str]]:
                 config.load(path)
         except InvalidArgument as exc:
             raise InvalidArgument(f'{path}: {exc.field}', exc.value, exc.rule) from None
-        output = os.path.abspath(args.resume or args.output or file.output_dir)
+        output = os.path.abspath(os.path.expanduser(args.resume or args.output
+                                                    or file.output_dir))
         goals.append((RunExperiment.Goal(experiment_file=path, resume=bool(args.resume),
                                          output_dir=output), file.part.mesh_path))
     return goals
