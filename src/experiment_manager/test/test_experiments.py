@@ -13,8 +13,10 @@ from experiment_manager.experiments import (
     faults,
     iteration_seed,
     plan,
+    Record,
     Runner,
     search_order,
+    Unit,
     WorkerLost,
 )
 from experiment_manager.local_backend import LocalBackend
@@ -263,6 +265,27 @@ def test_a_physics_fault_is_marked_left_out_of_the_figures_and_the_run_goes_on(s
     assert [b['iterations'] for b in bins['bins']] == [1, 2]
     assert summary['experiments']['bins']['faults'] == {
         'physics_fault': 0, 'unsettled': 0, 'escaped': 0, 'flagged': []}
+
+
+def test_parts_fallen_far_from_the_container_are_not_sent_to_the_check():
+    """Found by the reduced test case: an escaped part had fallen to z = -80 m, beyond what
+    check_parts accepts (10 m); the run failed."""
+    file = config.load(SMALL)
+    exp = file.experiment('emptying')
+    container = file.experiment('bins').bins[0]
+    u = Unit(exp, 0, 0, 5, container, 20)
+    with LocalBackend() as backend:
+        backend.start(file)
+        backend.reset(container, u.seed)
+        states, _ = backend.drop(20, 'container')
+        world = backend._world
+        pb.resetBasePositionAndOrientation(world._bodies[int(states.ids[0])], [0, 0, -80.0],
+                                           [0, 0, 0, 1], physicsClientId=world._client)
+        states = backend.parts()
+        record = Record(iteration={})
+        report, _ = Runner(file, [backend], None)._check(u, record, backend, states, True)
+    assert report.counts['checked'] == 19 and not states.inside[0]
+    assert [p['part_id'] for p in record.parts] == states.ids.tolist()   # recorded, all 20
 
 
 def test_unsettled_and_escaped_iterations_are_flagged():

@@ -103,7 +103,10 @@ class PartStates:
 
     def select(self, instances: Iterable[int]) -> 'PartStates':
         """The parts of the given instances only."""
-        mask = np.isin(self.instances, np.fromiter(instances, dtype=np.int64))
+        return self.masked(np.isin(self.instances, np.fromiter(instances, dtype=np.int64)))
+
+    def masked(self, mask: np.ndarray) -> 'PartStates':
+        """The parts where `mask` (N,) is true."""
         return PartStates(self.ids[mask], self.instances[mask], self.poses[mask],
                           self.inside[mask], self.sim_time)
 
