@@ -280,10 +280,13 @@ class GraphBackend:
 
     def check(self, container: ContainerSpec, states: PartStates, targets: list[int],
               neighbours: bool) -> Report:
-        parts = self._parts_msg.parts
+        # The messages as received (no encoding again), of the parts in `states`: all, or
+        # those the runner kept (it leaves out parts fallen far from the container).
+        wanted = set(states.ids.tolist())
+        parts = [p for p in self._parts_msg.parts if p.id in wanted]
         if [p.id for p in parts] != states.ids.tolist():
             raise GraphError(CheckParts.Response.INTERNAL,
-                             'check_parts: the parts to check are not the last ones received')
+                             'check_parts: the parts to check are not among the last received')
         request = CheckParts.Request(container=world_conv.container_to_msg(container),
                                      part_model=self._part_msg, parts=parts,
                                      target_ids=[int(t) for t in targets],
