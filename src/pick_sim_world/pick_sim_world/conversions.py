@@ -95,8 +95,8 @@ def part_spec_from_msg(msg: PartModel, mesh_dirs: Sequence[str] = ()) -> PartSpe
     """A PartSpec from a message. 0 in mass, scale or a friction field means the default.
     A mesh file must lie in one of `mesh_dirs` (the node's parameter of that name): a request
     cannot make a node read elsewhere."""
-    if msg.mesh_path:
-        check_inside('part_model.mesh_path', msg.mesh_path, mesh_dirs, 'mesh_dirs')
+    mesh = msg.mesh_path and check_inside('part_model.mesh_path', msg.mesh_path, mesh_dirs,
+                                          'mesh_dirs')     # the file checked is the one read
     names, values = list(msg.dimension_names), list(msg.dimension_values)
     if len(names) != len(values):
         raise InvalidArgument('part_model.dimension_values', len(values),
@@ -115,7 +115,7 @@ def part_spec_from_msg(msg: PartModel, mesh_dirs: Sequence[str] = ()) -> PartSpe
                                      defaults.spinning_friction),
         restitution=or_default('part_model.restitution', msg.restitution,
                                defaults.restitution),
-        mesh_path=msg.mesh_path, scale=or_default('part_model.scale', msg.scale, 1.0))
+        mesh_path=mesh, scale=or_default('part_model.scale', msg.scale, 1.0))
 
 
 def part_spec_to_msg(spec: PartSpec) -> PartModel:
