@@ -191,6 +191,9 @@ class GraphBackend:
         start = time.monotonic()
         absent_since = None
         serving = {c: server_ids(self._node, c) for c in self._clients}
+        if self._canceled():   # before the first wait too: short calls would never notice
+            future.cancel()
+            raise GraphError(CheckParts.Response.CANCELED, f'canceled before {what}')
         while not done.wait(POLL):
             now = time.monotonic()
             if self._canceled():
