@@ -31,13 +31,14 @@ import time
 from ament_index_python.packages import get_package_share_directory
 from pick_msgs.action import RunExperiment
 from pick_sim_world.errors import InvalidArgument
+from pick_sim_world.node_runner import probe
 import rclpy
 from rclpy.action import ActionClient
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from . import config
-from .graph_backend import MATCH_GRACE
+from .graph_backend import PROBE_WAIT
 from .launcher import MANAGER, NodeProcess, READS_MESHES, WORKER_NODES
 
 MAX_WORKERS = 64
@@ -289,6 +290,24 @@ class Graph:
         return new
 
 
+def _handshake(node: Node, client: ActionClient, manager: NodeProcess) -> bool:
+    """Probe the manager's action until it answers (node_runner.probe): then it can answer
+    our goal. False when it does not within START_TIMEOUT or dies."""
+    service, request = probe(node, client)
+    try:
+        deadline = time.monotonic() + START_TIMEOUT
+        while time.monotonic() < deadline:
+            future = service.call_async(request)
+            if _spin_until(node, future.done, [manager], PROBE_WAIT) is not None:
+                return False
+            if future.done():
+                return True
+            service.remove_pending_request(future)
+        return False
+    finally:
+        node.destroy_client(service)
+
+
 def _report_dead(node: Node, done, graph: Graph, timeout: float, bar) -> bool:
     """Spin until done() or timeout, reporting each watched process that dies. A worker
     node is started again (the manager runs the iteration it lost again and takes the worker
@@ -316,7 +335,10 @@ def _run(node: Node, client: ActionClient, goal, graph: Graph, bar) -> int:
         print(f'run: the experiment manager did not start (run_experiment did not appear '
               f'within {START_TIMEOUT:g} s)', file=sys.stderr)
         return 1
-    _spin_until(node, lambda: False, [manager], MATCH_GRACE)   # the manager must see us too
+    if not _handshake(node, client, manager):
+        print('run: the experiment manager did not answer a probe of run_experiment within '
+              f'{START_TIMEOUT:g} s', file=sys.stderr)
+        return 1
     send = client.send_goal_async(goal, feedback_callback=lambda f: bar.update(f.feedback.progress))
     _spin_until(node, send.done, [manager], START_TIMEOUT)
     handle = send.result()

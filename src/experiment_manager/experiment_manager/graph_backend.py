@@ -19,7 +19,7 @@ from pick_msgs.srv import CheckParts, GetParts, ResetScene
 from pick_sim_world import conversions as world_conv
 from pick_sim_world.containers import ContainerSpec
 from pick_sim_world.errors import PhysicsFault
-from pick_sim_world.node_runner import server_ids
+from pick_sim_world.node_runner import probe, server_ids
 from pick_sim_world.world import PartStates, SettleReport
 from pick_validity import conversions as validity_conv
 from pick_validity.validity import Report
@@ -31,11 +31,7 @@ from .experiments import FeedStep, WorkerLost
 
 POLL = 0.1              # s between checks of a pending call
 GONE_AFTER = 2.0        # s a server must stay absent from the graph before a call fails
-# s between seeing a worker's servers and calling them. Discovery is not symmetric: the client
-# sees the server before the server has matched the client's reply reader, and rmw_fastrtps
-# drops a reply whose reader is not matched within 100 ms (ros2/rmw_fastrtps#467). A likely
-# cause of a first goal seen unanswered here, under load.
-MATCH_GRACE = 1.0
+PROBE_WAIT = 1.0        # s for the answer to a probe (node_runner.probe) before another
 
 
 class GraphError(Exception):
@@ -113,7 +109,7 @@ class GraphBackend:
                          self._feed)
         self._file: ExperimentFile | None = None
         self._parts_msg = PartArray()
-        self._seen: float | None = None     # when every server was first seen (monotonic s)
+        self._shaken = False    # every server answered a probe (handshake)
 
     @property
     def worker(self) -> str:
@@ -158,25 +154,47 @@ class GraphBackend:
         deadline = time.monotonic() + self._rejoin_timeout
         while time.monotonic() < deadline and not stop():
             if not self._missing():
-                time.sleep(MATCH_GRACE)
-                return True
+                return self.handshake(deadline, stop)
             time.sleep(POLL)
         return False
+
+    def handshake(self, deadline: float, stop: Callable[[], bool]) -> bool:
+        """Probe each server until it answers (node_runner.probe): then it can answer us.
+        False at the deadline (monotonic s) or once stop() holds."""
+        for client in self._clients:
+            service, request = probe(self._node, client)
+            try:
+                while True:
+                    future = service.call_async(request)
+                    answered = threading.Event()
+                    future.add_done_callback(lambda _, event=answered: event.set())
+                    if answered.wait(PROBE_WAIT):
+                        break
+                    service.remove_pending_request(future)
+                    if time.monotonic() > deadline or stop():
+                        return False
+            finally:
+                if service is not client:
+                    self._node.destroy_client(service)
+        return True
 
     def wait_for_servers(self) -> None:
         """Raise WorkerGone with the missing endpoints' names unless all are there within
         server_timeout."""
         deadline = time.monotonic() + self._server_timeout
         while time.monotonic() < deadline:
-            if not self._missing():
-                if self._seen is None:
-                    self._seen = time.monotonic()
-                time.sleep(max(0.0, self._seen + MATCH_GRACE - time.monotonic()))
+            if not self._missing() and (self._shaken or self.handshake(deadline,
+                                                                       self._canceled)):
+                self._shaken = True
                 return
             if self._canceled():
                 raise GraphError(CheckParts.Response.CANCELED, 'canceled')
             time.sleep(POLL)
         missing = [self._endpoint(c) for c in self._missing()]
+        if not missing:
+            raise WorkerGone(CheckParts.Response.INTERNAL, (
+                f'the servers of worker {self._ns!r} are in the graph but did not answer a probe '
+                f'within server_timeout {self._server_timeout:g} s'))
         where = f'namespace {self._ns!r}' if self._ns else "the manager's namespace"
         raise WorkerGone(CheckParts.Response.INTERNAL, (
             f'not in the graph after {self._server_timeout:g} s: {", ".join(missing)} (are the '

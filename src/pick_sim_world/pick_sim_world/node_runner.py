@@ -4,7 +4,9 @@ shuts down cleanly on Ctrl-C or SIGINT (the Jazzy way: ros2/demos `qos_overrides
 
 from collections.abc import Callable
 import sys
+import uuid
 
+from action_msgs.srv import CancelGoal
 from rcl_interfaces.msg import ParameterDescriptor, ParameterType
 import rclpy
 from rclpy.action import ActionClient
@@ -39,6 +41,22 @@ def server_ids(node: Node, client) -> frozenset[bytes]:
         infos = node.get_publishers_info_by_topic(
             f'rr{node.resolve_service_name(client.srv_name)}Reply', no_mangle=True)
     return frozenset(bytes(i.endpoint_gid) for i in infos)
+
+
+def probe(node: Node, client) -> tuple[object, object]:
+    """A (service client, request) that the server of `client` answers without doing
+    anything: an action's cancel_goal for a goal id nobody has, or a service's empty request
+    (our services answer it, or refuse it, without a change). Its answer shows that the server
+    has matched this process's new reply readers: discovery is not symmetric, and rmw_fastrtps
+    drops a reply whose reader the server has not matched within 100 ms ("failed to send
+    response (timeout)", seen here under load for a first goal). Destroy the service client
+    when it is not `client`."""
+    if isinstance(client, ActionClient):
+        cancel = node.create_client(CancelGoal, client._action_name + '/_action/cancel_goal')
+        request = CancelGoal.Request()
+        request.goal_info.goal_id.uuid = list(uuid.uuid4().bytes)
+        return cancel, request
+    return client, client.srv_type.Request()
 
 
 def declare_mesh_dirs(node: Node) -> list[str]:
