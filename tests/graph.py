@@ -10,8 +10,7 @@ import tempfile
 import time
 
 from experiment_manager import launcher
-from experiment_manager.graph_backend import PROBE_WAIT
-from pick_sim_world.node_runner import probe
+from pick_sim_world.node_runner import handshake
 import rclpy
 from rclpy.action import ActionClient
 from rclpy.context import Context
@@ -81,27 +80,15 @@ class Client:
     def wait_for_servers(self, *clients, timeout: float = 60.0,
                          nodes: tuple[NodeProcess, ...] = ()) -> bool:
         """Wait until every client (service or action) sees its server and the server answers
-        a probe (node_runner.probe), as the experiment manager does: then it answers us."""
+        a probe (node_runner.handshake), as the experiment manager does."""
         def ready() -> bool:
             return all(c.server_is_ready() if isinstance(c, ActionClient)
                        else c.service_is_ready() for c in clients)
         if not self.wait(ready, timeout, nodes):
             return False
-        deadline = time.monotonic() + timeout
-        for client in clients:
-            service, request = probe(self.node, client)
-            try:
-                while True:
-                    future = service.call_async(request)
-                    if self.wait(future.done, PROBE_WAIT, nodes):
-                        break
-                    service.remove_pending_request(future)
-                    if time.monotonic() > deadline:
-                        return False
-            finally:
-                if service is not client:
-                    self.node.destroy_client(service)
-        return True
+        return handshake(self.node, clients,
+                         lambda future, wait: self.wait(future.done, wait, nodes),
+                         time.monotonic() + timeout)
 
     def result(self, future, timeout: float = 60.0):
         assert self.wait(future.done, timeout), f'no answer within {timeout} s'

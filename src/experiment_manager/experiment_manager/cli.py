@@ -31,14 +31,13 @@ import time
 from ament_index_python.packages import get_package_share_directory
 from pick_msgs.action import RunExperiment
 from pick_sim_world.errors import InvalidArgument
-from pick_sim_world.node_runner import probe
+from pick_sim_world.node_runner import handshake
 import rclpy
 from rclpy.action import ActionClient
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from . import config
-from .graph_backend import PROBE_WAIT
 from .launcher import MANAGER, NodeProcess, READS_MESHES, WORKER_NODES
 
 MAX_WORKERS = 64
@@ -290,24 +289,6 @@ class Graph:
         return new
 
 
-def _handshake(node: Node, client: ActionClient, manager: NodeProcess) -> bool:
-    """Probe the manager's action until it answers (node_runner.probe): then it can answer
-    our goal. False when it does not within START_TIMEOUT or dies."""
-    service, request = probe(node, client)
-    try:
-        deadline = time.monotonic() + START_TIMEOUT
-        while time.monotonic() < deadline:
-            future = service.call_async(request)
-            if _spin_until(node, future.done, [manager], PROBE_WAIT) is not None:
-                return False
-            if future.done():
-                return True
-            service.remove_pending_request(future)
-        return False
-    finally:
-        node.destroy_client(service)
-
-
 def _report_dead(node: Node, done, graph: Graph, timeout: float, bar) -> bool:
     """Spin until done() or timeout, reporting each watched process that dies. A worker
     node is started again (the manager runs the iteration it lost again and takes the worker
@@ -335,7 +316,9 @@ def _run(node: Node, client: ActionClient, goal, graph: Graph, bar) -> int:
         print(f'run: the experiment manager did not start (run_experiment did not appear '
               f'within {START_TIMEOUT:g} s)', file=sys.stderr)
         return 1
-    if not _handshake(node, client, manager):
+    if not handshake(node, [client], lambda future, timeout: _spin_until(
+            node, future.done, [manager], timeout) is None and future.done(),
+            time.monotonic() + START_TIMEOUT, lambda: not manager.running()):
         print('run: the experiment manager did not answer a probe of run_experiment within '
               f'{START_TIMEOUT:g} s', file=sys.stderr)
         return 1

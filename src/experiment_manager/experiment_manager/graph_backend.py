@@ -19,7 +19,7 @@ from pick_msgs.srv import CheckParts, GetParts, ResetScene
 from pick_sim_world import conversions as world_conv
 from pick_sim_world.containers import ContainerSpec
 from pick_sim_world.errors import PhysicsFault
-from pick_sim_world.node_runner import probe, server_ids
+from pick_sim_world.node_runner import handshake, server_ids
 from pick_sim_world.world import PartStates, SettleReport
 from pick_validity import conversions as validity_conv
 from pick_validity.validity import Report
@@ -31,7 +31,6 @@ from .experiments import FeedStep, WorkerLost
 
 POLL = 0.1              # s between checks of a pending call
 GONE_AFTER = 2.0        # s a server must stay absent from the graph before a call fails
-PROBE_WAIT = 1.0        # s for the answer to a probe (node_runner.probe) before another
 
 
 class GraphError(Exception):
@@ -159,24 +158,12 @@ class GraphBackend:
         return False
 
     def handshake(self, deadline: float, stop: Callable[[], bool]) -> bool:
-        """Probe each server until it answers (node_runner.probe): then it can answer us.
-        False at the deadline (monotonic s) or once stop() holds."""
-        for client in self._clients:
-            service, request = probe(self._node, client)
-            try:
-                while True:
-                    future = service.call_async(request)
-                    answered = threading.Event()
-                    future.add_done_callback(lambda _, event=answered: event.set())
-                    if answered.wait(PROBE_WAIT):
-                        break
-                    service.remove_pending_request(future)
-                    if time.monotonic() > deadline or stop():
-                        return False
-            finally:
-                if service is not client:
-                    self._node.destroy_client(service)
-        return True
+        """Probe each server until it answers (node_runner.handshake)."""
+        def wait(future, timeout: float) -> bool:
+            answered = threading.Event()
+            future.add_done_callback(lambda _: answered.set())
+            return answered.wait(timeout)
+        return handshake(self._node, self._clients, wait, deadline, stop)
 
     def wait_for_servers(self) -> None:
         """Raise WorkerGone with the missing endpoints' names unless all are there within

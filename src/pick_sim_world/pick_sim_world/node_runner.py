@@ -4,6 +4,7 @@ shuts down cleanly on Ctrl-C or SIGINT (the Jazzy way: ros2/demos `qos_overrides
 
 from collections.abc import Callable
 import sys
+import time
 import uuid
 
 from action_msgs.srv import CancelGoal
@@ -16,6 +17,7 @@ from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.task import Future
 
 from .errors import WorldError
 
@@ -41,6 +43,30 @@ def server_ids(node: Node, client) -> frozenset[bytes]:
         infos = node.get_publishers_info_by_topic(
             f'rr{node.resolve_service_name(client.srv_name)}Reply', no_mangle=True)
     return frozenset(bytes(i.endpoint_gid) for i in infos)
+
+
+PROBE_WAIT = 1.0   # s for the answer to a probe before another is sent
+
+
+def handshake(node: Node, clients, wait: Callable[[Future, float], bool], deadline: float,
+              stop: Callable[[], bool] = lambda: False) -> bool:
+    """Probe each client's server (probe()) until it answers, so that it can answer us.
+    wait(future, timeout) says whether the future completed in time (spinning, or waiting on
+    an executor spun elsewhere). False at the deadline (monotonic s) or once stop() holds."""
+    for client in clients:
+        service, request = probe(node, client)
+        try:
+            while True:
+                future = service.call_async(request)
+                if wait(future, PROBE_WAIT):
+                    break
+                service.remove_pending_request(future)
+                if time.monotonic() > deadline or stop():
+                    return False
+        finally:
+            if service is not client:
+                node.destroy_client(service)
+    return True
 
 
 def probe(node: Node, client) -> tuple[object, object]:
