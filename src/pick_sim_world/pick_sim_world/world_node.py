@@ -55,6 +55,7 @@ class WorldNode(Node):
         scene, physics, self._vibration = self._declare_parameters()
         self._world = World(scene, physics)
         self._lock = threading.Lock()
+        self._stopping = False
         group = ReentrantCallbackGroup()
         qos_options = QoSOverridingOptions.with_default_policies()
         self._parts_pub = self.create_publisher(PartArray, 'parts', 10,
@@ -259,6 +260,8 @@ class WorldNode(Node):
         settle: list[SettleReport] = []
 
         def progress(p: Progress) -> bool:
+            if self._stopping:   # shutting down: end the operation at this settle check
+                return False
             goal_handle.publish_feedback(action_type.Feedback(progress=conv.progress_to_msg(p)))
             return not goal_handle.is_cancel_requested
 
@@ -330,11 +333,16 @@ class WorldNode(Node):
     def destroy_node(self) -> None:
         """Stop serving first, then close PyBullet once no operation holds it: a disconnect
         under a running step is a native crash."""
+        self._stopping = True
         super().destroy_node()
-        locked = self._lock.acquire(timeout=SHUTDOWN_WAIT)
+        if not self._lock.acquire(timeout=SHUTDOWN_WAIT):
+            # PyBullet is still stepping (an operation with no settle check yet, such as
+            # adding thousands of parts): closing it now would crash; the process exit does.
+            self.get_logger().error(f'a physics operation still ran after {SHUTDOWN_WAIT:g} s; '
+                                    'PyBullet is left to the process exit')
+            return
         self._world.close()
-        if locked:
-            self._lock.release()
+        self._lock.release()
 
 
 def main(args=None) -> None:
