@@ -45,8 +45,8 @@ def values(t: d.AbstractType) -> st.SearchStrategy:
     if isinstance(t, d.BasicType):
         name = t.typename
         if name in ('float', 'double'):
-            nasty = [x for x in FLOATS if name == 'double' or not abs(x) < math.inf
-                     or abs(x) <= FLOAT32_MAX]
+            nasty = [x for x in FLOATS if name == 'double' or not math.isfinite(x)
+                     or abs(x) <= FLOAT32_MAX]      # rclpy refuses finite float32 overflow
             return st.one_of(st.sampled_from(nasty),
                              st.floats(width=32 if name == 'float' else 64))
         if name == 'boolean':

@@ -27,6 +27,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 import yaml
 
+from .metrics import FAULTS
+
 # The paper's results (section 5) for its test case, by experiment-file id.
 PAPER = {
     'pth0': {'best_bin_mm': [100, 175, 15], 'container_free': 0.2502, 'valid_first': 0.0036,
@@ -172,7 +174,7 @@ def _fault_reason(s: dict) -> list[str]:
     if not f['flagged']:
         return []
     return [f'{len(f["flagged"])} iteration(s) flagged: ' + ', '.join(
-        f'{k} {f[k]}' for k in ('physics_fault', 'unsettled', 'escaped') if f[k])
+        f'{k} {f[k]}' for k in FAULTS if f[k])
         + ' (see Physics faults)']
 
 
