@@ -1,29 +1,52 @@
-"""Does a vibration scatter the parts a feed dropped in the tray's feeder zone?
+"""Which vibration serves a feeder: does it scatter a fed pile, and does it empty the feeder?
 
-For each profile: feed 55 capacitors into the feeder zone of the 195 x 150 x 27 mm tray, then
-vibrate 10 times; after each vibration, check every part (all four stages, the default gripper)
-and measure how far the parts spread along the tray (standard deviation of x). Prints the
-median valid parts per check and the spread after the last vibration, per profile, over seeds.
+Scatter: for each profile, feed 55 capacitors into the feeder zone of the 195 x 150 x 27 mm
+tray, then vibrate 10 times; after each vibration, check every part (all four stages, the
+default gripper) and measure how far the parts spread along the tray (standard deviation of x).
+Prints the median valid parts per check and the spread after the last vibration, over seeds.
 
-    tools/ws python bench/bench_vibration.py [--seeds 4]
+Feeder: for each part (the test case's capacitor PTH0 and TO-220 PTH1, with their grasps) and
+profile, `feeder_emptying` runs of 100 parts with the optimal range [20, 30] (the policy's
+defaults, not a result of the paper) and a limit of 300 vibrations, through the experiment
+runner on the cores: runs emptied, vibrations to the last pick, parts lost over the edge.
+
+    tools/ws python bench/bench_vibration.py [--seeds 4] [--feeder-seeds 3]
 """
 
 import argparse
+import os
 import statistics
+import tempfile
 import time
 
-from pick_sim_world.config import SceneSpec, Vibration
+from experiment_manager import config
+from experiment_manager.experiments import Runner
+from experiment_manager.local_backend import LocalBackend
+from experiment_manager.results import read_csv, ResultsWriter
+from pick_sim_world.config import FIXED, RANDOM, SceneSpec, Vibration
 from pick_sim_world.containers import ContainerSpec
 from pick_sim_world.world import World
 from pick_validity.config import CAPACITOR_GRASPS, CheckConfig, Gripper, PlaceSpec
 from pick_validity.validity import Validator
+import yaml
 
 PROFILES = {
-    'x + z in phase, 1 x 0.5 x 1 mm, 30 Hz, 1 s (the former default)':
-        Vibration((0.001, 0.0005, 0.001), 30.0, 1.0),
-    'vertical 3 mm, 30 Hz, 0.5 s (the default)': Vibration(),
-    'vertical 1 mm, 30 Hz, 1 s': Vibration((0.0, 0.0, 0.001), 30.0, 1.0),
+    'x + z in phase, 1 x 0.5 x 1 mm, 30 Hz, 1 s (fixed)':
+        Vibration((0.001, 0.0005, 0.001), 30.0, 1.0, FIXED),
+    'vertical 3 mm, 30 Hz, 0.5 s (the former default)':
+        Vibration((0.0, 0.0, 0.003), 30.0, 0.5, FIXED),
+    'vertical 1 mm, 30 Hz, 1 s': Vibration((0.0, 0.0, 0.001), 30.0, 1.0, FIXED),
+    'vertical 3 mm + 1 mm horizontal, random direction (the default)': Vibration(),
 }
+FEEDER_PROFILES = {
+    'vertical 3 mm (the former default)': Vibration((0.0, 0.0, 0.003), 30.0, 0.5, FIXED),
+    'vertical 3 mm + 1 mm horizontal, random direction (the default)': Vibration(),
+    'vertical 3 mm + 3 mm horizontal, random direction':
+        Vibration((0.003, 0.0, 0.003), 30.0, 0.5, RANDOM),
+}
+TEST_CASE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src',
+                         'experiment_manager', 'config', 'test_case')
+FEEDER_PARTS = {'PTH0 (capacitor 5 x 11 mm)': 'pth0.yaml', 'PTH1 (TO-220)': 'pth1.yaml'}
 
 
 def run(vibration: Vibration, seed: int, count: int = 55, shakes: int = 10) -> dict:
@@ -45,10 +68,40 @@ def run(vibration: Vibration, seed: int, count: int = 55, shakes: int = 10) -> d
                 'escaped': int((~s.inside).sum()), 'wall': wall / shakes}
 
 
+def feeder_runs(part_file: str, vibration: Vibration, runs: int) -> list[dict]:
+    """`runs` feeder_emptying iterations of 100 parts, range [20, 30], on the cores."""
+    data = yaml.safe_load(open(os.path.join(TEST_CASE, part_file), encoding='utf-8'))
+    data['vibration'] = {'amplitude_mm': [a * 1000 for a in vibration.amplitude],
+                         'frequency_hz': vibration.frequency,
+                         'duration_s': vibration.duration, 'direction': vibration.direction}
+    data['experiments'] = [{'id': 'feeder', 'type': 'feeder_emptying', 'iterations': runs,
+                            'parts': 100, 'optimal_range': [20, 30], 'max_vibrations': 300}]
+    file = config.parse(yaml.safe_dump(data), os.path.join(TEST_CASE, part_file))
+    with tempfile.TemporaryDirectory() as out:
+        with LocalBackend() as backend, ResultsWriter(out, file.text) as writer:
+            Runner(file, [backend], writer).run()
+        return read_csv(os.path.join(out, 'iterations.csv'))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--seeds', type=int, default=4)
+    parser.add_argument('--feeder-seeds', type=int, default=3)
     args = parser.parse_args()
+    print(f'feeder_emptying: 100 parts, range [20, 30], limit 300 vibrations, '
+          f'{args.feeder_seeds} runs each')
+    for part, part_file in FEEDER_PARTS.items():
+        for name, vibration in FEEDER_PROFILES.items():
+            rows = feeder_runs(part_file, vibration, args.feeder_seeds)
+            emptied = sum(r['emptied'] for r in rows)
+            vibrations = [r['vibrations'] for r in rows]
+            wall = sum(r['wall_time'] for r in rows)
+            print(f'{part:<27} {name:<66} emptied {emptied}/{len(rows)}; vibrations '
+                  f'{"/".join(map(str, vibrations))}; picked '
+                  f'{"/".join(str(r["picks"]) for r in rows)}; lost '
+                  f'{sum(r["lost"] for r in rows)}; {wall / max(1, sum(vibrations)):.2f} s '
+                  'per vibration (picks included)', flush=True)
+    print()
     print(f'55 capacitors fed into the feeder zone, 10 vibrations, seeds 1..{args.seeds}')
     for name, vibration in PROFILES.items():
         runs = [run(vibration, seed) for seed in range(1, args.seeds + 1)]

@@ -139,6 +139,7 @@ def test_feed_drops_into_the_feeder_zone(cell):
      r'vibration.amplitude[0]: inf must be finite'),
     (Vibrate, Vibrate.Goal(frequency=-1.0), Vibrate.Result.INVALID_ARGUMENT,
      'vibration.frequency: -1.0'),
+    (Vibrate, Vibrate.Goal(direction=3), Vibrate.Result.INVALID_ARGUMENT, 'direction: 3 must be'),
     (RemoveParts, RemoveParts.Goal(part_ids=[123456]), RemoveParts.Result.UNKNOWN_PART,
      'part_ids: 123456 is not a part'),
     (RemoveParts, RemoveParts.Goal(), RemoveParts.Result.INVALID_ARGUMENT, 'part_ids: [] is'),

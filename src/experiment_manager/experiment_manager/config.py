@@ -16,6 +16,7 @@ from typing import Any
 from feeder_controller.policy import check_feeder, FeederConfig
 from pick_sim_world.config import (
     check_vibration,
+    DIRECTIONS,
     MAX_PARTS_PER_INSTANCE,
     MAX_SEED,
     Vibration,
@@ -418,7 +419,8 @@ def parse(text: str, path: str = '') -> ExperimentFile:
     vibration = Vibration(
         amplitude=v.vector('amplitude_mm', [a / MM for a in d.amplitude], 3, scale=MM),
         frequency=v.number('frequency_hz', d.frequency),
-        duration=v.number('duration_s', d.duration))
+        duration=v.number('duration_s', d.duration),
+        direction=v.text('direction', d.direction, DIRECTIONS))
     v.done()
     _checked(check_vibration, vibration, 'vibration')
     bin_wall = m.number('bin_wall_mm', 3.0, low=0.5, high=100.0, scale=MM)

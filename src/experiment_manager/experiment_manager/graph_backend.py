@@ -308,7 +308,8 @@ class GraphBackend:
         goal = FeedCycle.Goal(valid_parts=valid, parts_on_table=on_table,
                               amplitude=Vector3(x=v.amplitude[0], y=v.amplitude[1],
                                                 z=v.amplitude[2]),
-                              frequency=v.frequency, duration=v.duration)
+                              frequency=v.frequency, duration=v.duration,
+                              direction=world_conv.direction_to_msg(v.direction))
         if restart is not None:
             goal.restart = True
             goal.feeder_parts, goal.min_count = restart.feeder_parts, restart.min_count

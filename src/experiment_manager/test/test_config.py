@@ -23,7 +23,8 @@ def test_the_default_file_parses_into_si_units():
     assert f.gripper.body_diameter == pytest.approx(0.020)
     assert f.check.tolerance == pytest.approx(math.radians(45))
     assert f.tray.inner_size == pytest.approx((0.195, 0.150, 0.027))
-    assert f.vibration.amplitude == pytest.approx((0.0, 0.0, 0.003))
+    assert f.vibration.amplitude == pytest.approx((0.001, 0.0, 0.003))
+    assert f.vibration.direction == 'random'
     assert f.requirements.refill_interval == 4 * 3600 and f.requirements.capacity == 480
     emptying = f.experiment('emptying')
     assert emptying.bin is None and emptying.bin_from == 'bins'
@@ -89,6 +90,8 @@ BAD = [
      r'part\.grasps\[0\]\.jaw_opening_mm: None is required'),
     ('vibration: {amplitude_mm: [0, 0, 10], frequency_hz: 50}\n' + MINIMAL,
      r'vibration \(vibration\.amplitude\): .* gives a peak acceleration of .* \(limit 200\)'),
+    ('vibration: {direction: diagonal}\n' + MINIMAL,
+     r"vibration\.direction: 'diagonal' must be one of fixed, random"),
     ('experiments: [\n', r'line \d+, column \d+: .* is not valid YAML'),
     ('- just\n- a list\n', r'file: .* must be a mapping of keys'),
 ]

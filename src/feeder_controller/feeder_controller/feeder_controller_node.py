@@ -172,7 +172,8 @@ class FeederControllerNode(Node):
                     state=self._state_msg(), phase='vibrating'))
                 await self._world(self._vibrate, Vibrate.Goal(
                     instances=[goal.instance], amplitude=goal.amplitude,
-                    frequency=goal.frequency, duration=goal.duration), 'vibrate')
+                    frequency=goal.frequency, duration=goal.duration,
+                    direction=goal.direction), 'vibrate')
                 self._policy.vibrated()
             goal_handle.succeed()
             self.get_logger().debug(f'feed_cycle: {NAMES[step.decision]}')

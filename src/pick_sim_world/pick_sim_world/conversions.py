@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Point, Pose, Quaternion, Transform, Vector3
 import numpy as np
+from pick_msgs.action import Vibrate
 from pick_msgs.msg import ContainerGeometry, Part, PartArray, PartModel, PhysicsProgress, Scene
 from pick_msgs.msg import Instance as InstanceMsg
 from pick_msgs.msg import SettleReport as SettleReportMsg
@@ -17,6 +18,7 @@ from std_msgs.msg import ColorRGBA, Header
 from visualization_msgs.msg import Marker, MarkerArray
 
 from . import containers
+from .config import FIXED, RANDOM
 from .containers import ContainerSpec
 from .errors import (
     check_inside,
@@ -246,6 +248,25 @@ def or_default(field: str, value: float, default: float | None) -> float | None:
     """
     check_number(field, value)
     return default if value == 0.0 else value
+
+
+DIRECTIONS = {Vibrate.Goal.DIRECTION_FIXED: FIXED, Vibrate.Goal.DIRECTION_RANDOM: RANDOM}
+
+
+def direction_from_msg(value: int, default: str) -> str:
+    """A Vibrate/FeedCycle `direction` field as the core's name; DIRECTION_DEFAULT gives
+    `default`. Raises InvalidArgument for a value that is no DIRECTION_* constant."""
+    if value == Vibrate.Goal.DIRECTION_DEFAULT:
+        return default
+    if value not in DIRECTIONS:
+        raise InvalidArgument('direction', value, 'must be 0 (default), 1 (fixed) or 2 '
+                              '(random)')
+    return DIRECTIONS[value]
+
+
+def direction_to_msg(direction: str) -> int:
+    """The core's direction name as a DIRECTION_* value."""
+    return {name: value for value, name in DIRECTIONS.items()}[direction]
 
 
 # ----------------------------------------------------------------------------- markers

@@ -28,6 +28,7 @@ from .config import (
     check_vibration,
     MAX_PARTS_PER_INSTANCE,
     PhysicsConfig,
+    RANDOM,
     SceneSpec,
     Vibration,
 )
@@ -140,6 +141,17 @@ def rotate(quaternions: np.ndarray, vector: np.ndarray) -> np.ndarray:
     xyz, w = quaternions[:, :3], quaternions[:, 3:4]
     t = 2.0 * np.cross(xyz, vector)
     return vector + w * t + np.cross(xyz, t)
+
+
+def vibration_amplitude(vibration: Vibration, rng: np.random.Generator) -> np.ndarray:
+    """The peak displacement (3,) of one vibration, m: as given (FIXED), or with its horizontal
+    part turned about +Z by an angle drawn uniformly from `rng` (RANDOM)."""
+    x, y, z = vibration.amplitude
+    if vibration.direction == RANDOM:
+        angle = rng.uniform(0.0, 2.0 * math.pi)
+        cos, sin = math.cos(angle), math.sin(angle)
+        x, y = cos * x - sin * y, sin * x + cos * y
+    return np.array([x, y, z])
 
 
 def quaternion_angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -476,11 +488,13 @@ class World:
                 progress: ProgressCallback | None = None) -> SettleReport:
         """Move each tray along x(t) = amplitude sin(2 pi f t) for the duration, then settle.
 
-        Raises InvalidArgument for a bad vibration or an instance whose container is a bin.
+        With direction RANDOM, each tray's horizontal amplitude is first turned about the
+        vertical by an angle drawn from its instance's generator (so a seed gives the same
+        motions). Raises InvalidArgument for a bad vibration or an instance whose container is
+        a bin.
         """
         targets = self._instance_ids(instances)
         check_vibration(vibration)
-        amplitude = np.array(vibration.amplitude, dtype=np.float64)
         omega = 2.0 * math.pi * vibration.frequency
         for k in targets:
             if self._instances[k].constraint is None:
@@ -488,6 +502,7 @@ class World:
                                       'only trays vibrate')
         c = self._client
         trays = [self._instances[k] for k in targets]
+        amplitudes = np.array([vibration_amplitude(vibration, inst.rng) for inst in trays])
         dt = self._physics.time_step
         steps = max(1, int(round(vibration.duration / dt)))
         step = 0
@@ -495,10 +510,11 @@ class World:
         def drive() -> None:
             nonlocal step
             step += 1
-            offset = amplitude * math.sin(omega * step * dt)
-            for inst in trays:
-                pb.changeConstraint(inst.constraint, jointChildPivot=(inst.origin + offset)
-                                    .tolist(), maxForce=TRAY_MAX_FORCE, physicsClientId=c)
+            phase = math.sin(omega * step * dt)
+            for inst, amplitude in zip(trays, amplitudes, strict=True):
+                pb.changeConstraint(inst.constraint, jointChildPivot=(
+                    inst.origin + amplitude * phase).tolist(), maxForce=TRAY_MAX_FORCE,
+                    physicsClientId=c)
 
         try:
             report = self._run('vibrating', steps * dt, progress, before_step=drive,

@@ -25,7 +25,7 @@ from rclpy.qos_overriding_options import QoSOverridingOptions
 from visualization_msgs.msg import MarkerArray
 
 from . import conversions as conv
-from .config import PhysicsConfig, SceneSpec, Vibration
+from .config import check_vibration, FIXED, PhysicsConfig, RANDOM, SceneSpec, Vibration
 from .containers import BIN, ContainerSpec, TRAY
 from .errors import InvalidArgument, WorldError
 from .node_runner import declare_mesh_dirs, LATCHED, RESULT_KEEP, run
@@ -166,11 +166,14 @@ class WorldNode(Node):
             frequency=get('vibration.frequency', vib.frequency, 'default frequency, Hz',
                           0.1, 500.0),
             duration=get('vibration.duration', vib.duration, 'default duration, s',
-                         1e-3, 60.0))
+                         1e-3, 60.0),
+            direction=get('vibration.direction', vib.direction,
+                          f'default direction: {FIXED} (the amplitude as given) or {RANDOM} '
+                          '(its horizontal part turned by a random angle per vibration)'))
         self._publish_markers = get('publish_markers', True, 'publish `markers` after each '
                                     'operation')
         self._mesh_dirs = declare_mesh_dirs(self)
-        return scene, physics, vibration
+        return scene, physics, check_vibration(vibration)
 
     # ----------------------------------------------------------------------------- publish
     def _publish(self, scene_changed: bool = False) -> PartArray:
@@ -310,7 +313,8 @@ class WorldNode(Node):
                 amplitude=amplitude,
                 frequency=conv.or_default('frequency', goal.frequency,
                                           self._vibration.frequency),
-                duration=conv.or_default('duration', goal.duration, self._vibration.duration))
+                duration=conv.or_default('duration', goal.duration, self._vibration.duration),
+                direction=conv.direction_from_msg(goal.direction, self._vibration.direction))
             return self._world.vibrate(
                 vibration, instances,
                 conv.or_default('max_settle_time', goal.max_settle_time, None), progress)

@@ -4,11 +4,11 @@ import math
 
 import numpy as np
 from pick_sim_world import containers
-from pick_sim_world.config import PhysicsConfig, SceneSpec, Vibration
+from pick_sim_world.config import FIXED, PhysicsConfig, RANDOM, SceneSpec, Vibration
 from pick_sim_world.containers import ContainerSpec
 from pick_sim_world.errors import InvalidArgument, PhysicsFault, UnknownInstance, UnknownPart
 from pick_sim_world.parts import BUILTIN_MODELS, PartSpec
-from pick_sim_world.world import quaternion_angles, World
+from pick_sim_world.world import quaternion_angles, rotate, vibration_amplitude, World
 import pybullet as pb
 import pytest
 
@@ -89,6 +89,53 @@ def test_vibration_scatters_and_turns_parts_and_the_tray_returns_home():
     assert np.median(moved) > 0.005, 'a vibration must move most parts by millimetres'
     assert (turned > math.radians(90)).sum() >= 1, 'some parts must turn over'
     assert np.allclose(home, tray.origin, atol=1e-4)
+
+
+def test_a_random_direction_turns_only_the_horizontal_amplitude():
+    fixed = Vibration((0.001, 0.0005, 0.003), direction=FIXED)
+    assert vibration_amplitude(fixed, np.random.default_rng(0)).tolist() == [0.001, 0.0005, 0.003]
+    rng = np.random.default_rng(5)
+    turned = np.array([vibration_amplitude(Vibration((0.001, 0.0, 0.003), direction=RANDOM), rng)
+                       for _ in range(200)])
+    assert np.allclose(np.hypot(turned[:, 0], turned[:, 1]), 0.001)
+    assert np.allclose(turned[:, 2], 0.003)
+    angles = np.arctan2(turned[:, 1], turned[:, 0])
+    assert np.histogram(angles, bins=4, range=(-math.pi, math.pi))[0].min() > 30, \
+        'directions must cover every quadrant'
+    again = np.random.default_rng(5)
+    assert np.array_equal(vibration_amplitude(Vibration((0.001, 0.0, 0.003)), again), turned[0])
+
+
+def test_random_vibrations_repeat_with_the_seed():
+    runs = []
+    for seed in (4, 4, 5):
+        with _world(ContainerSpec.tray(), seed=seed) as world:
+            world.drop(30, zone='feeder')
+            for _ in range(3):
+                world.vibrate(Vibration())
+            runs.append(world.snapshot().poses)
+    assert np.array_equal(runs[0], runs[1])
+    assert not np.allclose(runs[0], runs[2])
+
+
+def _tipped(vibration: Vibration, seed: int, shakes: int = 10) -> bool:
+    """Stand a capacitor on the end of its body, leads up, mid-tray; vibrate; has it tipped?"""
+    with _world(ContainerSpec.tray(), seed=seed) as world:
+        (pid,), _ = world.drop(1)
+        pb.resetBasePositionAndOrientation(world._bodies[pid], [0.0, 0.0, 0.0056],
+                                           [1.0, 0.0, 0.0, 0.0], physicsClientId=world._client)
+        world.settle()
+        for _ in range(shakes):
+            world.vibrate(vibration)
+        up = rotate(world.snapshot().poses[:, 3:], np.array([0.0, 0.0, 1.0]))[0, 2]
+    return abs(up) < 0.5
+
+
+def test_a_random_horizontal_shake_tips_a_standing_part_that_a_vertical_one_does_not():
+    # The feeder's last parts stood like this for hundreds of vertical shakes (README).
+    vertical = Vibration((0.0, 0.0, 0.003), direction=FIXED)
+    assert [_tipped(vertical, seed) for seed in range(4)] == [False] * 4
+    assert sum(_tipped(Vibration(), seed) for seed in range(4)) >= 2
 
 
 def test_vibrating_a_bin_is_refused():
@@ -224,6 +271,8 @@ def test_a_bin_too_small_for_the_parts_is_refused_before_any_physics():
     (Vibration(frequency=-3.0), 'vibration.frequency: -3.0 must be >= 0.1'),
     (Vibration(duration=math.inf), 'vibration.duration: inf must be finite'),
     (Vibration(amplitude=(0.01, 0.0, 0.01), frequency=100.0), 'peak acceleration'),
+    (Vibration(direction='sideways'), "vibration.direction: 'sideways' must be one of fixed, "
+     'random'),
 ])
 def test_bad_vibrations_are_refused(vibration, rule):
     with _world(ContainerSpec.tray()) as world, pytest.raises(InvalidArgument, match=rule):
