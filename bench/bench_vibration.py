@@ -36,13 +36,13 @@ PROFILES = {
     'vertical 3 mm, 30 Hz, 0.5 s (the former default)':
         Vibration((0.0, 0.0, 0.003), 30.0, 0.5, FIXED),
     'vertical 1 mm, 30 Hz, 1 s': Vibration((0.0, 0.0, 0.001), 30.0, 1.0, FIXED),
-    'vertical 3 mm + 1 mm horizontal, random direction (the default)': Vibration(),
+    'vertical 3 mm + 3 mm horizontal, random direction (the default)': Vibration(),
 }
 FEEDER_PROFILES = {
     'vertical 3 mm (the former default)': Vibration((0.0, 0.0, 0.003), 30.0, 0.5, FIXED),
-    'vertical 3 mm + 1 mm horizontal, random direction (the default)': Vibration(),
-    'vertical 3 mm + 3 mm horizontal, random direction':
-        Vibration((0.003, 0.0, 0.003), 30.0, 0.5, RANDOM),
+    'vertical 3 mm + 1 mm horizontal, random direction':
+        Vibration((0.001, 0.0, 0.003), 30.0, 0.5, RANDOM),
+    'vertical 3 mm + 3 mm horizontal, random direction (the default)': Vibration(),
 }
 TEST_CASE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src',
                          'experiment_manager', 'config', 'test_case')

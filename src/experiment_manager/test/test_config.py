@@ -23,7 +23,7 @@ def test_the_default_file_parses_into_si_units():
     assert f.gripper.body_diameter == pytest.approx(0.020)
     assert f.check.tolerance == pytest.approx(math.radians(45))
     assert f.tray.inner_size == pytest.approx((0.195, 0.150, 0.027))
-    assert f.vibration.amplitude == pytest.approx((0.001, 0.0, 0.003))
+    assert f.vibration.amplitude == pytest.approx((0.003, 0.0, 0.003))
     assert f.vibration.direction == 'random'
     assert f.requirements.refill_interval == 4 * 3600 and f.requirements.capacity == 480
     emptying = f.experiment('emptying')
