@@ -101,8 +101,8 @@ def main() -> None:
             emptied = sum(r['emptied'] for r in rows)
             vibrations = [r['vibrations'] for r in rows]
             wall = sum(r['wall_time'] for r in rows)
-            print(f'{part:<27} [{low}, {high}] {name:<66} emptied {emptied}/{len(rows)}; vibrations '
-                  f'{"/".join(map(str, vibrations))}; picked '
+            print(f'{part:<27} [{low}, {high}] {name:<66} emptied {emptied}/{len(rows)}; '
+                  f'vibrations {"/".join(map(str, vibrations))}; picked '
                   f'{"/".join(str(r["picks"]) for r in rows)}; lost '
                   f'{sum(r["lost"] for r in rows)}; {wall / max(1, sum(vibrations)):.2f} s '
                   'per vibration (picks included)', flush=True)
