@@ -109,6 +109,10 @@ class GraphBackend:
         self._file: ExperimentFile | None = None
         self._parts_msg = PartArray()
         self._shaken = False    # every server answered a probe (handshake)
+        # client -> the DDS ids of its servers when this iteration began (reset): a server
+        # answering under other ids is a node started again, without the iteration's scene
+        # or feeder state.
+        self._serving: dict = {c: frozenset() for c in self._clients}
 
     @property
     def worker(self) -> str:
@@ -188,14 +192,16 @@ class GraphBackend:
             f'world, validity and feeder_controller nodes running in {where}?)'))
 
     def _wait(self, future, client, what: str):
-        """The future's result. Every endpoint of the worker must stay in the graph meanwhile:
-        a feed_cycle, say, waits on the world through the feeder_controller, and a world that
-        died would leave it waiting for ever."""
+        """The future's result. Every server of the worker that this iteration began with must
+        stay in the graph meanwhile (a feed_cycle, say, waits on the world through the
+        feeder_controller, and a world that died would leave it waiting for ever) and still be
+        there when the answer came: a node that died between two calls and was started again
+        answers from a new, empty state, which must not pass for the iteration's."""
         done = threading.Event()
         future.add_done_callback(lambda _: done.set())
         start = time.monotonic()
         absent_since = None
-        serving = {c: server_ids(self._node, c) for c in self._clients}
+        serving = self._serving
         if self._canceled():   # before the first wait too: short calls would never notice
             future.cancel()
             raise GraphError(CheckParts.Response.CANCELED, f'canceled before {what}')
@@ -217,6 +223,14 @@ class GraphBackend:
                 raise WorkerGone(CheckParts.Response.INTERNAL, (
                     f'{what}: {", ".join(self._endpoint(c) for c in missing)} left the graph '
                     'while the worker was answering (its node died, was stopped or restarted)'))
+        deadline = time.monotonic() + GONE_AFTER
+        while missing := self._lost(serving):
+            if time.monotonic() > deadline:
+                raise WorkerGone(CheckParts.Response.INTERNAL, (
+                    f'{what}: {", ".join(self._endpoint(c) for c in missing)} of this '
+                    'iteration left the graph (its node died, was stopped or restarted): the '
+                    "answer may come from a node without the iteration's state"))
+            time.sleep(POLL)
         return future.result()
 
     def _service(self, client, request, what: str):
@@ -263,6 +277,10 @@ class GraphBackend:
         self.wait_for_servers()
 
     def reset(self, container: ContainerSpec, seed: int) -> None:
+        """Begin an iteration: its servers are the ones in the graph now."""
+        if self._missing():
+            self.wait_for_servers()
+        self._serving = {c: server_ids(self._node, c) for c in self._clients}
         request = ResetScene.Request(container=world_conv.container_to_msg(container),
                                      part_model=self._part_msg, instance_count=1, seed=seed)
         self._service(self._reset, request, 'reset_scene')
