@@ -214,6 +214,9 @@ def test_a_second_goal_while_one_runs_is_busy_and_cancel_stops_the_first(cell, c
     (['-p', 'part.model:=mesh', '-p', 'part.mesh_path:=/no/such.stl', '-p', 'part.mass:=0.001'],
      "part.mesh_path: '/no/such.stl' does not exist"),
     (['--params-file', '/no/such.yaml'], "Couldn't parse params file"),
+    (['-p', 'vibration.direction:=sideways'],
+     "vibration.direction: 'sideways' must be one of fixed, random"),
+    (['-p', 'vibration.amplitude:=[0.0, 0.0, 0.0]'], 'vibration.amplitude'),
 ])
 def test_bad_parameters_stop_the_node_with_a_clear_message(private_ros_domain, args, text):
     proc = NodeProcess('pick_sim_world', 'world', args)
