@@ -17,6 +17,10 @@ from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 
+# The small file of every experiment type that the graph tests run.
+SMALL = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), 'src',
+                     'experiment_manager', 'test', 'small_experiment.yaml')
+
 
 def wait_for(predicate: Callable[[], bool], timeout: float, spin: Callable[[], None]) -> bool:
     """Spin until predicate() holds or timeout (s, steady clock) passes; no fixed sleeps."""

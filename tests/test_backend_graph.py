@@ -1,11 +1,10 @@
 """GraphBackend, the manager's side of a worker, against real node processes over DDS."""
 
-import os
 import threading
 
 from experiment_manager import config
 from experiment_manager.graph_backend import GraphBackend, WorkerGone
-from graph import NodeProcess, stop_all, unique_namespace
+from graph import NodeProcess, SMALL, stop_all, unique_namespace
 import pytest
 import rclpy
 from rclpy.callback_groups import ReentrantCallbackGroup
@@ -15,8 +14,6 @@ from rclpy.node import Node
 
 pytestmark = pytest.mark.graph
 NS = unique_namespace('cell_b')
-SMALL = os.path.join(os.path.dirname(__file__), '..', 'src', 'experiment_manager', 'test',
-                     'small_experiment.yaml')
 WORLD_ARGS = ['-r', f'__ns:={NS}', '-p', 'publish_markers:=false']
 
 

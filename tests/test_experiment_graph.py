@@ -19,7 +19,7 @@ from experiment_manager.experiments import Runner
 from experiment_manager.launcher import executable, WORKER_NODES
 from experiment_manager.local_backend import LocalBackend
 from experiment_manager.results import FILES, read_text_rows, ResultsWriter
-from graph import unique_namespace
+from graph import SMALL, unique_namespace
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 from pick_msgs.action import RunExperiment
@@ -29,8 +29,6 @@ import pytest
 from rclpy.action import ActionClient
 
 pytestmark = pytest.mark.graph
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SMALL = os.path.join(ROOT, 'src', 'experiment_manager', 'test', 'small_experiment.yaml')
 NS = unique_namespace('exp')
 WORKERS = 2
 STAGE_COUNTS = ('checked', 'candidates', 'placeable', 'container_free', 'valid')

@@ -65,7 +65,7 @@ class Vibration:
     amplitude: peak displacement along the tray's x, y, z, m. frequency: Hz.
     direction: FIXED moves the tray along the amplitude as given; RANDOM turns its horizontal
     part (x, y) about the vertical by an angle drawn uniformly from the instance's generator,
-    once per vibration, so that the pile spreads and tips without drifting to one wall.
+    once per vibration, so that the pile spreads and tips with no net drift toward one wall.
     The default, a 3 mm vertical shake with a 3 mm horizontal one in a random direction
     (15.4 g peak), is the profile that emptied the feeder in every run and in the fewest
     vibrations (measured: world README, "Vibration"); a fixed in-phase x + z motion conveys the

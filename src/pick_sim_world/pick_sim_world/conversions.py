@@ -250,7 +250,8 @@ def or_default(field: str, value: float, default: float | None) -> float | None:
     return default if value == 0.0 else value
 
 
-DIRECTIONS = {Vibrate.Goal.DIRECTION_FIXED: FIXED, Vibrate.Goal.DIRECTION_RANDOM: RANDOM}
+_DIRECTION_NAMES = {Vibrate.Goal.DIRECTION_FIXED: FIXED, Vibrate.Goal.DIRECTION_RANDOM: RANDOM}
+_DIRECTION_VALUES = {name: value for value, name in _DIRECTION_NAMES.items()}
 
 
 def direction_from_msg(value: int, default: str) -> str:
@@ -258,15 +259,15 @@ def direction_from_msg(value: int, default: str) -> str:
     `default`. Raises InvalidArgument for a value that is no DIRECTION_* constant."""
     if value == Vibrate.Goal.DIRECTION_DEFAULT:
         return default
-    if value not in DIRECTIONS:
+    if value not in _DIRECTION_NAMES:
         raise InvalidArgument('direction', value, 'must be 0 (default), 1 (fixed) or 2 '
                               '(random)')
-    return DIRECTIONS[value]
+    return _DIRECTION_NAMES[value]
 
 
 def direction_to_msg(direction: str) -> int:
     """The core's direction name as a DIRECTION_* value."""
-    return {name: value for value, name in DIRECTIONS.items()}[direction]
+    return _DIRECTION_VALUES[direction]
 
 
 # ----------------------------------------------------------------------------- markers
