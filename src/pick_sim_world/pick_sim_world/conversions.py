@@ -276,24 +276,26 @@ _PART_COLOR = ColorRGBA(r=0.1, g=0.3, b=0.8, a=1.0)
 _ESCAPED_COLOR = ColorRGBA(r=0.9, g=0.1, b=0.1, a=1.0)
 
 
-def _quat_mul(a: Sequence[float], b: Sequence[float]) -> list[float]:
-    ax, ay, az, aw = a
+def _quat_mul(a: np.ndarray, b: Sequence[float]) -> np.ndarray:
+    """Quaternion products a * b: a (N, 4), b (4,), xyzw; returns (N, 4)."""
+    ax, ay, az, aw = a.T
     bx, by, bz, bw = b
-    return [aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz]
-
-
-def _rotate(q: Sequence[float], v: Sequence[float]) -> np.ndarray:
-    return rotate(np.asarray([q], dtype=np.float64), np.asarray(v, dtype=np.float64))[0]
+    return np.stack([aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+                     aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz],
+                    axis=1)
 
 
 def markers_msg(world: World, states: PartStates, stamp: Time, prefix: str) -> MarkerArray:
     """Containers and parts as markers in their instance frames: one marker per collision
-    primitive (CUBE, CYLINDER) or hull (TRIANGLE_LIST). Starts with DELETEALL."""
+    primitive (CUBE, CYLINDER) or hull (TRIANGLE_LIST). Starts with DELETEALL.
+
+    The world publishes this after every operation, so the primitives' poses are computed for
+    all parts at once and the shapes (scale, hull points) are built once per call."""
     out = MarkerArray(markers=[Marker(action=Marker.DELETEALL)])
+    headers = {}
     marker_id = 0
     for inst in world.instances:
-        header = Header(stamp=stamp, frame_id=instance_frame(prefix, inst.id))
+        header = headers[inst.id] = Header(stamp=stamp, frame_id=instance_frame(prefix, inst.id))
         for half, center in containers.wall_boxes(world.scene.container):
             out.markers.append(Marker(
                 header=header, ns='container', id=marker_id, type=Marker.CUBE,
@@ -301,30 +303,35 @@ def markers_msg(world: World, states: PartStates, stamp: Time, prefix: str) -> M
                 scale=Vector3(x=2 * half[0], y=2 * half[1], z=2 * half[2]),
                 color=_CONTAINER_COLOR))
             marker_id += 1
-    hulls = {}
-    for pid, inst, pose, inside in zip(states.ids.tolist(), states.instances.tolist(),
-                                       states.poses.tolist(), states.inside.tolist(),
-                                       strict=True):
-        header = Header(stamp=stamp, frame_id=instance_frame(prefix, inst))
+    if not len(states.ids):
+        return out
+    primitives = world.part.primitives
+    shapes = []     # per primitive: marker type, scale and points, shared by every part
+    for p in primitives:
+        if p.kind == 'box':
+            shapes.append((Marker.CUBE, Vector3(x=2 * p.size[0], y=2 * p.size[1],
+                                                z=2 * p.size[2]), []))
+        elif p.kind == 'cylinder':
+            shapes.append((Marker.CYLINDER, Vector3(x=2 * p.size[0], y=2 * p.size[0],
+                                                    z=p.size[1]), []))
+        else:
+            shapes.append((Marker.TRIANGLE_LIST, Vector3(x=1.0, y=1.0, z=1.0),
+                           [Point(x=float(x), y=float(y), z=float(z))
+                            for x, y, z in p.vertices[p.faces.reshape(-1)]]))
+    q = states.poses[:, 3:]
+    # (N, K, 3) positions and (N, K, 4) orientations of primitive k of part n.
+    positions = np.stack([states.poses[:, :3] + rotate(q, np.asarray(p.position, dtype=float))
+                          for p in primitives], axis=1).tolist()
+    orientations = np.stack([_quat_mul(q, p.orientation) for p in primitives], axis=1).tolist()
+    for pid, inst, inside, part_positions, part_orientations in zip(
+            states.ids.tolist(), states.instances.tolist(), states.inside.tolist(), positions,
+            orientations, strict=True):
+        header, ns = headers[inst], f'part_{pid}'
         color = _PART_COLOR if inside else _ESCAPED_COLOR
-        for k, p in enumerate(world.part.primitives):
-            position = np.asarray(pose[:3]) + _rotate(pose[3:], p.position)
-            orientation = _quat_mul(pose[3:], p.orientation)
-            m = Marker(header=header, ns=f'part_{pid}', id=k, pose=_pose(position, orientation),
-                       color=color)
-            if p.kind == 'box':
-                m.type = Marker.CUBE
-                m.scale = Vector3(x=2 * p.size[0], y=2 * p.size[1], z=2 * p.size[2])
-            elif p.kind == 'cylinder':
-                m.type = Marker.CYLINDER
-                m.scale = Vector3(x=2 * p.size[0], y=2 * p.size[0], z=p.size[1])
-            else:
-                m.type = Marker.TRIANGLE_LIST
-                m.scale = Vector3(x=1.0, y=1.0, z=1.0)
-                if k not in hulls:
-                    hulls[k] = [Point(x=float(x), y=float(y), z=float(z))
-                                for x, y, z in p.vertices[p.faces.reshape(-1)]]
-                m.points = hulls[k]
-            out.markers.append(m)
+        for k, ((kind, scale, points), (x, y, z), (qx, qy, qz, qw)) in enumerate(zip(
+                shapes, part_positions, part_orientations, strict=True)):
+            out.markers.append(Marker(
+                header=header, ns=ns, id=k, type=kind, scale=scale, color=color, points=points,
+                pose=Pose(position=Point(x=x, y=y, z=z),
+                          orientation=Quaternion(x=qx, y=qy, z=qz, w=qw))))
     return out
-

@@ -1,0 +1,44 @@
+"""Pure tests of message conversions that carry geometry (real PyBullet world, no ROS graph)."""
+
+from builtin_interfaces.msg import Time
+import numpy as np
+from pick_sim_world import conversions as conv
+from pick_sim_world.config import SceneSpec
+from pick_sim_world.containers import ContainerSpec
+from pick_sim_world.parts import PartSpec
+from pick_sim_world.world import World
+import pybullet as pb
+import pytest
+from visualization_msgs.msg import Marker
+
+
+@pytest.mark.parametrize('model', ['radial_capacitor', 'to220'])
+def test_each_part_marker_is_its_primitive_placed_by_the_part_pose(model):
+    with World(SceneSpec(ContainerSpec.tray(), PartSpec(model=model), 2, seed=4)) as world:
+        world.drop(12)
+        states = world.snapshot()
+        msg = conv.markers_msg(world, states, Time(sec=3), 'w/')
+        primitives = world.part.primitives
+    assert msg.markers[0].action == Marker.DELETEALL
+    parts = [m for m in msg.markers[1:] if m.ns.startswith('part_')]
+    walls = [m for m in msg.markers[1:] if m.ns == 'container']
+    assert len(walls) == 2 * 5 and len(parts) == len(states.ids) * len(primitives)
+    by_key = {(m.ns, m.id): m for m in parts}
+    for pid, instance, pose, inside in zip(states.ids, states.instances, states.poses,
+                                           states.inside, strict=True):
+        for k, p in enumerate(primitives):
+            m = by_key[(f'part_{pid}', k)]
+            position, orientation = pb.multiplyTransforms(pose[:3], pose[3:], p.position,
+                                                          p.orientation)
+            o = m.pose.orientation
+            assert [m.pose.position.x, m.pose.position.y, m.pose.position.z] == pytest.approx(
+                position, abs=1e-7)   # pybullet composes in about single precision
+            assert abs(np.dot([o.x, o.y, o.z, o.w], orientation)) == pytest.approx(1.0, abs=1e-7)
+            assert m.header.frame_id == f'w/instance_{instance}' and m.header.stamp.sec == 3
+            expected = {'box': Marker.CUBE, 'cylinder': Marker.CYLINDER}.get(p.kind,
+                                                                              Marker.TRIANGLE_LIST)
+            assert m.type == expected
+            assert (m.color.r, m.color.g, m.color.b) == pytest.approx(
+                (0.1, 0.3, 0.8) if inside else (0.9, 0.1, 0.1))
+            if p.kind == 'hull':
+                assert len(m.points) == 3 * len(p.faces)
