@@ -67,9 +67,9 @@ class Vibration:
     part (x, y) about the vertical by an angle drawn uniformly from the instance's generator,
     once per vibration, so that the pile spreads and tips with no net drift toward one wall.
     The default, a 3 mm vertical shake with a 3 mm horizontal one in a random direction
-    (15.4 g peak), is the profile that emptied the feeder in every run and in the fewest
-    vibrations (measured: world README, "Vibration"); a fixed in-phase x + z motion conveys the
-    pile to one wall.
+    (15.4 g peak), emptied the most feeder runs, in the fewest vibrations, of the profiles
+    measured (world README, "Vibration"); a fixed in-phase x + z motion conveys the pile to one
+    wall.
     """
 
     amplitude: tuple[float, float, float] = (0.003, 0.0, 0.003)
