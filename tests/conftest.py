@@ -2,10 +2,21 @@
 
 from collections.abc import Callable, Iterator
 import os
+import signal
 
 from fuzz import TRIED
 from graph import Client, NodeProcess
 import pytest
+
+
+def pytest_configure(config) -> None:
+    """A test run started in the background of a non-interactive shell (`(cmd &)`) inherits
+    SIGINT ignored, and an ignored signal stays ignored across exec: every run and node process
+    the tests start would then ignore the SIGINT the tests send (seen: the stopped-run test's run
+    finished with 0 instead of 130). A Python handler is reset to the default on exec, so with
+    it the processes the tests start get SIGINT as a user's shell delivers it."""
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def pytest_terminal_summary(terminalreporter) -> None:
