@@ -2,6 +2,7 @@
 
 import math
 import os
+import signal
 
 from ament_index_python.packages import get_package_share_directory
 from geometry_msgs.msg import Vector3
@@ -235,3 +236,18 @@ def test_parameter_file_configures_the_scene(private_ros_domain, client, start_n
     assert client.wait(lambda: scenes, 60.0), 'no latched scene from the parameter file node'
     assert scenes[-1].part_model.name == 'to220'
     assert scenes[-1].instances[0].container.type == ContainerGeometry.TYPE_TRAY
+
+
+def test_a_node_that_crashes_natively_leaves_its_python_stacks_in_its_log(client):
+    """Shutdown crashes seen in CI left nothing to go on; the launcher turns on faulthandler."""
+    proc = NodeProcess('pick_sim_world', 'world', ['-r', f'__ns:={NS}/crash'])
+    try:
+        probe = client.node.create_client(GetParts, f'{NS}/crash/get_parts')
+        assert client.wait_for_servers(probe, nodes=(proc,))
+        os.kill(proc.process.pid, signal.SIGSEGV)
+        assert proc.process.wait(30) == -signal.SIGSEGV
+    finally:
+        proc.stop()
+    output = proc.output()
+    assert 'Fatal Python error: Segmentation fault' in output, output
+    assert 'Current thread' in output and 'Thread 0x' in output, output

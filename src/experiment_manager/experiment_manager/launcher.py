@@ -46,9 +46,12 @@ class NodeProcess:
         self.command = [executable(package, name), '--ros-args', *ros_args]
         self.log_path = log_path
         with open(log_path, 'ab' if append else 'wb') as log:
+            # A native crash (SIGSEGV in PyBullet, FCL or rcl) then leaves every thread's
+            # Python stack in the log instead of nothing.
             self.process = subprocess.Popen(self.command, stdout=log, stderr=subprocess.STDOUT,
                                             stdin=subprocess.DEVNULL,
-                                            preexec_fn=_die_with_parent)
+                                            preexec_fn=_die_with_parent,
+                                            env={**os.environ, 'PYTHONFAULTHANDLER': '1'})
 
     def respawn(self) -> 'NodeProcess':
         """The same node started again, its output appended to the same log."""

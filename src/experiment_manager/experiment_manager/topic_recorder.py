@@ -97,5 +97,8 @@ class TopicRecorder:
             self._recorder = None
 
     def destroy(self) -> None:
+        """Stop spinning, and destroy the node only once the spinning thread has left the
+        executor: a node destroyed under a thread still waiting on it can crash the process."""
         self._executor.shutdown(timeout_sec=1.0)
+        self._thread.join(timeout=5.0)
         self.node.destroy_node()
