@@ -328,10 +328,9 @@ def markers_msg(world: World, states: PartStates, stamp: Time, prefix: str) -> M
             orientations, strict=True):
         header, ns = headers[inst], f'part_{pid}'
         color = _PART_COLOR if inside else _ESCAPED_COLOR
-        for k, ((kind, scale, points), (x, y, z), (qx, qy, qz, qw)) in enumerate(zip(
+        for k, ((kind, scale, points), position, orientation) in enumerate(zip(
                 shapes, part_positions, part_orientations, strict=True)):
             out.markers.append(Marker(
                 header=header, ns=ns, id=k, type=kind, scale=scale, color=color, points=points,
-                pose=Pose(position=Point(x=x, y=y, z=z),
-                          orientation=Quaternion(x=qx, y=qy, z=qz, w=qw))))
+                pose=_pose(position, orientation)))
     return out
