@@ -226,6 +226,7 @@ class World:
         self._scene, self._part = scene, part
         self._instances, self._bodies, self._owner = [], {}, {}
         self._next_id, self._sim_time = 0, 0.0
+        self._at_rest = True     # every part rested at the end of the last step run
         self._part_shape = self._create_part_shape(part)
         pitch = containers.outer_size(scene.container)[0] + INSTANCE_GAP
         for k in range(scene.instance_count):
@@ -464,6 +465,7 @@ class World:
         c = self._client
         spec = self._part.spec
         ids = []
+        self._at_rest = False
         for pose in poses:
             body = pb.createMultiBody(
                 self._part.mass, self._part_shape, basePosition=(pose[:3] + inst.origin).tolist(),
@@ -535,7 +537,12 @@ class World:
     def remove(self, part_ids: Iterable[int], settle: bool = True,
                max_settle_time: float | None = None,
                progress: ProgressCallback | None = None) -> tuple[list[int], SettleReport]:
-        """Remove parts by id (all or none), then settle unless `settle` is False."""
+        """Remove parts by id (all or none), then settle unless `settle` is False.
+
+        The settle is skipped (a report of 0 steps) when the scene rested after the last
+        step run and no removed part touched a part that stays (by the last step's contacts,
+        within the contact-breaking threshold): lifting such a part out moves nothing else.
+        """
         ids = []
         for value in part_ids:
             pid = check_int('part_ids[]', value, low=0, high=2**32 - 1)
@@ -545,12 +552,26 @@ class World:
                 ids.append(pid)
         if not ids:
             raise InvalidArgument('part_ids', [], 'is empty: name at least one part')
+        touched = self._touch_other_parts(ids)
         for pid in ids:
             pb.removeBody(self._bodies.pop(pid), physicsClientId=self._client)
             self._instances[self._owner.pop(pid)].part_ids.remove(pid)
-        if not settle:
-            return ids, SettleReport(True, 0.0, 0.0, 0, escaped_ids=self._escaped())
-        return ids, self._settle('settling', max_settle_time, progress)
+        if settle and (touched or not self._at_rest):
+            return ids, self._settle('settling', max_settle_time, progress)
+        self._at_rest = self._at_rest and not touched
+        return ids, SettleReport(True, 0.0, 0.0, 0, escaped_ids=self._escaped())
+
+    def _touch_other_parts(self, ids: list[int]) -> bool:
+        """Whether a part of `ids` touches (is within the contact-breaking threshold of) a part
+        not in `ids`, by the contacts of the last step."""
+        removed = {self._bodies[pid] for pid in ids}
+        containers_ = {inst.body for inst in self._instances}
+        for body in removed:
+            for contact in pb.getContactPoints(bodyA=body, physicsClientId=self._client):
+                other = contact[2]
+                if other not in removed and other not in containers_:
+                    return True
+        return False
 
     # ----------------------------------------------------------------------------- settle
     def settle(self, max_settle_time: float | None = None,
@@ -620,6 +641,7 @@ class World:
                 break
         self._sim_time += steps * dt
         wall = time.perf_counter() - start
+        self._at_rest = settled
         if not stop_when_settled:
             settled = not canceled
         unsettled = [ids[i] for i in np.flatnonzero(moving)]

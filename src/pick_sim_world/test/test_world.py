@@ -158,13 +158,49 @@ def test_remove_parts_then_resettle_and_ids_are_not_reused():
         ids, _ = world.drop(30)
         removed, report = world.remove(ids[:10])
         assert removed == ids[:10]
-        assert report.settled
+        assert report.settled and report.steps > 0
         state = world.snapshot()
         assert sorted(state.ids.tolist()) == ids[10:]
         new, _ = world.drop(5)
         assert min(new) == max(ids) + 1
         with pytest.raises(UnknownPart, match='part_ids: 3 is not a part'):
             world.remove([3])
+
+
+def _lone_and_piled(world: World) -> tuple[list[int], list[int]]:
+    """Ids of parts more than 5 mm from every other part, and of parts within 0.5 mm of
+    another, by PyBullet's closest points (not the contacts the world reads)."""
+    ids = world.snapshot().ids.tolist()
+    bodies = [world._bodies[i] for i in ids]
+
+    def near(body, distance):
+        return any(pb.getClosestPoints(body, other, distance, physicsClientId=world._client)
+                   for other in bodies if other != body)
+
+    return ([i for i, b in zip(ids, bodies) if not near(b, 0.005)],
+            [i for i, b in zip(ids, bodies) if near(b, 0.0005)])
+
+
+def test_picking_a_lone_part_from_a_resting_scene_skips_the_settle_and_loses_nothing():
+    with _world(ContainerSpec.tray(), seed=5) as world:
+        _, report = world.drop(40)
+        assert report.settled
+        lone, piled = _lone_and_piled(world)
+        assert len(lone) >= 2 and len(piled) >= 2, 'the scene must have lone and touching parts'
+        _, report = world.remove([lone[0]])
+        assert report.settled and report.steps == 0
+        before = world.snapshot()
+        # A settle now would move nothing: the skipped settle lost nothing.
+        world.settle()
+        after = world.snapshot()
+        assert np.abs(after.poses[:, :3] - before.poses[:, :3]).max() < 1e-4
+        # A part that touches another: the scene settles.
+        _, report = world.remove([piled[0]])
+        assert report.steps > 0
+        # A scene left unsettled (a removal without a settle): even a lone part settles it.
+        world.remove([piled[1]], settle=False)
+        _, report = world.remove([lone[1]])
+        assert report.steps > 0
 
 
 def test_instances_are_independent_with_their_own_frames_and_seeds():
