@@ -177,8 +177,8 @@ def _lone_and_piled(world: World) -> tuple[list[int], list[int]]:
         return any(pb.getClosestPoints(body, other, distance, physicsClientId=world._client)
                    for other in bodies if other != body)
 
-    return ([i for i, b in zip(ids, bodies) if not near(b, 0.005)],
-            [i for i, b in zip(ids, bodies) if near(b, 0.0005)])
+    return ([i for i, b in zip(ids, bodies, strict=True) if not near(b, 0.005)],
+            [i for i, b in zip(ids, bodies, strict=True) if near(b, 0.0005)])
 
 
 def test_picking_a_lone_part_from_a_resting_scene_skips_the_settle_and_loses_nothing():
