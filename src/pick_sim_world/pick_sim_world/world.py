@@ -226,7 +226,7 @@ class World:
         self._scene, self._part = scene, part
         self._instances, self._bodies, self._owner = [], {}, {}
         self._next_id, self._sim_time = 0, 0.0
-        self._at_rest = True     # every part rested at the end of the last step run
+        self._at_rest = True     # the last step run ended settled (the settle criterion)
         self._part_shape = self._create_part_shape(part)
         pitch = containers.outer_size(scene.container)[0] + INSTANCE_GAP
         for k in range(scene.instance_count):
