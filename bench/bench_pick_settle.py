@@ -17,18 +17,10 @@ import argparse
 import collections
 import multiprocessing
 import os
-import tempfile
-import time
 
-from experiment_manager import config
-from experiment_manager.experiments import Runner
-from experiment_manager.local_backend import LocalBackend
-from experiment_manager.results import read_csv, ResultsWriter
+from paper_case import run_on_cores
 from pick_sim_world import world as world_module
-import yaml
 
-TEST_CASE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src',
-                         'experiment_manager', 'config', 'test_case')
 # Per part: its file, the reduced test case's optimal range (2026-11-22) and best bin, mm.
 PARTS = {'PTH0': ('pth0.yaml', (72, 82), (100, 175, 15)),
          'PTH1': ('pth1.yaml', (39, 49), (300, 300, 26)),
@@ -69,17 +61,8 @@ def measure(kind: str, part: str, mode: int, runs: int) -> dict:
         return report
 
     world_module.World._run = counted
-    path = os.path.join(TEST_CASE, PARTS[part][0])
-    data = yaml.safe_load(open(path, encoding='utf-8'))
-    data['experiments'] = experiments(kind, part, runs)
-    file = config.parse(yaml.safe_dump(data), path)
-    with tempfile.TemporaryDirectory() as out:
-        start = time.perf_counter()
-        with LocalBackend() as backend, ResultsWriter(out, file.text) as writer:
-            Runner(file, [backend], writer).run()
-        wall = time.perf_counter() - start
-        rows = [r for r in read_csv(os.path.join(out, 'iterations.csv'))
-                if r['type'] != 'bin_static']
+    rows, wall = run_on_cores(PARTS[part][0], experiments(kind, part, runs))
+    rows = [r for r in rows if r['type'] != 'bin_static']
     return dict(wall=wall, steps=steps[0], rows=rows, **counts)
 
 

@@ -18,12 +18,11 @@ import statistics
 import time
 
 from experiment_manager.config import load
+from paper_case import TEST_CASE
 from pick_sim_world.config import PhysicsConfig, SceneSpec
 from pick_sim_world.world import World
 from pick_validity.validity import Validator
 
-CASES = os.path.join(os.path.dirname(__file__), '..', 'src', 'experiment_manager', 'config',
-                     'test_case')
 FRACTIONS = (0.01, 0.02)
 CAPS = (3.0, 5.0)
 
@@ -77,7 +76,7 @@ def main() -> None:
     totals: dict[str, float] = {}
     changes: dict[str, list[float]] = {}
     for name in ('pth0', 'pth1', 'pth2'):
-        file = load(os.path.join(CASES, f'{name}.yaml'))
+        file = load(os.path.join(TEST_CASE, f'{name}.yaml'))
         exp = next(e for e in file.experiments if e.type == 'bin_static')
         for container in (exp.bins[0], exp.bins[len(exp.bins) // 2], exp.bins[-1]):
             size = ' x '.join(f'{v * 1000:g}' for v in container.inner_size)

@@ -20,19 +20,14 @@ import itertools
 import multiprocessing
 import os
 import statistics
-import tempfile
 import time
 
-from experiment_manager import config
-from experiment_manager.experiments import Runner
-from experiment_manager.local_backend import LocalBackend
-from experiment_manager.results import read_csv, ResultsWriter
+from paper_case import run_on_cores
 from pick_sim_world.config import FIXED, RANDOM, SceneSpec, Vibration
 from pick_sim_world.containers import ContainerSpec
 from pick_sim_world.world import World
 from pick_validity.config import CAPACITOR_GRASPS, CheckConfig, Gripper, PlaceSpec
 from pick_validity.validity import Validator
-import yaml
 
 PROFILES = {
     'x + z in phase, 1 x 0.5 x 1 mm, 30 Hz, 1 s (fixed)':
@@ -50,8 +45,6 @@ FEEDER_PROFILES = {
     'vertical 1.5 mm + 3 mm horizontal, random direction':
         Vibration((0.003, 0.0, 0.0015), 30.0, 0.5, RANDOM),
 }
-TEST_CASE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src',
-                         'experiment_manager', 'config', 'test_case')
 FEEDER_PARTS = {'PTH0 (capacitor 5 x 11 mm)': 'pth0.yaml', 'PTH1 (TO-220)': 'pth1.yaml'}
 FEEDER_RANGES = ((20, 30), (50, 60), (70, 80))
 
@@ -78,19 +71,15 @@ def run(vibration: Vibration, seed: int, count: int = 55, shakes: int = 10) -> d
 def feeder_runs(part_file: str, vibration: Vibration, runs: int,
                 optimal_range: tuple[int, int]) -> list[dict]:
     """`runs` feeder_emptying iterations of 100 parts in `optimal_range`, on the cores."""
-    data = yaml.safe_load(open(os.path.join(TEST_CASE, part_file), encoding='utf-8'))
-    data['vibration'] = {'amplitude_mm': [a * 1000 for a in vibration.amplitude],
+    vibration_section = {'amplitude_mm': [a * 1000 for a in vibration.amplitude],
                          'frequency_hz': vibration.frequency,
                          'duration_s': vibration.duration, 'direction': vibration.direction}
-    data['experiments'] = [{'id': 'feeder', 'type': 'feeder_emptying', 'iterations': runs,
-                            'parts': 100, 'optimal_range': list(optimal_range),
-                            'max_vibrations': 300}]
-    file = config.parse(yaml.safe_dump(data), os.path.join(TEST_CASE, part_file))
-    with tempfile.TemporaryDirectory() as out:
-        with LocalBackend() as backend, ResultsWriter(out, file.text) as writer:
-            Runner(file, [backend], writer).run()
-        return read_csv(os.path.join(out, 'iterations.csv'))
-
+    rows, _ = run_on_cores(part_file, [{'id': 'feeder', 'type': 'feeder_emptying',
+                                        'iterations': runs, 'parts': 100,
+                                        'optimal_range': list(optimal_range),
+                                        'max_vibrations': 300}],
+                           vibration=vibration_section)
+    return rows
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
