@@ -14,7 +14,7 @@ import signal
 import subprocess
 import time
 
-from experiment_manager import config
+from experiment_manager import cli, config
 from experiment_manager.experiments import Runner
 from experiment_manager.launcher import executable, WORKER_NODES
 from experiment_manager.local_backend import LocalBackend
@@ -26,7 +26,9 @@ from pick_msgs.action import RunExperiment
 from pick_msgs.msg import ValidityReport
 from pick_sim_world.world import instance_seed
 import pytest
+import rclpy
 from rclpy.action import ActionClient
+from rclpy.signals import SignalHandlerOptions
 
 pytestmark = pytest.mark.graph
 NS = unique_namespace('exp')
@@ -290,7 +292,7 @@ def test_a_stopped_run_closes_its_files_and_resumes_to_the_same_results(
         tmp_path, client, core_run, private_ros_domain, signum):
     def interrupt(run: subprocess.Popen, ns: str) -> None:
         run.send_signal(signum)
-        assert run.wait(120) == 130
+        assert run.wait(120) == 130, run.stderr.read()
     run_dir, _ = _interrupted(tmp_path, client, interrupt)
     with open(os.path.join(run_dir, 'recording.mcap'), 'rb') as f:
         summary = make_reader(f).get_summary()      # closed: it has a summary
@@ -299,6 +301,38 @@ def test_a_stopped_run_closes_its_files_and_resumes_to_the_same_results(
     assert os.path.exists(os.path.join(run_dir, 'recording_2.mcap'))   # the resumed part
     for name in FILES:
         assert rows(run_dir, name) == rows(core_run, name), name
+
+
+@pytest.mark.parametrize('signum', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
+def test_a_signal_stops_run_between_two_callbacks_never_inside_one(private_ros_domain, signum):
+    """`run`'s handler only sets a flag; its spin loop raises KeyboardInterrupt after the
+    callback in progress returns. Raised inside rclpy's executor (the progress feedback runs as
+    each iteration ends, which is when a user or a test stops a run), it left the callback half
+    run and `run` once exited with 1 instead of 130."""
+    saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)     # as cli.main does
+    node = rclpy.create_node('signal_test', namespace=unique_namespace('exp_signal'))
+    events = []
+
+    def tick():
+        events.append('start')
+        if len(events) == 1:
+            os.kill(os.getpid(), signum)    # delivered before the next bytecode here
+        events.append('end')
+    try:
+        for s in saved:
+            signal.signal(s, cli._interrupt)      # as cli.main installs it
+        node.create_timer(0.01, tick)
+        with pytest.raises(KeyboardInterrupt):
+            cli._spin_until(node, lambda: False, [], 10.0)
+        assert events == ['start', 'end']
+        assert cli._spin_until(node, lambda: len(events) == 4, [], 10.0) is None
+        assert events == ['start', 'end'] * 2, 'a second spin loop runs on (the flag is reset)'
+    finally:
+        for s, handler in saved.items():
+            signal.signal(s, handler)
+        node.destroy_node()
+        rclpy.try_shutdown()
 
 
 def test_a_killed_manager_s_recording_is_recovered_and_its_run_resumed(

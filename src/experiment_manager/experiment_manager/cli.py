@@ -26,6 +26,7 @@ import os
 import signal
 import sys
 import tempfile
+import threading
 import time
 
 from ament_index_python.packages import get_package_share_directory
@@ -126,8 +127,16 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     return args
 
 
+# SIGINT and SIGTERM only set this; _spin_until raises KeyboardInterrupt between two spin_once
+# calls. Raised by the signal handler itself, it could land inside rclpy's executor (in the
+# progress feedback callback, which runs as each iteration ends, or while a message is taken)
+# and leave that task half run: the cancel that follows then failed and `run` exited with 1
+# instead of 130 (seen once in CI, on the SIGINT test).
+_STOP = threading.Event()
+
+
 def _interrupt(signum, frame) -> None:
-    raise KeyboardInterrupt
+    _STOP.set()
 
 
 def _dirs(name: str, paths) -> list[str]:
@@ -221,6 +230,8 @@ def main(argv: list[str] | None = None) -> int:
     log_dir = args.logs or tempfile.mkdtemp(prefix='pick_run_logs_')
     os.makedirs(log_dir, exist_ok=True)
     print(f'run: {len(goals)} experiment file(s); node logs in {log_dir}', file=sys.stderr)
+    signal.signal(signal.SIGINT, _interrupt)     # see _STOP
+    signal.signal(signal.SIGTERM, _interrupt)
     try:
         procs = _start_graph(args.namespace, log_dir, args.workers, goals, args.respawns)
     except FileNotFoundError as exc:
@@ -228,7 +239,6 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     # No rclpy signal handlers: Ctrl-C (or SIGTERM) must leave the context alive to cancel the
     # run and wait for the manager to close its files (rclpy's handler shuts it down first).
-    signal.signal(signal.SIGTERM, _interrupt)
     rclpy.init(args=['--ros-args', '-r', f'__ns:={args.namespace}'],
                signal_handler_options=SignalHandlerOptions.NO)
     node = Node('experiment_cli')
@@ -258,6 +268,9 @@ def _spin_until(node: Node, done, procs: list[NodeProcess], timeout: float) -> N
     """Spin until done() or timeout; returns a process that died meanwhile, if any."""
     deadline = time.monotonic() + timeout
     while not done() and time.monotonic() < deadline:
+        if _STOP.is_set():
+            _STOP.clear()       # a second signal stops the wait for the cancel as well
+            raise KeyboardInterrupt
         rclpy.spin_once(node, timeout_sec=0.1)
         dead = _dead(procs)
         if dead is not None:
