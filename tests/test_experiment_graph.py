@@ -157,6 +157,26 @@ def test_replay_republishes_a_topic_of_the_recording(graph_run, client):
     assert f'{NS}/worker_0/results' in info.stdout and 'attachment iterations.csv' in info.stdout
 
 
+def test_replay_stopped_with_sigint_says_how_far_it_got(graph_run, client):
+    _, recording, _ = graph_run
+    prefix = unique_namespace('replay_stop')
+    received = []
+    client.node.create_subscription(ValidityReport, f'{prefix}{NS}/worker_0/results',
+                                    received.append, 100)
+    replay = subprocess.Popen([executable('experiment_manager', 'replay'), recording,
+                               '--rate', '0.1', '--prefix', prefix,
+                               '--topics', f'{NS}/worker_0/results'],
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        assert client.wait(lambda: len(received) >= 1, 60.0), replay.communicate(timeout=30)[0]
+        replay.send_signal(signal.SIGINT)
+        output = replay.communicate(timeout=30)[0]
+    finally:
+        replay.kill()
+    assert replay.returncode == 130, output
+    assert 1 <= int(re.search(r'stopped after (\d+) messages', output).group(1)) < 10, output
+
+
 def test_a_bad_file_fails_before_any_node_starts(tmp_path):
     bad = tmp_path / 'bad.yaml'
     bad.write_text(open(SMALL).read().replace('max_vibrations: 15', 'max_vibrations: -3'))
