@@ -73,6 +73,59 @@ def test_the_papers_numbers_stand_beside_ours_for_its_test_case(run_dir, tmp_pat
     assert '1 iteration(s) flagged: physics_fault 1 (see Physics faults)' in text
 
 
+def _as_paper_says(summary: dict, paper: dict) -> dict:
+    """summary given the paper's figures and findings (pth0), within the 1.25 ratio."""
+    s = copy.deepcopy(summary)
+    s['id'] = 'pth0'
+    e, b = s['experiments']['emptying'], s['experiments']['bins']
+    w, f = s['experiments']['sweep'], s['experiments']['feeder']
+    e.update(emptied=0, iterations=40)
+    e['first_check']['valid']['mean'] = 0.0040      # paper 0.0036: ratio 1.11
+    e['removed']['mean'] = 0.7
+    b['bins'][b['best_bin']]['size_mm'] = b['best_bin_mm'] = [100.0, 175.0, 15.0]
+    b['bins'][b['best_bin']]['fractions']['container_free']['mean'] = 0.25
+    # 2500 - 0.25 (n - 49)^2 over n = 1..100: a peak at 49, 26 % lower at n = 100
+    w.update(per_n=[{'n': n, 'valid': {'mean': 0.0}} for n in range(1, 101)],
+             coefficients=[-0.25, 24.5, 2500.0 - 0.25 * 49.0 ** 2], n_star=49, fit_max=2500.0)
+    f.update(emptied=50, iterations=50, lost=0)
+    f['vibrations_to_empty']['mean'] = 130.0
+    return s
+
+
+def test_against_the_paper_says_which_findings_hold_and_why_figures_differ(run_dir):
+    paper = report.PAPER['pth0']
+    s = _as_paper_says(_summary(run_dir), paper)
+    text = '\n'.join(report.against_paper(s, paper))
+    assert text.count('| agrees |') == 3 and '| differs |' not in text, text
+    assert 'rise to n* = 49, then fall: 26 % below the peak at n = 100 (fit)' in text
+    assert '| best bin (mm) | 100 x 175 x 15 | 100 x 175 x 15 | the same |' in text
+    assert '| parts on the table at the optimum, n* | 49 | 49 | 1.00 |' in text
+    assert 'None does.' in text and '\n- ' not in text
+
+    s['experiments']['emptying']['emptied'] = 1
+    s['experiments']['sweep']['coefficients'] = [-0.01, 0.98, 2500.0 - 0.01 * 49.0 ** 2]
+    s['experiments']['feeder'].update(emptied=47, lost=4)
+    s['experiments']['feeder']['faults']['escaped'] = 3
+    s['experiments']['feeder']['vibrations_to_empty']['mean'] = 250.0
+    text = '\n'.join(report.against_paper(s, paper))
+    assert '| static bins never emptied (0 of 40) | 1 of 40 emptied | differs |' in text
+    assert 'then level off: 1 % below the peak' in text
+    assert '| the tray emptied in every feeder run (50 of 50) | 47 of 50 emptied | differs |' \
+        in text
+    assert '| vibrations to empty the feeder (mean) | 250 | 123.1 | 2.03 |' in text
+    reasons = [line for line in text.splitlines() if line.startswith('- ')]
+    assert [r.split(':')[0] for r in reasons[:3]] == ['- Static bins', '- Table optimum',
+                                                      '- Feeder']
+    assert reasons[3] == ("- 4 parts fell over the tray's wall, in 3 of 50 feeder runs; a run "
+                          'that loses a part has not emptied the feeder.')
+
+    s['experiments']['sweep'].update(n_star=100)
+    assert "still rising at the sweep's last count, n = 100" in '\n'.join(
+        report.against_paper(s, paper))
+    page = report.to_html(report.markdown(s, {}, {}), 'pth0')
+    assert '<h2>Against the paper</h2>' in page and page.count('<li>') == 4
+
+
 def test_pictures_re_simulate_the_recorded_iteration(run_dir):
 
     captions = pictures.write(config.load(os.path.join(run_dir, 'experiment.yaml')), run_dir)
