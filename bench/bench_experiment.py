@@ -4,8 +4,13 @@ iteration and type, the graph's ratio to the cores, the throughput of two worker
 one, the peak memory of each worker's processes, and whether the result files of the three are
 identical (they must be).
 
-    tools/ws python bench/bench_experiment.py [FILE] [--workers 1 2]
+    tools/ws python bench/bench_experiment.py [FILE] [--workers 1 2] [--paper-case RUN_DIR ...]
     (default: the built-in experiment file)
+
+--paper-case adds the wall time of the paper's full test case from the run directories of a
+run made before (about 5 hours on this machine, so not run here: `make run RUN_ARGS="--output
+DIR src/experiment_manager/config/test_case/pth0.yaml ...pth1.yaml ...pth2.yaml"`, resumed with
+`--resume RUN_DIR` if it was interrupted): the recordings' spans, summed over resumes.
 """
 
 import argparse
@@ -24,6 +29,7 @@ from experiment_manager.experiments import Runner
 from experiment_manager.launcher import executable
 from experiment_manager.local_backend import LocalBackend
 from experiment_manager.results import FILES, read_text_rows, ResultsWriter
+from paper_case import print_full_case
 
 
 def rows(directory: str, name: str, drop: tuple[str, ...] = ()) -> list[dict]:
@@ -98,6 +104,8 @@ def main() -> int:
     parser.add_argument('file', nargs='?', default=None)
     parser.add_argument('--workers', type=int, nargs=2, default=[1, 2], metavar=('A', 'B'),
                         help='the two worker counts to compare (default 1 2)')
+    parser.add_argument('--paper-case', nargs='+', default=[], metavar='RUN_DIR',
+                        help="run directories of the paper's full test case, made before")
     args = parser.parse_args()
     path = os.path.abspath(args.file or default_file())
     file = config.load(path)
@@ -142,6 +150,9 @@ def main() -> int:
               + ', '.join(f'{w} {kb / 1024:.0f} MiB' for w, kb in sorted(per_worker.items()))
               + f'; worker_0 and manager by node (MiB): {nodes}')
     print(f'result files identical (wall times aside): {identical}')
+    if args.paper_case:
+        print()
+        print_full_case(args.paper_case)
     return 0 if identical else 1
 
 

@@ -1,7 +1,10 @@
-"""The paper's test case files, and a variant of one run on the cores in this process, for the
-benchmarks (run them as `tools/ws python bench/NAME.py`: this directory is on the path)."""
+"""The paper's test case files, a variant of one run on the cores in this process, and the
+working time of a full run from its run directories, for the benchmarks (run them as
+`tools/ws python bench/NAME.py`: this directory is on the path)."""
 
 import os
+import re
+import struct
 import tempfile
 import time
 
@@ -9,6 +12,10 @@ from experiment_manager import config
 from experiment_manager.experiments import Runner
 from experiment_manager.local_backend import LocalBackend
 from experiment_manager.results import read_csv, ResultsWriter
+from mcap.exceptions import McapError
+from mcap.reader import make_reader
+from mcap.records import Message
+from mcap.stream_reader import StreamReader
 import yaml
 
 TEST_CASE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src',
@@ -31,3 +38,49 @@ def run_on_cores(part_file: str, experiments: list[dict],
             Runner(file, [backend], writer).run()
         wall = time.perf_counter() - start
         return read_csv(os.path.join(out, 'iterations.csv')), wall
+
+
+def recorded_spans(run_dir: str) -> list[float]:
+    """Seconds from the first message to the last of each recording of a run directory
+    (recording.mcap, then recording_<k>.mcap of each --resume): the run's working time
+    without the gaps between an interruption and its resume, nor the start of the processes
+    and the report. A recording cut off by a kill is read up to its tear."""
+    names = sorted((n for n in os.listdir(run_dir) if re.fullmatch(r'recording(_\d+)?\.mcap', n)),
+                   key=lambda n: int(re.sub(r'\D', '', n) or 1))
+    spans = []
+    for name in names:
+        with open(os.path.join(run_dir, name), 'rb') as f:
+            try:
+                summary = make_reader(f).get_summary()
+            except McapError:               # cut off: no footer
+                summary = None
+            if summary is not None and summary.statistics is not None:
+                stats = summary.statistics
+                first, last = stats.message_start_time, stats.message_end_time
+            else:
+                f.seek(0)
+                first, last = None, None
+                try:
+                    for record in StreamReader(f).records:
+                        if isinstance(record, Message):
+                            first = record.log_time if first is None else first
+                            last = record.log_time
+                except (McapError, struct.error):     # the tear
+                    pass
+        if first is not None:
+            spans.append((last - first) / 1e9)
+    return spans
+
+
+def print_full_case(run_dirs: list[str]) -> None:
+    """The working time of the paper's full test case from its run directories."""
+    total = 0.0
+    for run_dir in run_dirs:
+        spans = recorded_spans(run_dir)
+        iterations = len(read_csv(os.path.join(run_dir, 'iterations.csv')))
+        total += sum(spans)
+        print(f'{os.path.basename(run_dir.rstrip("/"))}: {iterations} iterations, '
+              f'{sum(spans) / 60:.1f} min in {len(spans)} segment(s) '
+              f'({", ".join(f"{s / 60:.1f}" for s in spans)})')
+    print(f"the paper's test case, full counts: {total / 60:.1f} min of recorded work "
+          f'({total / 3600:.2f} h; starting the processes and the reports not included)')
