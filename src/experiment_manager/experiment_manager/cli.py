@@ -130,8 +130,8 @@ def _parse(argv: list[str]) -> argparse.Namespace:
 # SIGINT and SIGTERM only set this; _spin_until raises KeyboardInterrupt between two spin_once
 # calls. Raised by the signal handler itself, it could land inside rclpy's executor (in the
 # progress feedback callback, which runs as each iteration ends, or while a message is taken)
-# and leave that task half run: the cancel that follows then failed and `run` exited with 1
-# instead of 130 (seen once in CI, on the SIGINT test).
+# and leave that work half done: the likely cause of `run` exiting once with 1 instead of 130
+# on the SIGINT test in CI.
 _STOP = threading.Event()
 
 
