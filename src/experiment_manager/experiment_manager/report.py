@@ -62,6 +62,11 @@ def _fmt(value, digits: int = 3) -> str:
     return str(value)
 
 
+def _count(n: int, noun: str) -> str:
+    """'1 part', '35 parts': the report's sentences say a count as it is read."""
+    return f'{n} {noun}' + ('' if n == 1 else 's')
+
+
 def _pct(value) -> str:
     return '-' if value is None else f'{100 * value:.1f} %'
 
@@ -103,7 +108,7 @@ def verdicts(summary: dict, spec: dict) -> list[dict]:
                            f'refill interval allows one vibration every '
                            f'{_fmt(s["minutes_per_vibration_allowed"])} min')
         if s['lost']:
-            reasons.append(f'{s["lost"]} parts fell off the table')
+            reasons.append(f'{_count(s["lost"], "part")} fell off the table')
         ok = s['iterations'] > 0 and s['emptied'] == s['iterations']
         reasons += _fault_reason(s)
         if s['parts'] < capacity:
@@ -176,7 +181,7 @@ def _fault_reason(s: dict) -> list[str]:
     f = s['faults']
     if not f['flagged']:
         return []
-    return [f'{len(f["flagged"])} iteration(s) flagged: ' + ', '.join(
+    return [f'{_count(len(f["flagged"]), "iteration")} flagged: ' + ', '.join(
         f'{k} {f[k]}' for k in FAULTS if f[k])
         + ' (see Physics faults)']
 
@@ -385,7 +390,7 @@ def against_paper(summary: dict, paper: dict) -> list[str]:
               + (' Where this run differs, and why:' if differ else ' None does.')]
     lines += [f'- {why[k]}' for k in ('bins', 'table', 'feeder') if k in differ]
     if f and f['lost']:
-        lines.append(f'- {f["lost"]} parts fell over the tray\'s wall, in '
+        lines.append(f'- {_count(f["lost"], "part")} fell over the tray\'s wall, in '
                      f'{f["faults"]["escaped"]} of {f["iterations"]} feeder runs; a run that '
                      'loses a part has not emptied the feeder.')
     lines += ['', 'No setting of the simulation was tuned to agree with the paper.']

@@ -47,8 +47,9 @@ def test_verdicts_follow_the_emptied_runs_and_the_capacity(run_dir):
     s['experiments']['emptying'].update(emptied=1, iterations=1)
     s['experiments']['feeder'].update(emptied=1, iterations=1)
     assert [v['verdict'] for v in report.verdicts(s, {})] == [FEASIBLE, FEASIBLE]
-    s['experiments']['feeder']['emptied'] = 0
-    assert [v['verdict'] for v in report.verdicts(s, {})] == [FEASIBLE, NOT_FEASIBLE]
+    s['experiments']['feeder'].update(emptied=0, lost=1)
+    table = report.verdicts(s, {})[1]
+    assert table['verdict'] == NOT_FEASIBLE and '1 part fell off the table' in table['reasons']
     s['requirements']['capacity'] = 480         # 30 parts cannot last a refill interval
     bin_verdict = report.verdicts(s, {})[0]
     assert bin_verdict['verdict'] == NOT_FEASIBLE
@@ -70,7 +71,7 @@ def test_the_papers_numbers_stand_beside_ours_for_its_test_case(run_dir, tmp_pat
     assert '| paper | 50 | 480 | 17-27 | 50 | 167 |' in text
     assert 'paper: n* = 22, 17-27' in text
     assert '| `feeder` | 1 | 1 | 0 | 0 |' in text
-    assert '1 iteration(s) flagged: physics_fault 1 (see Physics faults)' in text
+    assert '1 iteration flagged: physics_fault 1 (see Physics faults)' in text
 
 
 def _as_paper_says(summary: dict, paper: dict) -> dict:
