@@ -137,18 +137,25 @@ def test_every_recorded_message_decodes_and_matches_the_results(graph_run):
             assert attachments[name] == f.read(), name
 
 
-def test_replay_republishes_a_topic_of_the_recording(graph_run, client):
-    _, recording, _ = graph_run
-    prefix = unique_namespace('replay')
-    expected = sum(1 for _ in make_reader(open(recording, 'rb')).iter_messages(
-        topics=[f'{NS}/worker_0/results']))
-    received = []
+def start_replay(client, recording: str, name: str, rate: str) -> tuple[subprocess.Popen, list]:
+    """`replay` of worker_0's results at `rate` under the prefix `name` (one per test: no test
+    hears another's replay), and the list that receives what it publishes."""
+    prefix = unique_namespace(name)
+    received: list = []
     client.node.create_subscription(ValidityReport, f'{prefix}{NS}/worker_0/results',
                                     received.append, 100)
     replay = subprocess.Popen([executable('experiment_manager', 'replay'), recording,
-                               '--rate', '100', '--prefix', prefix,
+                               '--rate', rate, '--prefix', prefix,
                                '--topics', f'{NS}/worker_0/results'],
                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    return replay, received
+
+
+def test_replay_republishes_a_topic_of_the_recording(graph_run, client):
+    _, recording, _ = graph_run
+    expected = sum(1 for _ in make_reader(open(recording, 'rb')).iter_messages(
+        topics=[f'{NS}/worker_0/results']))
+    replay, received = start_replay(client, recording, 'replay', '100')
     assert client.wait(lambda: len(received) == expected, 60.0), (
         f'{len(received)} of {expected}: {replay.communicate()[0]}')
     assert replay.wait(30) == 0
@@ -159,14 +166,7 @@ def test_replay_republishes_a_topic_of_the_recording(graph_run, client):
 
 def test_replay_stopped_with_sigint_says_how_far_it_got(graph_run, client):
     _, recording, _ = graph_run
-    prefix = unique_namespace('replay_stop')
-    received = []
-    client.node.create_subscription(ValidityReport, f'{prefix}{NS}/worker_0/results',
-                                    received.append, 100)
-    replay = subprocess.Popen([executable('experiment_manager', 'replay'), recording,
-                               '--rate', '0.1', '--prefix', prefix,
-                               '--topics', f'{NS}/worker_0/results'],
-                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    replay, received = start_replay(client, recording, 'replay_stop', '0.1')
     try:
         assert client.wait(lambda: len(received) >= 1, 60.0), replay.communicate(timeout=30)[0]
         replay.send_signal(signal.SIGINT)
