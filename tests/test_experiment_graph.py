@@ -14,7 +14,7 @@ import signal
 import subprocess
 import time
 
-from experiment_manager import cli, config
+from experiment_manager import cli, config, interrupt
 from experiment_manager.experiments import Runner
 from experiment_manager.launcher import executable, WORKER_NODES
 from experiment_manager.local_backend import LocalBackend
@@ -325,10 +325,10 @@ def test_a_stopped_run_closes_its_files_and_resumes_to_the_same_results(
 
 @pytest.mark.parametrize('signum', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
 def test_a_signal_stops_run_between_two_callbacks_never_inside_one(private_ros_domain, signum):
-    """`run`'s handler only sets a flag; its spin loop raises KeyboardInterrupt after the
-    callback in progress returns. Raised inside rclpy's executor (the progress feedback runs as
-    each iteration ends, which is when a user or a test stops a run), it left the callback half
-    run and `run` once exited with 1 instead of 130."""
+    """`run`'s handler (`interrupt`) only sets a flag; its spin loop raises KeyboardInterrupt
+    after the callback in progress returns. Raised inside rclpy's executor (the progress
+    feedback runs as each iteration ends, which is when a user or a test stops a run), it left
+    the callback half run and `run` once exited with 1 instead of 130."""
     saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)     # as cli.main does
     node = rclpy.create_node('signal_test', namespace=unique_namespace('exp_signal'))
@@ -340,8 +340,7 @@ def test_a_signal_stops_run_between_two_callbacks_never_inside_one(private_ros_d
             os.kill(os.getpid(), signum)    # delivered before the next bytecode here
         events.append('end')
     try:
-        for s in saved:
-            signal.signal(s, cli._interrupt)      # as cli.main installs it
+        interrupt.install()                 # as cli.main does
         node.create_timer(0.01, tick)
         with pytest.raises(KeyboardInterrupt):
             cli._spin_until(node, lambda: False, [], 10.0)

@@ -23,10 +23,8 @@ import argparse
 import collections
 import json
 import os
-import signal
 import sys
 import tempfile
-import threading
 import time
 
 from ament_index_python.packages import get_package_share_directory
@@ -38,7 +36,7 @@ from rclpy.action import ActionClient
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
-from . import config
+from . import config, interrupt
 from .launcher import MANAGER, NodeProcess, READS_MESHES, WORKER_NODES
 
 MAX_WORKERS = 64
@@ -125,18 +123,6 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     if not 1 <= args.workers <= MAX_WORKERS:
         parser.error(f'--workers {args.workers} must be within [1, {MAX_WORKERS}]')
     return args
-
-
-# SIGINT and SIGTERM only set this; _spin_until raises KeyboardInterrupt between two spin_once
-# calls. Raised by the signal handler itself, it could land inside rclpy's executor (in the
-# progress feedback callback, which runs as each iteration ends, or while a message is taken)
-# and leave that work half done: the likely cause of `run` exiting once with 1 instead of 130
-# on the SIGINT test in CI.
-_STOP = threading.Event()
-
-
-def _interrupt(signum, frame) -> None:
-    _STOP.set()
 
 
 def _dirs(name: str, paths) -> list[str]:
@@ -230,8 +216,7 @@ def main(argv: list[str] | None = None) -> int:
     log_dir = args.logs or tempfile.mkdtemp(prefix='pick_run_logs_')
     os.makedirs(log_dir, exist_ok=True)
     print(f'run: {len(goals)} experiment file(s); node logs in {log_dir}', file=sys.stderr)
-    signal.signal(signal.SIGINT, _interrupt)     # see _STOP
-    signal.signal(signal.SIGTERM, _interrupt)
+    interrupt.install()     # _spin_until stops between two spin_once calls, never inside one
     try:
         procs = _start_graph(args.namespace, log_dir, args.workers, goals, args.respawns)
     except FileNotFoundError as exc:
@@ -268,9 +253,7 @@ def _spin_until(node: Node, done, procs: list[NodeProcess], timeout: float) -> N
     """Spin until done() or timeout; returns a process that died meanwhile, if any."""
     deadline = time.monotonic() + timeout
     while not done() and time.monotonic() < deadline:
-        if _STOP.is_set():
-            _STOP.clear()       # a second signal stops the wait for the cancel as well
-            raise KeyboardInterrupt
+        interrupt.check()       # a second signal stops the wait for the cancel as well
         rclpy.spin_once(node, timeout_sec=0.1)
         dead = _dead(procs)
         if dead is not None:

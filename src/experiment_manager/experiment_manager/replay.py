@@ -8,7 +8,8 @@ divided by the rate; `scene` and `markers` are latched (transient local) as the 
 them. --info lists the topics, types, message counts and attachments, and exits. Payloads are
 published as recorded (CDR, no decode), so any type in the file replays if its package is
 installed. --recover copies every complete record of a recording cut off before it was closed
-(its manager was killed) into a closed file that every reader opens, and exits.
+(its manager was killed) into a closed file that every reader opens, and exits. SIGINT or
+SIGTERM stops a replay before its next message (exit 130, "stopped after N messages").
 """
 
 import argparse
@@ -25,7 +26,9 @@ import rclpy
 from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
 
+from . import interrupt
 from .recording import recover
 
 LATCHED_TOPICS = ('scene', 'markers')
@@ -104,7 +107,8 @@ def main(argv: list[str] | None = None) -> int:
     except (OSError, McapError) as exc:
         print(f'replay: {args.recording}: {exc}', file=sys.stderr)
         return 2
-    rclpy.init()
+    interrupt.install()
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     node = Node('replay')
     publishers: dict[int, object] = {}
     sent = 0
@@ -122,17 +126,15 @@ def main(argv: list[str] | None = None) -> int:
                     msg_type, topic, LATCHED if latched else STREAM)
                 deadline = time.monotonic() + MATCH_WAIT
                 while pub.get_subscription_count() == 0 and time.monotonic() < deadline:
-                    time.sleep(0.02)
+                    interrupt.sleep(0.02)
                 if start_log is not None:   # keep the recorded spacing after the wait
                     start_wall = time.monotonic() - (
                         message.log_time - start_log) / 1e9 / args.rate
             if start_log is None:
                 start_log, start_wall = message.log_time, time.monotonic()
             due = start_wall + (message.log_time - start_log) / 1e9 / args.rate
-            delay = due - time.monotonic()
-            if delay > 0:
-                time.sleep(delay)
-            pub.publish(message.data)
+            interrupt.sleep(due - time.monotonic())     # SIGINT, SIGTERM: stop here, not
+            pub.publish(message.data)                   # between a publish and its count
             sent += 1
         for pub in publishers.values():   # exiting at once would drop messages still in flight
             pub.wait_for_all_acked(Duration(seconds=ACK_WAIT))
