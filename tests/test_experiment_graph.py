@@ -243,8 +243,8 @@ def _world_pid(namespace: str) -> int:
     return _pid(f'{namespace}/worker_0', 'lib/pick_sim_world/world')
 
 
-def test_a_second_goal_is_busy_and_a_killed_last_worker_ends_the_run(tmp_path, client,
-                                                                     private_ros_domain):
+def test_a_second_goal_or_run_is_refused_and_a_killed_last_worker_ends_the_run(
+        tmp_path, client, private_ros_domain):
     ns = unique_namespace('exp_kill')
     path = tmp_path / 'long.yaml'
     path.write_text(LONG)
@@ -260,6 +260,12 @@ def test_a_second_goal_is_busy_and_a_killed_last_worker_ends_the_run(tmp_path, c
             experiment_file=str(path), output_dir=str(tmp_path / 'other'))))
         busy = client.result(handle.get_result_async()).result
         assert busy.error_code == RunExperiment.Result.BUSY and 'not queued' in busy.error_msg
+        # a second `run` in the namespace starts no node beside the running ones
+        second = run_command(str(path), '--output', str(tmp_path / 'second'), '--namespace', ns,
+                             '--workers', '1', timeout=120)
+        assert second.returncode == 2, second.stderr
+        assert re.search(rf"namespace '{ns}' of ROS domain \d+ already has {ns}/"
+                         r'(experiment_manager|worker_0/)', second.stderr), second.stderr
 
         os.kill(_world_pid(ns), signal.SIGKILL)
         stdout, stderr = run.communicate(timeout=120)
@@ -276,6 +282,7 @@ def test_a_second_goal_is_busy_and_a_killed_last_worker_ends_the_run(tmp_path, c
     assert summary is not None and summary.statistics.message_count > 0
     assert {a.name for a in summary.attachment_indexes} >= {'experiment.yaml', 'iterations.csv'}
     assert not os.path.exists(tmp_path / 'other'), 'the busy goal wrote nothing'
+    assert not os.path.exists(tmp_path / 'second'), 'the refused run wrote nothing'
 
 
 def _pid(namespace: str, executable_path: str) -> int:
@@ -310,10 +317,10 @@ def _interrupted(tmp_path, client, stop: Callable[[subprocess.Popen, str], None]
 @pytest.mark.parametrize('signum', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
 def test_a_stopped_run_closes_its_files_and_resumes_to_the_same_results(
         tmp_path, client, core_run, private_ros_domain, signum):
-    def interrupt(run: subprocess.Popen, ns: str) -> None:
+    def stop(run: subprocess.Popen, ns: str) -> None:
         run.send_signal(signum)
         assert run.wait(120) == 130, run.stderr.read()
-    run_dir, _ = _interrupted(tmp_path, client, interrupt)
+    run_dir, _ = _interrupted(tmp_path, client, stop)
     with open(os.path.join(run_dir, 'recording.mcap'), 'rb') as f:
         summary = make_reader(f).get_summary()      # closed: it has a summary
     assert summary.statistics.message_count > 0

@@ -43,6 +43,12 @@ MAX_WORKERS = 64
 START_TIMEOUT = 60.0    # s for the manager's action server to appear
 RESPAWNS = 3            # times a worker node that died is started again, per run
 STOP_TIMEOUT = 30.0     # s for a canceled run to close its files
+DISCOVERY_WAIT = 3.0    # s to discover a graph already running in the namespace (Fast DDS on
+                        # this 2-core host under full load: 0.2-2.0 s, measured 2026-11-23)
+
+
+class NamespaceInUse(Exception):
+    """Another graph runs the nodes `run` would start."""
 
 
 def default_workers() -> int:
@@ -132,12 +138,33 @@ def _dirs(name: str, paths) -> list[str]:
     return ['-p', f'{name}:={json.dumps(paths)}'] if paths else []
 
 
+def _ns(namespace: str) -> str:
+    """'/a/b' for 'a/b/', '' for the root namespace."""
+    return '/' + namespace.strip('/') if namespace.strip('/') else ''
+
+
+def _already_running(node: Node, namespace: str, workers: int) -> list[str]:
+    """The nodes of the graph `run` would start that the ROS domain already has (another
+    `run` in the same namespace), found within DISCOVERY_WAIT. Started beside them, ours would
+    serve the same names, and the running graph's calls could be answered by our nodes."""
+    ns = _ns(namespace)
+    ours = {f'{ns}/{MANAGER[1]}'} | {f'{ns}/worker_{k}/{exe}' for k in range(workers)
+                                     for _, exe in WORKER_NODES}
+    deadline = time.monotonic() + DISCOVERY_WAIT
+    while True:
+        found = ours & {f'{space.rstrip("/")}/{name}'
+                        for name, space in node.get_node_names_and_namespaces()}
+        if found or time.monotonic() >= deadline:
+            return sorted(found)
+        interrupt.sleep(0.1)
+
+
 def _start_graph(namespace: str, log_dir: str, workers: int,
                  goals: list[tuple[RunExperiment.Goal, str]], respawns: int
                  ) -> list[NodeProcess]:
     """The workers' nodes, then the manager (last). Each may read and write only where the
     goals need: their files' and meshes' directories, and their output directories."""
-    ns = '/' + namespace.strip('/') if namespace.strip('/') else ''
+    ns = _ns(namespace)
     names = [f'worker_{k}' for k in range(workers)]
     meshes = [os.path.dirname(mesh) for _, mesh in goals if mesh]
     procs = []
@@ -217,16 +244,27 @@ def main(argv: list[str] | None = None) -> int:
     os.makedirs(log_dir, exist_ok=True)
     print(f'run: {len(goals)} experiment file(s); node logs in {log_dir}', file=sys.stderr)
     interrupt.install()     # _spin_until stops between two spin_once calls, never inside one
-    try:
-        procs = _start_graph(args.namespace, log_dir, args.workers, goals, args.respawns)
-    except FileNotFoundError as exc:
-        print(f'run: {exc}', file=sys.stderr)
-        return 2
     # No rclpy signal handlers: Ctrl-C (or SIGTERM) must leave the context alive to cancel the
     # run and wait for the manager to close its files (rclpy's handler shuts it down first).
     rclpy.init(args=['--ros-args', '-r', f'__ns:={args.namespace}'],
                signal_handler_options=SignalHandlerOptions.NO)
     node = Node('experiment_cli')
+    try:
+        running = _already_running(node, args.namespace, args.workers)
+        if running:
+            raise NamespaceInUse(
+                f'namespace {_ns(args.namespace) or "/"!r} of ROS domain '
+                f'{node.context.get_domain_id()} already has {", ".join(running)} (another '
+                '`run`, or one killed less than about 20 s ago): ours would answer to the same '
+                'names. Pass --namespace with another namespace, or set another ROS_DOMAIN_ID')
+        procs = _start_graph(args.namespace, log_dir, args.workers, goals, args.respawns)
+    except (FileNotFoundError, NamespaceInUse, KeyboardInterrupt) as exc:
+        node.destroy_node()
+        rclpy.try_shutdown()
+        if isinstance(exc, KeyboardInterrupt):
+            return 130
+        print(f'run: {exc}', file=sys.stderr)
+        return 2
     client = ActionClient(node, RunExperiment, 'run_experiment')
     bar = ProgressBar()
     graph = Graph(procs, args.respawns)
