@@ -21,6 +21,7 @@ its files closed).
 
 import argparse
 import collections
+import fcntl
 import json
 import os
 import sys
@@ -44,7 +45,8 @@ START_TIMEOUT = 60.0    # s for the manager's action server to appear
 RESPAWNS = 3            # times a worker node that died is started again, per run
 STOP_TIMEOUT = 30.0     # s for a canceled run to close its files
 DISCOVERY_WAIT = 3.0    # s to discover a graph already running in the namespace (Fast DDS on
-                        # this 2-core host under full load: 0.2-2.0 s, measured 2026-11-23)
+                        # this 2-core host under full load: 0.2-2.0 s, measured 2026-11-23;
+                        # over 3 s once, with CI beside it)
 
 
 class NamespaceInUse(Exception):
@@ -143,10 +145,51 @@ def _ns(namespace: str) -> str:
     return '/' + namespace.strip('/') if namespace.strip('/') else ''
 
 
+def _claim(node: Node, namespace: str, workers: int):
+    """The namespace for this run's graph, or NamespaceInUse naming who has it: another `run`
+    on this host (_lock, certain) or nodes of our names in the graph (_already_running, best
+    effort: another host). Returns the lock file, to keep open."""
+    domain, where = node.context.get_domain_id(), repr(_ns(namespace) or '/')
+    advice = ('ours would answer to the same names. Pass --namespace with another namespace, '
+              'or set another ROS_DOMAIN_ID')
+    lock = _lock(domain, namespace)
+    if isinstance(lock, str):
+        raise NamespaceInUse(f'namespace {where} of ROS domain {domain} is taken by `run` '
+                             f'(pid {lock}) on this host: {advice}')
+    running = _already_running(node, namespace, workers)
+    if running:
+        lock.close()
+        raise NamespaceInUse(f'namespace {where} of ROS domain {domain} already has '
+                             f'{", ".join(running)} (another `run`, or one killed less than '
+                             f'about 20 s ago): {advice}')
+    return lock
+
+
+def _lock(domain: int, namespace: str):
+    """Take (ROS domain, namespace) for this process's life, against other `run`s on this host:
+    the open lock file, or the pid of the `run` that holds it. flock, so a `run` killed with
+    SIGKILL leaves no stale lock (and, unlike the graph, nothing to wait out)."""
+    name = f'pick_run.{os.getuid()}.domain_{domain}{_ns(namespace).replace("/", ".")}.lock'
+    f = open(os.path.join(tempfile.gettempdir(), name), 'a+')
+    try:
+        fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        f.seek(0)
+        holder = f.read().strip() or '?'
+        f.close()
+        return holder
+    f.truncate(0)
+    f.write(str(os.getpid()))
+    f.flush()
+    return f
+
+
 def _already_running(node: Node, namespace: str, workers: int) -> list[str]:
     """The nodes of the graph `run` would start that the ROS domain already has (another
-    `run` in the same namespace), found within DISCOVERY_WAIT. Started beside them, ours would
-    serve the same names, and the running graph's calls could be answered by our nodes."""
+    `run` in the same namespace, on another host: _lock covers this one), found within
+    DISCOVERY_WAIT, which is best effort (discovery took longer on a loaded host). Started
+    beside them, ours would serve the same names, and the running graph's calls could be
+    answered by our nodes."""
     ns = _ns(namespace)
     ours = {f'{ns}/{MANAGER[1]}'} | {f'{ns}/worker_{k}/{exe}' for k in range(workers)
                                      for _, exe in WORKER_NODES}
@@ -250,13 +293,7 @@ def main(argv: list[str] | None = None) -> int:
                signal_handler_options=SignalHandlerOptions.NO)
     node = Node('experiment_cli')
     try:
-        running = _already_running(node, args.namespace, args.workers)
-        if running:
-            raise NamespaceInUse(
-                f'namespace {_ns(args.namespace) or "/"!r} of ROS domain '
-                f'{node.context.get_domain_id()} already has {", ".join(running)} (another '
-                '`run`, or one killed less than about 20 s ago): ours would answer to the same '
-                'names. Pass --namespace with another namespace, or set another ROS_DOMAIN_ID')
+        lock = _claim(node, args.namespace, args.workers)   # released after our nodes stop
         procs = _start_graph(args.namespace, log_dir, args.workers, goals, args.respawns)
     except (FileNotFoundError, NamespaceInUse, KeyboardInterrupt) as exc:
         node.destroy_node()
@@ -285,6 +322,7 @@ def main(argv: list[str] | None = None) -> int:
         rclpy.try_shutdown()
         for p in graph.procs:   # SIGINT: the manager cancels its run and closes its files
             p.stop()
+        lock.close()            # the namespace is free once our nodes are gone
 
 
 def _spin_until(node: Node, done, procs: list[NodeProcess], timeout: float) -> NodeProcess | None:
