@@ -27,6 +27,7 @@ import os
 import sys
 import tempfile
 import time
+from typing import IO
 
 from ament_index_python.packages import get_package_share_directory
 from pick_msgs.action import RunExperiment
@@ -145,7 +146,7 @@ def _ns(namespace: str) -> str:
     return '/' + namespace.strip('/') if namespace.strip('/') else ''
 
 
-def _claim(node: Node, namespace: str, workers: int):
+def _claim(node: Node, namespace: str, workers: int) -> IO[str]:
     """The namespace for this run's graph, or NamespaceInUse naming who has it: another `run`
     on this host (_lock, certain) or nodes of our names in the graph (_already_running, best
     effort: another host). Returns the lock file, to keep open."""
@@ -165,7 +166,7 @@ def _claim(node: Node, namespace: str, workers: int):
     return lock
 
 
-def _lock(domain: int, namespace: str):
+def _lock(domain: int, namespace: str) -> IO[str] | str:
     """Take (ROS domain, namespace) for this process's life, against other `run`s on this host:
     the open lock file, or the pid of the `run` that holds it. flock, so a `run` killed with
     SIGKILL leaves no stale lock (and, unlike the graph, nothing to wait out)."""
