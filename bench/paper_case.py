@@ -4,18 +4,17 @@ working time of a full run from its run directories, for the benchmarks (run the
 
 import os
 import re
-import struct
 import tempfile
 import time
 
 from experiment_manager import config
 from experiment_manager.experiments import Runner
 from experiment_manager.local_backend import LocalBackend
+from experiment_manager.recording import CompleteRecords
 from experiment_manager.results import read_csv, ResultsWriter
 from mcap.exceptions import McapError
 from mcap.reader import make_reader
 from mcap.records import Message
-from mcap.stream_reader import StreamReader
 import yaml
 
 TEST_CASE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src',
@@ -60,13 +59,10 @@ def recorded_spans(run_dir: str) -> list[float]:
             else:
                 f.seek(0)
                 first, last = None, None
-                try:
-                    for record in StreamReader(f).records:
-                        if isinstance(record, Message):
-                            first = record.log_time if first is None else first
-                            last = record.log_time
-                except (McapError, struct.error):     # the tear
-                    pass
+                for record in CompleteRecords(f):
+                    if isinstance(record, Message):
+                        first = record.log_time if first is None else first
+                        last = record.log_time
         if first is not None:
             spans.append((last - first) / 1e9)
     return spans

@@ -149,6 +149,21 @@ class Recorder:
         self.close()
 
 
+class CompleteRecords:
+    """The complete records of an MCAP stream in file order, up to its tear if it has one (a
+    record cut off, or its CRC wrong: what a manager killed before close() leaves); `torn`
+    says afterwards whether there was one."""
+
+    def __init__(self, f) -> None:
+        self._f, self.torn = f, False
+
+    def __iter__(self) -> Iterator:
+        try:
+            yield from StreamReader(self._f, validate_crcs=True).records
+        except (McapError, struct.error):
+            self.torn = True
+
+
 def recover(source: str, target: str) -> dict[str, int]:
     """Copy every complete record of a recording into a new file, closed with its summary and
     indexes: what a manager killed before close() leaves becomes a file every reader opens.
@@ -160,35 +175,32 @@ def recover(source: str, target: str) -> dict[str, int]:
     channels: dict[int, int] = {}
     with open(source, 'rb') as f, open(target, 'wb') as out:
         writer = None
-        try:
-            for record in StreamReader(f, validate_crcs=True).records:
-                if isinstance(record, Header):
-                    writer = Writer(out, compression=CompressionType.ZSTD)
-                    writer.start(profile=record.profile, library=record.library)
-                elif isinstance(record, Schema):
-                    schemas[record.id] = writer.register_schema(record.name, record.encoding,
-                                                                record.data)
-                    counts['schemas'] += 1
-                elif isinstance(record, Channel):
-                    channels[record.id] = writer.register_channel(
-                        record.topic, record.message_encoding, schemas.get(record.schema_id, 0),
-                        record.metadata)
-                    counts['channels'] += 1
-                elif isinstance(record, Message):
-                    writer.add_message(channels[record.channel_id], record.log_time,
-                                       record.data, record.publish_time, record.sequence)
-                    counts['messages'] += 1
-                elif isinstance(record, Attachment):
-                    writer.add_attachment(record.create_time, record.log_time, record.name,
-                                          record.media_type, record.data)
-                    counts['attachments'] += 1
-                elif isinstance(record, Metadata):
-                    writer.add_metadata(record.name, record.metadata)
-                    counts['metadata'] += 1
-        except (McapError, struct.error):   # the tear: a record cut off (or its CRC wrong)
-            if writer is None:
-                raise McapError(f'{source} does not start as an MCAP file') from None
-            counts['torn'] = 1
+        records = CompleteRecords(f)
+        for record in records:
+            if isinstance(record, Header):
+                writer = Writer(out, compression=CompressionType.ZSTD)
+                writer.start(profile=record.profile, library=record.library)
+            elif isinstance(record, Schema):
+                schemas[record.id] = writer.register_schema(record.name, record.encoding,
+                                                            record.data)
+                counts['schemas'] += 1
+            elif isinstance(record, Channel):
+                channels[record.id] = writer.register_channel(
+                    record.topic, record.message_encoding, schemas.get(record.schema_id, 0),
+                    record.metadata)
+                counts['channels'] += 1
+            elif isinstance(record, Message):
+                writer.add_message(channels[record.channel_id], record.log_time,
+                                   record.data, record.publish_time, record.sequence)
+                counts['messages'] += 1
+            elif isinstance(record, Attachment):
+                writer.add_attachment(record.create_time, record.log_time, record.name,
+                                      record.media_type, record.data)
+                counts['attachments'] += 1
+            elif isinstance(record, Metadata):
+                writer.add_metadata(record.name, record.metadata)
+                counts['metadata'] += 1
+        counts['torn'] = int(records.torn)
         if writer is None:
             raise McapError(f'{source} does not start as an MCAP file')
         writer.finish()
