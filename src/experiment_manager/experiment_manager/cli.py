@@ -150,26 +150,27 @@ def _claim(node: Node, namespace: str, workers: int) -> IO[str]:
     """The namespace for this run's graph, or NamespaceInUse naming who has it: another `run`
     on this host (_lock, certain) or nodes of our names in the graph (_already_running, best
     effort: another host). Returns the lock file, to keep open."""
-    domain, where = node.context.get_domain_id(), repr(_ns(namespace) or '/')
-    advice = ('ours would answer to the same names. Pass --namespace with another namespace, '
-              'or set another ROS_DOMAIN_ID')
+    domain = node.context.get_domain_id()
     lock = _lock(domain, namespace)
-    if isinstance(lock, str):
-        raise NamespaceInUse(f'namespace {where} of ROS domain {domain} is taken by `run` '
-                             f'(pid {lock}) on this host: {advice}')
     running = _already_running(node, namespace, workers)
     if running:
         lock.close()
-        raise NamespaceInUse(f'namespace {where} of ROS domain {domain} already has '
-                             f'{", ".join(running)} (another `run`, or one killed less than '
-                             f'about 20 s ago): {advice}')
+        raise _in_use(domain, namespace, f'already has {", ".join(running)} (another `run`, or '
+                      'one killed less than about 20 s ago)')
     return lock
 
 
-def _lock(domain: int, namespace: str) -> IO[str] | str:
+def _in_use(domain: int, namespace: str, why: str) -> NamespaceInUse:
+    return NamespaceInUse(f'namespace {_ns(namespace) or "/"!r} of ROS domain {domain} {why}: '
+                          'ours would answer to the same names. Pass --namespace with another '
+                          'namespace, or set another ROS_DOMAIN_ID')
+
+
+def _lock(domain: int, namespace: str) -> IO[str]:
     """Take (ROS domain, namespace) for this process's life, against other `run`s on this host:
-    the open lock file, or the pid of the `run` that holds it. flock, so a `run` killed with
-    SIGKILL leaves no stale lock (and, unlike the graph, nothing to wait out)."""
+    the open lock file, or NamespaceInUse naming the pid of the `run` that holds it. flock, so
+    a `run` killed with SIGKILL leaves no stale lock (and, unlike the graph, nothing to wait
+    out)."""
     name = f'pick_run.{os.getuid()}.domain_{domain}{_ns(namespace).replace("/", ".")}.lock'
     f = open(os.path.join(tempfile.gettempdir(), name), 'a+')
     try:
@@ -178,7 +179,8 @@ def _lock(domain: int, namespace: str) -> IO[str] | str:
         f.seek(0)
         holder = f.read().strip() or '?'
         f.close()
-        return holder
+        raise _in_use(domain, namespace,
+                      f'is taken by `run` (pid {holder}) on this host') from None
     f.truncate(0)
     f.write(str(os.getpid()))
     f.flush()
@@ -293,37 +295,36 @@ def main(argv: list[str] | None = None) -> int:
     rclpy.init(args=['--ros-args', '-r', f'__ns:={args.namespace}'],
                signal_handler_options=SignalHandlerOptions.NO)
     node = Node('experiment_cli')
+    bar = ProgressBar()
+    lock = client = graph = None
     try:
         lock = _claim(node, args.namespace, args.workers)   # released after our nodes stop
-        procs = _start_graph(args.namespace, log_dir, args.workers, goals, args.respawns)
-    except (FileNotFoundError, NamespaceInUse, KeyboardInterrupt) as exc:
-        node.destroy_node()
-        rclpy.try_shutdown()
-        if isinstance(exc, KeyboardInterrupt):
-            return 130
-        print(f'run: {exc}', file=sys.stderr)
-        return 2
-    client = ActionClient(node, RunExperiment, 'run_experiment')
-    bar = ProgressBar()
-    graph = Graph(procs, args.respawns)
-    try:
+        graph = Graph(_start_graph(args.namespace, log_dir, args.workers, goals,
+                                   args.respawns), args.respawns)
+        client = ActionClient(node, RunExperiment, 'run_experiment')
         for goal, _ in goals:
             code = _run(node, client, goal, graph, bar)
             if code:
                 return code
         return 0
+    except (FileNotFoundError, NamespaceInUse) as exc:   # before any goal was sent
+        print(f'run: {exc}', file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
-        print('\nrun: interrupted; the run was canceled (its files are closed by the manager)',
-              file=sys.stderr)
+        if client is not None:
+            print('\nrun: interrupted; the run was canceled (its files are closed by the '
+                  'manager)', file=sys.stderr)
         return 130
     finally:
         bar.close()
-        client.destroy()
+        if client is not None:
+            client.destroy()
         node.destroy_node()
         rclpy.try_shutdown()
-        for p in graph.procs:   # SIGINT: the manager cancels its run and closes its files
-            p.stop()
-        lock.close()            # the namespace is free once our nodes are gone
+        for p in graph.procs if graph else []:   # SIGINT: the manager cancels its run and
+            p.stop()                              # closes its files
+        if lock is not None:
+            lock.close()        # the namespace is free once our nodes are gone
 
 
 def _spin_until(node: Node, done, procs: list[NodeProcess], timeout: float) -> NodeProcess | None:
