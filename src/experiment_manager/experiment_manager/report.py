@@ -52,6 +52,8 @@ FIGSIZE = (6.4, 4.0)   # inches
 DIFFERS = 1.25     # a figure differs from the paper's when ours is over 1.25x or under 0.8x it
 FALLS = 0.05       # past n*, the sweep's fit "falls" when it ends at least 5 % below its peak
 FEASIBLE, NOT_FEASIBLE, NOT_ANALYSED = 'FEASIBLE', 'NOT FEASIBLE', 'not analysed'
+# the feeder policy's stop decisions (feeder_controller.policy.NAMES), as a report says them
+_STOPS = {'stop: empty': 'feeder and table empty', 'stop: vibration limit': 'vibration limit'}
 
 
 def _fmt(value, digits: int = 3) -> str:
@@ -102,7 +104,8 @@ def verdicts(summary: dict, spec: dict) -> list[dict]:
         v = s['vibrations_to_empty']
         reasons = [f'{s["emptied"]} of {s["iterations"]} feeder runs emptied '
                    f'(optimal range {s["optimal_range"][0]}-{s["optimal_range"][1]} parts on '
-                   f'the table; stops: {", ".join(f"{k} {n}" for k, n in s["stops"].items())})']
+                   f'the table; runs ended by: '
+                   f'{", ".join(f"{_STOPS.get(k, k)} {n}" for k, n in s["stops"].items())})']
         if v['mean'] is not None:
             reasons.append(f'vibrations to empty the feeder: mean {_fmt(v["mean"], 4)}; the '
                            f'refill interval allows one vibration every '

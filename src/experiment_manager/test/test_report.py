@@ -50,6 +50,9 @@ def test_verdicts_follow_the_emptied_runs_and_the_capacity(run_dir):
     s['experiments']['feeder'].update(emptied=0, lost=1)
     table = report.verdicts(s, {})[1]
     assert table['verdict'] == NOT_FEASIBLE and '1 part fell off the table' in table['reasons']
+    s['experiments']['feeder']['stops'] = {'stop: empty': 1, 'stop: vibration limit': 2}
+    assert 'runs ended by: feeder and table empty 1, vibration limit 2)' in \
+        report.verdicts(s, {})[1]['reasons'][0]
     s['requirements']['capacity'] = 480         # 30 parts cannot last a refill interval
     bin_verdict = report.verdicts(s, {})[0]
     assert bin_verdict['verdict'] == NOT_FEASIBLE
