@@ -106,8 +106,10 @@ def test_an_interrupted_run_resumes_to_the_same_results(small, run_file, tmp_pat
     class StopAfter(ResultsWriter):
         def write(self, record):
             if record.iteration['experiment'] == 'sweep' and record.iteration['group'] == 6:
-                # half of the iteration's rows are written, then the run dies
+                # some of the iteration's rows are written, then the run dies mid-row: the
+                # torn row's key reads as a finished iteration's
                 self._writers['parts'].writerows(record.parts[:3])
+                self._files['parts'].write('sweep,0,0,0,')
                 self._files['parts'].flush()
                 raise Interrupt
             super().write(record)
