@@ -8,9 +8,10 @@ identical (they must be).
     (default: the built-in experiment file)
 
 --paper-case adds the wall time of the paper's full test case from the run directories of a
-run made before (6.1 hours on this machine on 2026-11-23, so not run here: `make run RUN_ARGS="--output
-DIR src/experiment_manager/config/test_case/pth0.yaml ...pth1.yaml ...pth2.yaml"`, resumed with
-`--resume RUN_DIR` if it was interrupted): the recordings' spans, summed over resumes.
+run made before (6.1 hours on this machine on 2026-11-23, so not run here: `make run
+RUN_ARGS="--output DIR src/experiment_manager/config/test_case/pth0.yaml ...pth1.yaml
+...pth2.yaml"`, resumed with `--resume RUN_DIR` if it was interrupted): the recordings' spans,
+summed over resumes.
 """
 
 import argparse

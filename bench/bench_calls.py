@@ -1,0 +1,97 @@
+"""What one call to a worker costs over the graph, by the parts in the scene: the round trip of
+`get_parts`, of `check_parts` (one target, neighbours checked) and of `remove_parts` without a
+settle (no physics: only the graph's work), in the widest bin of the test case's PTH2 file,
+from GraphBackend as the manager makes them, with the world's `markers` on and off
+(`publish_markers`). Median of 30, 10 and 20 calls.
+
+    tools/ws python bench/bench_calls.py [--parts 30 150 480]
+
+The cores make none of these round trips; their cost is what the graph adds to an iteration
+per call (bench_experiment.py measures the sum).
+"""
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+from experiment_manager import config
+from experiment_manager.experiments import BIN_STATIC, plan
+from experiment_manager.graph_backend import GraphBackend
+from experiment_manager.launcher import NodeProcess, WORKER_NODES
+import rclpy
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import MultiThreadedExecutor
+from rclpy.node import Node
+
+# 480 radial capacitors (PTH2) fit its widest bin, 300 x 300 x 22 mm
+TEST_CASE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src',
+                         'experiment_manager', 'config', 'test_case', 'pth2.yaml')
+
+
+def timed(call, n: int) -> float:
+    """The median wall time of n calls, ms."""
+    times = []
+    for _ in range(n):
+        start = time.perf_counter()
+        call()
+        times.append(time.perf_counter() - start)
+    return 1000.0 * statistics.median(times)
+
+
+def probe(ns: str, parts: int) -> str:
+    """The three medians for a bin of `parts` parts, from a node spun like the manager's."""
+    rclpy.init()
+    node = Node('calls_probe', namespace=ns)
+    executor = MultiThreadedExecutor(num_threads=4)
+    executor.add_node(node)
+    threading.Thread(target=executor.spin, daemon=True).start()
+    backend = GraphBackend(node, 'worker_0', ReentrantCallbackGroup(), 600.0, 30.0,
+                           lambda: False)
+    file = config.load(TEST_CASE)
+    backend.start(file)
+    units = plan(file, next(e for e in file.experiments if e.type == BIN_STATIC), {})
+    unit = max(units, key=lambda u: u.container.inner_size[0] * u.container.inner_size[1])
+    backend.reset(unit.container, 1)
+    states, _ = backend.drop(parts, 'container')
+    ids = iter(states.ids.tolist())
+    get = timed(backend.parts, 30)
+    check = timed(lambda: backend.check(unit.container, states, [int(states.ids[0])], True), 10)
+    remove = timed(lambda: backend.remove([next(ids)], settle=False), 20)
+    return f'{get:9.1f} {check:11.1f} {remove:12.1f}'
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--parts', type=int, nargs='+', default=[30, 150, 480])
+    parser.add_argument('--probe', nargs=2, help=argparse.SUPPRESS)   # NS PARTS, in a child
+    args = parser.parse_args()
+    if args.probe:      # one scene, in a process of its own (a fresh rclpy)
+        print(probe(args.probe[0], int(args.probe[1])), flush=True)
+        os._exit(0)     # the executor thread is a daemon; nothing to close cleanly
+    os.environ.setdefault('ROS_DOMAIN_ID', str(150 + os.getpid() % 50))
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    logs = tempfile.mkdtemp(prefix='bench_calls_')
+    print('median round trip, ms      get_parts check_parts remove_parts')
+    for markers in ('true', 'false'):
+        ns = f'/calls_{os.getpid()}_{markers}'
+        procs = [NodeProcess(pkg, exe, ['-r', f'__ns:={ns}/worker_0', *(
+                     ['-p', f'publish_markers:={markers}'] if exe == 'world' else [])],
+                             f'{logs}/{exe}_{markers}.log') for pkg, exe in WORKER_NODES]
+        try:
+            for parts in args.parts:
+                out = subprocess.run([sys.executable, __file__, '--probe', ns, str(parts)],
+                                     check=True, capture_output=True, text=True, timeout=600)
+                print(f'{parts:4d} parts, markers {markers:<5} {out.stdout.strip()}', flush=True)
+        finally:
+            for p in procs:
+                p.stop()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
