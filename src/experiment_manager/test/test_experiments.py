@@ -310,6 +310,17 @@ def test_an_unwritable_output_directory_is_named(tmp_path):
         ResultsWriter(str(tmp_path / 'empty'), 'x', resume=True)
 
 
+def test_a_results_file_cut_before_its_header_ends_gets_its_header_back_on_resume(tmp_path):
+    with ResultsWriter(str(tmp_path), 'x'):
+        pass
+    (tmp_path / 'parts.csv').write_text('experiment,gr')    # killed while writing the header
+    (tmp_path / 'picks.csv').write_text('')
+    with ResultsWriter(str(tmp_path), 'x', resume=True):
+        pass
+    for name in ('parts', 'picks'):
+        assert (tmp_path / f'{name}.csv').read_text().splitlines() == [','.join(FILES[name])]
+
+
 def test_iteration_seeds_differ_per_key_and_do_not_change():
     seeds = {iteration_seed(7, e, (g, i)) for e in ('a', 'b') for g in range(3)
              for i in range(3)}
