@@ -4,8 +4,13 @@ iteration and type, the graph's ratio to the cores, the throughput of two worker
 one, the peak memory of each worker's processes, and whether the result files of the three are
 identical (they must be).
 
-    tools/ws python bench/bench_experiment.py [FILE] [--workers 1 2] [--paper-case RUN_DIR ...]
+    tools/ws python bench/bench_experiment.py [FILE] [--iterations N] [--workers 1 2]
+        [--paper-case RUN_DIR ...]
     (default: the built-in experiment file)
+
+--iterations N caps every experiment of FILE at N iterations (as `run --iterations` does), so
+that a test-case file can be the workload: e.g. `--iterations 2
+src/experiment_manager/config/test_case/pth2.yaml`, about 17 min.
 
 --paper-case adds the wall time of the paper's full test case from the run directories of a
 run made before (6.1 hours on this machine on 2026-11-23, so not run here: `make run
@@ -107,12 +112,19 @@ def main() -> int:
                         help='the two worker counts to compare (default 1 2)')
     parser.add_argument('--paper-case', nargs='+', default=[], metavar='RUN_DIR',
                         help="run directories of the paper's full test case, made before")
+    parser.add_argument('--iterations', type=int, metavar='N',
+                        help='cap every experiment of the file at N iterations')
     args = parser.parse_args()
     path = os.path.abspath(args.file or default_file())
     file = config.load(path)
     os.environ.setdefault('ROS_DOMAIN_ID', str(150 + os.getpid() % 50))
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     work = tempfile.mkdtemp(prefix='bench_experiment_')
+    if args.iterations is not None:
+        path = os.path.join(work, os.path.basename(path))
+        with open(path, 'w', encoding='utf-8') as f:
+            f.write(config.reduced(file, args.iterations))
+        file = config.load(path)
 
     start = time.perf_counter()
     local_dir = os.path.join(work, 'local')
