@@ -36,6 +36,7 @@ from experiment_manager.launcher import executable
 from experiment_manager.local_backend import LocalBackend
 from experiment_manager.results import FILES, read_text_rows, ResultsWriter
 from paper_case import print_full_case
+from pick_sim_world.errors import InvalidArgument
 
 
 def rows(directory: str, name: str, drop: tuple[str, ...] = ()) -> list[dict]:
@@ -116,14 +117,18 @@ def main() -> int:
                         help='cap every experiment of the file at N iterations')
     args = parser.parse_args()
     path = os.path.abspath(args.file or default_file())
-    file = config.load(path)
+    try:
+        file = config.load(path)
+        text = None if args.iterations is None else config.reduced(file, args.iterations)
+    except InvalidArgument as exc:
+        parser.error(str(exc))
     os.environ.setdefault('ROS_DOMAIN_ID', str(150 + os.getpid() % 50))
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     work = tempfile.mkdtemp(prefix='bench_experiment_')
-    if args.iterations is not None:
+    if text is not None:
         path = os.path.join(work, os.path.basename(path))
         with open(path, 'w', encoding='utf-8') as f:
-            f.write(config.reduced(file, args.iterations))
+            f.write(text)
         file = config.load(path)
 
     start = time.perf_counter()
