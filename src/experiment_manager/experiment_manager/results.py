@@ -165,13 +165,16 @@ class ResultsWriter:
             raise InvalidArgument('experiment_file', self.path('experiment.yaml'),
                                   'differs from the file of the run being resumed: results '
                                   'would mix two experiments')
-        done = {key for key, _, _ in _blocks(self.path('iterations'))[1]}   # whole rows
-        for name in FILES:     # without the rows of the iterations in flight
-            if os.path.exists(self.path(name)):
-                header, blocks = _blocks(self.path(name))
-                self._write_blocks(name, header, [b for b in blocks if b[0] in done])
-                if name in self._rows:
-                    self._rows[name] = read_csv(self.path(name))
+        scans = {name: _blocks(self.path(name)) for name in FILES
+                 if os.path.exists(self.path(name))}
+        done = {key for key, _, _ in scans['iterations'][1]}   # whole rows
+        for name, (header, blocks) in scans.items():   # without the iterations in flight
+            if not header:      # cut inside its header, so no rows: _open writes it anew
+                os.remove(self.path(name))
+                continue
+            self._write_blocks(name, header, [b for b in blocks if b[0] in done])
+            if name in self._rows:
+                self._rows[name] = read_csv(self.path(name))
 
     # ------------------------------------------------------------------------- Sink
     def is_done(self, experiment_id: str, group: int, iteration: int) -> bool:
@@ -215,10 +218,10 @@ class ResultsWriter:
     def _write_blocks(self, name: str, header: bytes, blocks: list[tuple[tuple, int, int]]
                       ) -> None:
         """Replace a results file atomically with its header and `blocks` (of _blocks), in
-        the order given, copied byte for byte (a header as _open writes it when b'')."""
+        the order given, copied byte for byte."""
         fd, tmp = tempfile.mkstemp(dir=self.directory, prefix=f'.{name}.')
         with open(self.path(name), 'rb') as f, os.fdopen(fd, 'wb') as out:
-            out.write(header or (','.join(FILES[name]) + '\r\n').encode())
+            out.write(header)
             for _, begin, end in blocks:
                 f.seek(begin)
                 out.write(f.read(end - begin))
