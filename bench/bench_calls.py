@@ -20,9 +20,10 @@ import threading
 import time
 
 from experiment_manager import config
-from experiment_manager.experiments import BIN_STATIC, plan
+from experiment_manager.config import BIN_STATIC
 from experiment_manager.graph_backend import GraphBackend
 from experiment_manager.launcher import NodeProcess, WORKER_NODES
+from experiment_manager.plan import plan
 import rclpy
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import MultiThreadedExecutor

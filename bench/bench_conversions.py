@@ -14,9 +14,9 @@ import statistics
 import time
 
 from builtin_interfaces.msg import Time
+from pick_common.containers import ContainerSpec
+from pick_common.specs import SceneSpec
 from pick_sim_world import conversions as conv
-from pick_sim_world.config import SceneSpec
-from pick_sim_world.containers import ContainerSpec
 from pick_sim_world.world import World
 from rclpy.serialization import serialize_message
 

@@ -31,12 +31,13 @@ import time
 
 from experiment_manager import config
 from experiment_manager.cli import default_file
-from experiment_manager.experiments import Runner
 from experiment_manager.launcher import executable
 from experiment_manager.local_backend import LocalBackend
-from experiment_manager.results import FILES, read_text_rows, ResultsWriter
+from experiment_manager.results import read_text_rows, ResultsWriter
+from experiment_manager.rows import FILES
+from experiment_manager.scheduler import Runner
 from paper_case import print_full_case
-from pick_sim_world.errors import InvalidArgument
+from pick_common.errors import InvalidArgument
 
 
 def rows(directory: str, name: str, drop: tuple[str, ...] = ()) -> list[dict]:

@@ -18,9 +18,10 @@ import threading
 import time
 
 from experiment_manager import config
-from experiment_manager.experiments import plan, Runner
 from experiment_manager.graph_backend import GraphBackend
 from experiment_manager.launcher import NodeProcess, WORKER_NODES
+from experiment_manager.plan import plan
+from experiment_manager.procedures import run_unit
 from experiment_manager.topic_recorder import QOS, RECORDED, TopicRecorder
 import rclpy
 from rclpy.callback_groups import ReentrantCallbackGroup
@@ -68,7 +69,7 @@ def iteration(ns: str, mode: str) -> tuple[float, dict]:
     file = config.parse(FILE)
     backend.start(file)
     start = time.perf_counter()
-    Runner(file, [backend], None).run_unit(plan(file, file.experiments[0], {})[0], backend)
+    run_unit(file, plan(file, file.experiments[0], {})[0], backend)
     total = time.perf_counter() - start
     keep.clear()
     return total, times

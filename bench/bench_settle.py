@@ -19,7 +19,8 @@ import time
 
 from experiment_manager.config import load
 from paper_case import TEST_CASE
-from pick_sim_world.config import PhysicsConfig, SceneSpec
+from pick_common.specs import SceneSpec
+from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
 from pick_validity.validity import Validator
 

@@ -13,8 +13,8 @@ import os
 import statistics
 import time
 
-from pick_sim_world.config import SceneSpec
-from pick_sim_world.containers import ContainerSpec
+from pick_common.containers import ContainerSpec
+from pick_common.specs import SceneSpec
 from pick_sim_world.world import World
 from pick_validity.config import CAPACITOR_GRASPS, CheckConfig, Gripper, PlaceSpec
 from pick_validity.validity import naive_check, Validator

@@ -23,8 +23,8 @@ import statistics
 import time
 
 from paper_case import run_on_cores
-from pick_sim_world.config import FIXED, RANDOM, SceneSpec, Vibration
-from pick_sim_world.containers import ContainerSpec
+from pick_common.containers import ContainerSpec
+from pick_common.specs import FIXED, RANDOM, SceneSpec, Vibration
 from pick_sim_world.world import World
 from pick_validity.config import CAPACITOR_GRASPS, CheckConfig, Gripper, PlaceSpec
 from pick_validity.validity import Validator

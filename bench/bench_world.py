@@ -20,10 +20,11 @@ import sys
 import time
 
 import numpy as np
+from pick_common.containers import ContainerSpec
+from pick_common.specs import SceneSpec, Vibration
 from pick_msgs.action import DropParts
 from pick_msgs.srv import ResetScene
-from pick_sim_world.config import PhysicsConfig, SceneSpec, Vibration
-from pick_sim_world.containers import ContainerSpec
+from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
 from rclpy.action import ActionClient
 

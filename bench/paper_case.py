@@ -8,10 +8,10 @@ import tempfile
 import time
 
 from experiment_manager import config
-from experiment_manager.experiments import Runner
 from experiment_manager.local_backend import LocalBackend
 from experiment_manager.recording import CompleteRecords
 from experiment_manager.results import read_csv, ResultsWriter
+from experiment_manager.scheduler import Runner
 from mcap.exceptions import McapError
 from mcap.reader import make_reader
 from mcap.records import Message

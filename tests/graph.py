@@ -10,7 +10,7 @@ import tempfile
 import time
 
 from experiment_manager import launcher
-from pick_sim_world.node_runner import handshake
+from pick_common.node_runner import handshake
 import rclpy
 from rclpy.action import ActionClient
 from rclpy.context import Context

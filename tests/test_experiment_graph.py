@@ -14,17 +14,17 @@ import signal
 import subprocess
 import time
 
-from experiment_manager import cli, config, interrupt
-from experiment_manager.experiments import Runner
+from experiment_manager import config, interrupt, supervisor
 from experiment_manager.launcher import executable, WORKER_NODES
 from experiment_manager.local_backend import LocalBackend
 from experiment_manager.results import FILES, read_text_rows, ResultsWriter
+from experiment_manager.scheduler import Runner
 from graph import SMALL, unique_namespace
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 from pick_msgs.action import RunExperiment
 from pick_msgs.msg import ValidityReport
-from pick_sim_world.world import instance_seed
+from pick_sim_world.bodies import instance_seed
 import pytest
 import rclpy
 from rclpy.action import ActionClient
@@ -350,9 +350,9 @@ def test_a_signal_stops_run_between_two_callbacks_never_inside_one(private_ros_d
         interrupt.install()                 # as cli.main does
         node.create_timer(0.01, tick)
         with pytest.raises(KeyboardInterrupt):
-            cli._spin_until(node, lambda: False, [], 10.0)
+            supervisor.spin_until(node, lambda: False, [], 10.0)
         assert events == ['start', 'end']
-        assert cli._spin_until(node, lambda: len(events) == 4, [], 10.0) is None
+        assert supervisor.spin_until(node, lambda: len(events) == 4, [], 10.0) is None
         assert events == ['start', 'end'] * 2, 'a second spin loop runs on (the flag is reset)'
     finally:
         for s, handler in saved.items():

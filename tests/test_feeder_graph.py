@@ -3,10 +3,10 @@
 import time
 
 from graph import NodeProcess, stop_all, unique_namespace
+from pick_common.node_runner import LATCHED
 from pick_msgs.action import FeedCycle, RemoveParts
 from pick_msgs.msg import FeederState
 from pick_msgs.srv import GetParts
-from pick_sim_world.node_runner import LATCHED
 import pytest
 from rclpy.action import ActionClient
 

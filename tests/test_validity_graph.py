@@ -5,12 +5,12 @@ import copy
 import math
 
 from graph import NodeProcess, stop_all, unique_namespace
+from pick_common.conversions import container_from_msg, part_spec_from_msg, parts_to_arrays
+from pick_common.node_runner import LATCHED
+from pick_common.parts import build_part
 from pick_msgs.action import DropParts
 from pick_msgs.msg import Scene, ValidityReport
 from pick_msgs.srv import CheckParts, GetParts
-from pick_sim_world.conversions import container_from_msg, part_spec_from_msg, parts_to_arrays
-from pick_sim_world.node_runner import LATCHED
-from pick_sim_world.parts import build_part
 from pick_validity.config import CAPACITOR_GRASPS, CheckConfig, Gripper, PlaceSpec
 from pick_validity.validity import Validator
 import pytest

@@ -8,10 +8,10 @@ from ament_index_python.packages import get_package_share_directory
 from geometry_msgs.msg import Vector3
 from graph import NodeProcess, stop_all, unique_namespace
 import numpy as np
+from pick_common.node_runner import LATCHED
 from pick_msgs.action import DropParts, RemoveParts, Vibrate
 from pick_msgs.msg import ContainerGeometry, PartArray, Scene
 from pick_msgs.srv import GetParts, ResetScene
-from pick_sim_world.node_runner import LATCHED
 import pytest
 from rclpy.action import ActionClient
 from visualization_msgs.msg import Marker, MarkerArray

@@ -20,38 +20,29 @@ its files closed).
 """
 
 import argparse
-import collections
-import fcntl
 import json
 import os
 import sys
 import tempfile
 import time
-from typing import IO
 
 from ament_index_python.packages import get_package_share_directory
+from pick_common.errors import InvalidArgument
+from pick_common.node_runner import handshake
 from pick_msgs.action import RunExperiment
-from pick_sim_world.errors import InvalidArgument
-from pick_sim_world.node_runner import handshake
 import rclpy
 from rclpy.action import ActionClient
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from . import config, interrupt
-from .launcher import MANAGER, NodeProcess, READS_MESHES, WORKER_NODES
+from .claim import claim, NamespaceInUse
+from .supervisor import Graph, report_dead, spin_until, start_graph
 
 MAX_WORKERS = 64
 START_TIMEOUT = 60.0    # s for the manager's action server to appear
 RESPAWNS = 3            # times a worker node that died is started again, per run
 STOP_TIMEOUT = 30.0     # s for a canceled run to close its files
-DISCOVERY_WAIT = 3.0    # s to discover a graph already running in the namespace (Fast DDS on
-                        # this 2-core host under full load: 0.2-2.0 s, measured 2026-11-23;
-                        # over 3 s once, with CI beside it)
-
-
-class NamespaceInUse(Exception):
-    """Another graph runs the nodes `run` would start."""
 
 
 def default_workers() -> int:
@@ -134,106 +125,6 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     return args
 
 
-def _dirs(name: str, paths) -> list[str]:
-    """`-p name:=[...]` for a string array parameter (JSON is YAML), or nothing when empty
-    (rcl refuses an empty list)."""
-    paths = sorted(set(paths))
-    return ['-p', f'{name}:={json.dumps(paths)}'] if paths else []
-
-
-def _ns(namespace: str) -> str:
-    """'/a/b' for 'a/b/', '' for the root namespace."""
-    return '/' + namespace.strip('/') if namespace.strip('/') else ''
-
-
-def _claim(node: Node, namespace: str, workers: int) -> IO[str]:
-    """The namespace for this run's graph, or NamespaceInUse naming who has it: another `run`
-    on this host (_lock, certain) or nodes of our names in the graph (_already_running, best
-    effort: another host). Returns the lock file, to keep open."""
-    domain = node.context.get_domain_id()
-    lock = _lock(domain, namespace)
-    running = _already_running(node, namespace, workers)
-    if running:
-        lock.close()
-        raise _in_use(domain, namespace, f'already has {", ".join(running)} (another `run`, or '
-                      'one killed less than about 20 s ago)')
-    return lock
-
-
-def _in_use(domain: int, namespace: str, why: str) -> NamespaceInUse:
-    return NamespaceInUse(f'namespace {_ns(namespace) or "/"!r} of ROS domain {domain} {why}: '
-                          'ours would answer to the same names. Pass --namespace with another '
-                          'namespace, or set another ROS_DOMAIN_ID')
-
-
-def _lock(domain: int, namespace: str) -> IO[str]:
-    """Take (ROS domain, namespace) for this process's life, against other `run`s on this host:
-    the open lock file, or NamespaceInUse naming the pid of the `run` that holds it. flock, so
-    a `run` killed with SIGKILL leaves no stale lock (and, unlike the graph, nothing to wait
-    out)."""
-    name = f'pick_run.{os.getuid()}.domain_{domain}{_ns(namespace).replace("/", ".")}.lock'
-    f = open(os.path.join(tempfile.gettempdir(), name), 'a+')
-    try:
-        fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        f.seek(0)
-        holder = f.read().strip() or '?'
-        f.close()
-        raise _in_use(domain, namespace,
-                      f'is taken by `run` (pid {holder}) on this host') from None
-    f.truncate(0)
-    f.write(str(os.getpid()))
-    f.flush()
-    return f
-
-
-def _already_running(node: Node, namespace: str, workers: int) -> list[str]:
-    """The nodes of the graph `run` would start that the ROS domain already has (another
-    `run` in the same namespace, on another host: _lock covers this one), found within
-    DISCOVERY_WAIT, which is best effort (discovery took longer on a loaded host). Started
-    beside them, ours would serve the same names, and the running graph's calls could be
-    answered by our nodes."""
-    ns = _ns(namespace)
-    ours = {f'{ns}/{MANAGER[1]}'} | {f'{ns}/worker_{k}/{exe}' for k in range(workers)
-                                     for _, exe in WORKER_NODES}
-    deadline = time.monotonic() + DISCOVERY_WAIT
-    while True:
-        found = ours & {f'{space.rstrip("/")}/{name}'
-                        for name, space in node.get_node_names_and_namespaces()}
-        if found or time.monotonic() >= deadline:
-            return sorted(found)
-        interrupt.sleep(0.1)
-
-
-def _start_graph(namespace: str, log_dir: str, workers: int,
-                 goals: list[tuple[RunExperiment.Goal, str]], respawns: int
-                 ) -> list[NodeProcess]:
-    """The workers' nodes, then the manager (last). Each may read and write only where the
-    goals need: their files' and meshes' directories, and their output directories."""
-    ns = _ns(namespace)
-    names = [f'worker_{k}' for k in range(workers)]
-    meshes = [os.path.dirname(mesh) for _, mesh in goals if mesh]
-    procs = []
-    for worker in names:
-        procs += [NodeProcess(pkg, exe, ['-r', f'__ns:={ns}/{worker}', *(
-                                  _dirs('mesh_dirs', meshes) if exe in READS_MESHES else [])],
-                              os.path.join(log_dir, f'{worker}.{exe}.log'), f'{worker}/{exe}')
-                  for pkg, exe in WORKER_NODES]
-    pkg, exe = MANAGER
-    files = [os.path.dirname(g.experiment_file) for g, _ in goals]
-    procs.append(NodeProcess(pkg, exe, [
-        '-r', f'__ns:={ns or "/"}', '-p', f'workers:=[{", ".join(names)}]',
-        *([] if respawns else ['-p', 'rejoin_timeout:=0.0']),
-        *_dirs('experiment_dirs', files + meshes),
-        *_dirs('output_dirs', [g.output_dir for g, _ in goals])],
-        os.path.join(log_dir, f'{exe}.log')))
-    return procs
-
-
-def _dead(procs: list[NodeProcess]) -> NodeProcess | None:
-    return next((p for p in procs if not p.running()), None)
-
-
 def _summary_lines(summary: dict) -> list[str]:
     lines = []
     for exp_id, s in summary.get('experiments', {}).items():
@@ -289,7 +180,7 @@ def main(argv: list[str] | None = None) -> int:
     log_dir = args.logs or tempfile.mkdtemp(prefix='pick_run_logs_')
     os.makedirs(log_dir, exist_ok=True)
     print(f'run: {len(goals)} experiment file(s); node logs in {log_dir}', file=sys.stderr)
-    interrupt.install()     # _spin_until stops between two spin_once calls, never inside one
+    interrupt.install()     # spin_until stops between two spin_once calls, never inside one
     # No rclpy signal handlers: Ctrl-C (or SIGTERM) must leave the context alive to cancel the
     # run and wait for the manager to close its files (rclpy's handler shuts it down first).
     rclpy.init(args=['--ros-args', '-r', f'__ns:={args.namespace}'],
@@ -298,9 +189,11 @@ def main(argv: list[str] | None = None) -> int:
     bar = ProgressBar()
     lock = client = graph = None
     try:
-        lock = _claim(node, args.namespace, args.workers)   # released after our nodes stop
-        graph = Graph(_start_graph(args.namespace, log_dir, args.workers, goals,
-                                   args.respawns), args.respawns)
+        lock = claim(node, args.namespace, args.workers)   # released after our nodes stop
+        graph = Graph(start_graph(args.namespace, log_dir, args.workers,
+                                  [g.experiment_file for g, _ in goals], [m for _, m in goals],
+                                  [g.output_dir for g, _ in goals], args.respawns),
+                      args.respawns)
         client = ActionClient(node, RunExperiment, 'run_experiment')
         for goal, _ in goals:
             code = _run(node, client, goal, graph, bar)
@@ -327,88 +220,33 @@ def main(argv: list[str] | None = None) -> int:
             lock.close()        # the namespace is free once our nodes are gone
 
 
-def _spin_until(node: Node, done, procs: list[NodeProcess], timeout: float) -> NodeProcess | None:
-    """Spin until done() or timeout; returns a process that died meanwhile, if any."""
-    deadline = time.monotonic() + timeout
-    while not done() and time.monotonic() < deadline:
-        interrupt.check()       # a second signal stops the wait for the cancel as well
-        rclpy.spin_once(node, timeout_sec=0.1)
-        dead = _dead(procs)
-        if dead is not None:
-            return dead
-    return None
-
-
-class Graph:
-    """The node processes of `run`: the workers' nodes, then the manager (last); those not
-    given up as dead (`watched`), and how often each was started again."""
-
-    def __init__(self, procs: list[NodeProcess], limit: int) -> None:
-        self.procs, self.watched, self.limit = procs, list(procs), limit
-        self.respawns: collections.Counter = collections.Counter()
-
-    @property
-    def manager(self) -> NodeProcess:
-        return self.procs[-1]
-
-    def replace(self, dead: NodeProcess) -> NodeProcess | None:
-        """Start a dead worker node again (`limit` times per run and node); None when it
-        may not be, and then it is no longer watched."""
-        if self.respawns[dead.name] >= self.limit:
-            self.watched.remove(dead)
-            return None
-        self.respawns[dead.name] += 1
-        new = dead.respawn()
-        self.procs[self.procs.index(dead)] = self.watched[self.watched.index(dead)] = new
-        return new
-
-
-def _report_dead(node: Node, done, graph: Graph, timeout: float, bar) -> bool:
-    """Spin until done() or timeout, reporting each watched process that dies. A worker
-    node is started again (the manager runs the iteration it lost again and takes the worker
-    back). False when the manager died."""
-    while (dead := _spin_until(node, done, graph.watched, timeout)):
-        bar.close()
-        print(f'run: {dead.describe_exit()}:\n{dead.output(20)}', file=sys.stderr)
-        if dead is graph.manager:
-            return False
-        if graph.replace(dead):
-            print(f'run: {dead.name} started again ({graph.respawns[dead.name]} of '
-                  f'{graph.limit}); its iteration runs again, on it or another worker',
-                  file=sys.stderr)
-        else:
-            print('run: its worker is lost; the manager runs its iterations on the others',
-                  file=sys.stderr)
-    return True
-
-
 def _run(node: Node, client: ActionClient, goal, graph: Graph, bar) -> int:
     print(f'run: {goal.experiment_file}', file=sys.stderr)
     manager = graph.manager
-    if not _report_dead(node, client.server_is_ready, graph, START_TIMEOUT, bar) \
+    if not report_dead(node, client.server_is_ready, graph, START_TIMEOUT, bar) \
             or not client.server_is_ready():
         print(f'run: the experiment manager did not start (run_experiment did not appear '
               f'within {START_TIMEOUT:g} s)', file=sys.stderr)
         return 1
-    if not handshake(node, [client], lambda future, timeout: _spin_until(
+    if not handshake(node, [client], lambda future, timeout: spin_until(
             node, future.done, [manager], timeout) is None and future.done(),
             time.monotonic() + START_TIMEOUT, lambda: not manager.running()):
         print('run: the experiment manager did not answer a probe of run_experiment within '
               f'{START_TIMEOUT:g} s', file=sys.stderr)
         return 1
     send = client.send_goal_async(goal, feedback_callback=lambda f: bar.update(f.feedback.progress))
-    _spin_until(node, send.done, [manager], START_TIMEOUT)
+    spin_until(node, send.done, [manager], START_TIMEOUT)
     handle = send.result()
     if handle is None or not handle.accepted:
         print('run: the experiment manager did not accept the goal', file=sys.stderr)
         return 1
     result_future = handle.get_result_async()
     try:
-        if not _report_dead(node, result_future.done, graph, float('inf'), bar):
+        if not report_dead(node, result_future.done, graph, float('inf'), bar):
             return 1
     except KeyboardInterrupt:
         handle.cancel_goal_async()
-        _spin_until(node, result_future.done, [manager], STOP_TIMEOUT)
+        spin_until(node, result_future.done, [manager], STOP_TIMEOUT)
         raise
     result = result_future.result().result
     bar.close()

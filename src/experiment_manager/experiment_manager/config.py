@@ -14,21 +14,16 @@ import os
 from typing import Any
 
 from feeder_controller.policy import check_feeder, FeederConfig
-from pick_sim_world.config import (
+from pick_common.containers import check_container, check_fits, ContainerSpec, TRAY_DEFAULT_SIZE
+from pick_common.errors import check_int, check_number, InvalidArgument
+from pick_common.parts import build_part, BUILTIN_MODELS, PartSpec
+from pick_common.specs import (
     check_vibration,
     DIRECTIONS,
     MAX_PARTS_PER_INSTANCE,
     MAX_SEED,
     Vibration,
 )
-from pick_sim_world.containers import (
-    check_container,
-    ContainerSpec,
-    TRAY_DEFAULT_SIZE,
-)
-from pick_sim_world.errors import check_int, check_number, InvalidArgument
-from pick_sim_world.parts import build_part, BUILTIN_MODELS, PartGeometry, PartSpec
-from pick_sim_world.world import PACKING_LIMIT
 from pick_validity.config import (
     CAPACITOR_GRASPS,
     check_grasps,
@@ -293,16 +288,6 @@ def _checked(check: Callable, value: Any, where: str) -> Any:
         raise InvalidArgument(f'{where} ({exc.field})', exc.value, exc.rule) from None
 
 
-def _fits(part: PartGeometry, count: int, container: ContainerSpec, where: str) -> None:
-    inner = math.prod(container.inner_size)
-    if count * part.volume > PACKING_LIMIT * inner:
-        most = int(PACKING_LIMIT * inner / part.volume)
-        size = ' x '.join(f'{s / MM:g}' for s in container.inner_size)
-        raise InvalidArgument(where, count, (
-            f'parts do not fit a container of {size} mm: {part.volume * 1e9:.4g} mm^3 each, at '
-            f'most {most} within the packing limit {PACKING_LIMIT:g}'))
-
-
 def _earlier(m: _Map, key: str, exp_id: str, earlier: dict[str, Experiment], kind: str,
              alternative: str) -> Experiment:
     """The earlier experiment of type `kind` that `key` names by id."""
@@ -326,17 +311,18 @@ def _experiment(m: _Map, f: dict, earlier: dict[str, Experiment]) -> Experiment:
     if kind == BIN_STATIC:
         out['bins'] = _bins(m, 'bins_mm', wall, limit)
         for i, b in enumerate(out['bins']):
-            _fits(part, out['parts'], b, m.where('parts') + f' (bins_mm[{i}])')
+            check_fits(m.where('parts') + f' (bins_mm[{i}])', out['parts'], part.volume, b)
     elif kind == BIN_EMPTYING:
         raw = m.get('bin', None, required=True)
         if isinstance(raw, str):
             source = _earlier(m, 'bin', raw, earlier, BIN_STATIC, 'a bin [x, y, z] in mm')
             out['bin_from'] = raw
             for i, b in enumerate(source.bins):
-                _fits(part, out['parts'], b, m.where('parts') + f' ({raw}.bins_mm[{i}])')
+                check_fits(m.where('parts') + f' ({raw}.bins_mm[{i}])', out['parts'],
+                           part.volume, b)
         else:
             out['bin'] = _bin(raw, m.where('bin'), wall, limit)
-            _fits(part, out['parts'], out['bin'], m.where('parts'))
+            check_fits(m.where('parts'), out['parts'], part.volume, out['bin'])
     elif kind == TABLE_SWEEP:
         counts = m.sub('counts')
         first = counts.integer('first', 1, 1, MAX_PARTS_PER_INSTANCE)
@@ -344,7 +330,7 @@ def _experiment(m: _Map, f: dict, earlier: dict[str, Experiment]) -> Experiment:
         step = counts.integer('step', 1, 1, MAX_PARTS_PER_INSTANCE)
         counts.done()
         out['counts'] = tuple(range(first, last + 1, step))
-        _fits(part, out['counts'][-1], tray, m.where('counts.last'))
+        check_fits(m.where('counts.last'), out['counts'][-1], part.volume, tray)
         out['margin'] = m.integer('margin', 5, 0, 1000)
     if kind == FEEDER_EMPTYING:
         raw = m.get('optimal_range', None, required=True)
@@ -368,7 +354,7 @@ def _experiment(m: _Map, f: dict, earlier: dict[str, Experiment]) -> Experiment:
         if out.get('optimal_range'):
             _checked(check_feeder, FeederConfig(out['parts'], *out['optimal_range'],
                                                 out['max_vibrations']), m.path)
-        _fits(part, high, tray, m.where('optimal_range') + ' (max)')
+        check_fits(m.where('optimal_range') + ' (max)', high, part.volume, tray)
     m.done()
     return Experiment(**out)
 

@@ -9,25 +9,17 @@ experiment file and the results into one MCAP file per run (recording.py). One r
 second goal is answered BUSY, not queued.
 """
 
-from datetime import datetime
 import json
 import os
 import threading
 import time
-import traceback
 
 from ament_index_python.packages import get_package_share_directory
+from pick_common.errors import InvalidArgument, Limit
+from pick_common.node_runner import answer_error, declare, run
 from pick_msgs.action import RunExperiment
 from pick_msgs.msg import ExperimentProgress
-from pick_sim_world import conversions as world_conv
-from pick_sim_world.errors import check_inside, InvalidArgument, WorldError
-from pick_sim_world.node_runner import run
-from rcl_interfaces.msg import (
-    FloatingPointRange,
-    IntegerRange,
-    ParameterDescriptor,
-    ParameterType,
-)
+from rcl_interfaces.msg import ParameterDescriptor, ParameterType
 from rclpy.action import ActionServer, CancelResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.exceptions import InvalidNamespaceException
@@ -36,28 +28,21 @@ from rclpy.node import Node
 from rclpy.validate_namespace import validate_namespace
 from std_msgs.msg import Header
 
-from . import config, pictures, report
-from .experiments import Progress, Runner
 from .graph_backend import GraphBackend, GraphError
-from .recording import Recorder
-from .results import ResultsWriter
+from .scheduler import Progress
+from .session import RunSession
 from .topic_recorder import TopicRecorder
 
 STOP_WAIT = 15.0        # s a shutdown waits for the run to close its files
 DISCOVERY_SETTLE = 3.0  # s the worker list must stay the same before discovery ends
 BUILTIN_FILES = os.path.join(get_package_share_directory('experiment_manager'), 'config')
-RESULT_FILES = ('iterations.csv', 'checks.csv', 'picks.csv', 'parts.csv', 'summary.json')
-
-
-def run_directory(output_dir: str, file_id: str) -> str:
-    """A new directory name <output_dir>/<id>_<YYYYmmdd-HHMMSS>[_k] that does not exist yet."""
-    stamp = datetime.now().strftime('%Y%m%d-%H%M%S')
-    base = os.path.join(os.path.abspath(os.path.expanduser(output_dir)), f'{file_id}_{stamp}')
-    path, k = base, 1
-    while os.path.exists(path):
-        k += 1
-        path = f'{base}_{k}'
-    return path
+# The range of each numeric parameter (s, bytes).
+LIMITS = {
+    'call_timeout': Limit(1.0, 86400.0),
+    'server_timeout': Limit(0.1, 3600.0),
+    'rejoin_timeout': Limit(0.0, 3600.0),
+    'recording.chunk_size': Limit(1024, 1 << 30, integer=True),
+}
 
 
 class ExperimentManagerNode(Node):
@@ -74,22 +59,19 @@ class ExperimentManagerNode(Node):
             raise InvalidArgument('workers', workers, "'*' stands alone: discover, or name them")
         if len(set(self._workers)) < len(self._workers):
             raise InvalidArgument('workers', workers, 'names a worker twice')
-        call_timeout = self.declare_parameter('call_timeout', 600.0, ParameterDescriptor(
-            description='longest wait for one call to a node of the worker, s', read_only=True,
-            floating_point_range=[FloatingPointRange(from_value=1.0, to_value=86400.0)])).value
-        server_timeout = self.declare_parameter('server_timeout', 10.0, ParameterDescriptor(
-            description="longest wait for the worker's services and actions at the start of a "
-            'run, s', read_only=True,
-            floating_point_range=[FloatingPointRange(from_value=0.1, to_value=3600.0)])).value
-        self._rejoin_timeout = self.declare_parameter('rejoin_timeout', 60.0, ParameterDescriptor(
-            description='longest wait for a lost worker to come back (its nodes restarted, as '
-            '`run` does) before the run goes on without it, s; 0: do not wait', read_only=True,
-            floating_point_range=[FloatingPointRange(from_value=0.0, to_value=3600.0)])).value
-        self._chunk_size = self.declare_parameter('recording.chunk_size', 1 << 20,
-                                                  ParameterDescriptor(
-            description='bytes of messages per MCAP chunk; a killed run loses at most one',
-            read_only=True, integer_range=[IntegerRange(from_value=1024,
-                                                        to_value=1 << 30)])).value
+        def get(name: str, default, text: str):
+            return declare(self, name, default, text, LIMITS[name])
+
+        call_timeout = get('call_timeout', 600.0,
+                           'longest wait for one call to a node of the worker, s')
+        server_timeout = get('server_timeout', 10.0, "longest wait for the worker's services "
+                             'and actions at the start of a run, s')
+        self._rejoin_timeout = get('rejoin_timeout', 60.0, (
+            'longest wait for a lost worker to come back (its nodes restarted, as `run` does) '
+            'before the run goes on without it, s; 0: do not wait'))
+        self._chunk_size = get('recording.chunk_size', 1 << 20, 'bytes of messages per MCAP '
+                               'chunk; a killed run loses at most one')
+
         def dirs(name: str, default: list[str], text: str) -> list[str]:
             return self.declare_parameter(name, default, ParameterDescriptor(
                 description=text, read_only=True,
@@ -182,6 +164,7 @@ class ExperimentManagerNode(Node):
 
     # ------------------------------------------------------------------------- the action
     def _run(self, goal_handle) -> RunExperiment.Result:
+        """Map the goal to a run session, and what fails to an error code."""
         result = RunExperiment.Result()
         if not self._lock.acquire(blocking=False):
             result.error_code = RunExperiment.Result.BUSY
@@ -190,69 +173,28 @@ class ExperimentManagerNode(Node):
             goal_handle.abort()
             return result
         self._goal = goal_handle
-        writer = recorder = None
+        goal = goal_handle.request
+        session = RunSession(self._experiment_dirs, self._output_dirs, self._chunk_size,
+                             self._topics, self.get_fully_qualified_name(), self.get_logger())
         try:
-            goal = goal_handle.request
-            check_inside('experiment_file', goal.experiment_file, self._experiment_dirs,
-                         'experiment_dirs')
-            file = config.load(goal.experiment_file)
-            if file.part.mesh_path:
-                check_inside('part.mesh', file.part.mesh_path, self._experiment_dirs,
-                             'experiment_dirs')
-            if goal.resume:
-                if not goal.output_dir:
-                    raise InvalidArgument('output_dir', '', 'must name the run '
-                                                 'directory to resume')
-                run_dir = os.path.abspath(os.path.expanduser(goal.output_dir))
-            else:
-                run_dir = run_directory(goal.output_dir or file.output_dir, file.id)
-            check_inside('output_dir', run_dir, self._output_dirs, 'output_dirs')
-            writer = ResultsWriter(run_dir, file.text, goal.resume)
-            result.results_path = run_dir
-            recorder = self._open_recording(run_dir, file, goal.resume)
-            result.recording_path = recorder.path
+            session.open(goal.experiment_file, goal.output_dir, goal.resume)
+            result.results_path = session.run_dir
+            result.recording_path = session.recorder.path
             self._abort.clear()
             backends = self._workers_of_run()
-            self.get_logger().info(f'running {file.path} into {run_dir} on '
-                                   f'{len(backends)} worker(s): '
-                                   f'{", ".join(b.worker or "." for b in backends)}')
-            runner = Runner(file, backends, writer, self._publish_progress, self._abort)
-            try:
-                summary = runner.run()
-            finally:
-                for k in runner.lost_workers:
-                    self.get_logger().warning(f'worker {backends[k].worker or "."} was lost '
-                                              '(missing at the start, or during the run)')
-                for k in runner.rejoined:
-                    self.get_logger().warning(f'worker {backends[k].worker or "."} was lost '
-                                              'and came back')
+            summary = session.run(backends, self._publish_progress, self._abort,
+                                  [b.worker or '.' for b in backends])
             result.summary_json = json.dumps(summary)
-            try:
-                pictures.write(file, run_dir)
-                result.report_path = report.write(run_dir)
-            except Exception as exc:  # the results stand without their report
-                self.get_logger().error(f'the report could not be written: {exc}\n'
-                                        f'{traceback.format_exc()}')
+            result.report_path = session.write_report()
             goal_handle.succeed()
-        except (WorldError, GraphError) as exc:
-            result.error_code = (exc.code if isinstance(exc, GraphError)
-                                 else world_conv.error_code(exc))
-            result.error_msg = str(exc)
-            self.get_logger().error(f'run_experiment: {exc}')
-            self._end(goal_handle, result)
-        except Exception as exc:  # a bug: answer, log, keep serving
-            result.error_code = RunExperiment.Result.INTERNAL
-            result.error_msg = f'internal error: {type(exc).__name__}: {exc}'
-            self.get_logger().error(f'{result.error_msg}\n{traceback.format_exc()}')
+        except Exception as exc:  # core and worker errors get their code, bugs INTERNAL
+            answer_error(result, exc, self.get_logger(), 'run_experiment')
             self._end(goal_handle, result)
         finally:
-            if recorder is not None:
-                self._close_recording(recorder, writer)
-            if writer is not None:
-                writer.close()
-                if result.error_code:
-                    result.error_msg += (f' (finished iterations are kept in {writer.directory};'
-                                         ' resume the run there to finish it)')
+            session.close()
+            if session.writer is not None and result.error_code:
+                result.error_msg += (f' (finished iterations are kept in {session.run_dir};'
+                                     ' resume the run there to finish it)')
             self._goal = None
             self._lock.release()
         return result
@@ -266,34 +208,6 @@ class ExperimentManagerNode(Node):
             goal_handle.canceled()
         else:
             goal_handle.abort()
-
-    def _open_recording(self, run_dir: str, file: config.ExperimentFile,
-                        resume: bool) -> Recorder:
-        path, k = os.path.join(run_dir, 'recording.mcap'), 1
-        while resume and os.path.exists(path):
-            k += 1
-            path = os.path.join(run_dir, f'recording_{k}.mcap')
-        recorder = Recorder(path, self._chunk_size)
-        recorder.attach('experiment.yaml', file.text.encode(), 'application/yaml')
-        recorder.metadata('run', {'experiment_id': file.id, 'seed': str(file.seed),
-                                  'experiment_file': file.path, 'run_directory': run_dir,
-                                  'resumed': str(bool(resume)),
-                                  'node': self.get_fully_qualified_name()})
-        recorder.flush()
-        self._topics.start(recorder)
-        return recorder
-
-    def _close_recording(self, recorder: Recorder, writer: ResultsWriter | None) -> None:
-        self._topics.stop()
-        try:
-            for name in RESULT_FILES if writer is not None else ():
-                path = writer.path(name)
-                if os.path.exists(path):
-                    with open(path, 'rb') as f:
-                        recorder.attach(name, f.read(), 'application/json'
-                                        if name.endswith('.json') else 'text/csv')
-        finally:
-            recorder.close()
 
     def destroy_node(self) -> None:
         """On shutdown, stop a run at its next call and let it close its files."""

@@ -12,34 +12,28 @@ import threading
 import time
 
 from feeder_controller.policy import FeederConfig
-from geometry_msgs.msg import Vector3
+from pick_common import conversions as common
+from pick_common.containers import ContainerSpec
+from pick_common.errors import CodedError, PhysicsFault
+from pick_common.node_runner import GONE_AFTER, handshake, server_ready, ServerWatch, serving
+from pick_common.states import PartStates, SettleReport
 from pick_msgs.action import DropParts, FeedCycle, RemoveParts
 from pick_msgs.msg import PartArray
 from pick_msgs.srv import CheckParts, GetParts, ResetScene
-from pick_sim_world import conversions as world_conv
-from pick_sim_world.containers import ContainerSpec
-from pick_sim_world.errors import PhysicsFault
-from pick_sim_world.node_runner import handshake, server_ids
-from pick_sim_world.world import PartStates, SettleReport
 from pick_validity import conversions as validity_conv
 from pick_validity.validity import Report
 from rclpy.action import ActionClient
 from rclpy.node import Node
 
+from .backend import FeedStep, WorkerLost
 from .config import ExperimentFile
-from .experiments import FeedStep, WorkerLost
 
 POLL = 0.1              # s between checks of a pending call
-GONE_AFTER = 2.0        # s a server must stay absent from the graph before a call fails
 
 
-class GraphError(Exception):
-    """A call failed: `code` is a pick_msgs error code (the server's own, or INTERNAL when
-    the server is missing or lost, CANCELED when the goal was canceled)."""
-
-    def __init__(self, code: int, message: str) -> None:
-        self.code = code
-        super().__init__(message)
+class GraphError(CodedError):
+    """A call to a worker failed: `code` is a pick_msgs error code (the server's own, or
+    INTERNAL when the server is missing or lost, CANCELED when the goal was canceled)."""
 
 
 class WorkerGone(GraphError, WorkerLost):
@@ -111,7 +105,7 @@ class GraphBackend:
         self._shaken = False    # every server answered a probe (handshake)
         # client -> the DDS ids of its servers when this iteration began (reset): a server
         # answering under other ids is a node started again, without the iteration's scene
-        # or feeder state.
+        # or feeder state. Before the first iteration, any server will do.
         self._serving: dict = {c: frozenset() for c in self._clients}
 
     @property
@@ -131,25 +125,13 @@ class GraphBackend:
                 self._node.destroy_client(client)
 
     # ------------------------------------------------------------------------- waiting
-    def _ready(self, client) -> bool:
-        if isinstance(client, ActionClient):
-            return client.server_is_ready()
-        return client.service_is_ready()
-
     def _endpoint(self, client) -> str:
         name = client._action_name if isinstance(client, ActionClient) else client.srv_name
         return self._node.resolve_service_name(name)
 
     def _missing(self) -> list:
         """The worker's clients whose server is not in the graph now."""
-        return [c for c in self._clients if not self._ready(c)]
-
-    def _lost(self, serving: dict) -> list:
-        """The worker's clients none of whose servers in `serving` (client -> server_ids,
-        taken when a call began) is in the graph now: their node died, even if it has been
-        started again since."""
-        return [c for c in self._clients if not (
-            serving[c] & server_ids(self._node, c) if serving[c] else self._ready(c))]
+        return [c for c in self._clients if not server_ready(c)]
 
     def rejoin(self, stop: Callable[[], bool]) -> bool:
         """Wait for a lost worker to come back (its nodes restarted: every endpoint served
@@ -200,48 +182,41 @@ class GraphBackend:
         done = threading.Event()
         future.add_done_callback(lambda _: done.set())
         start = time.monotonic()
-        absent_since = None
-        serving = self._serving
+        watch = ServerWatch(self._node, self._serving)
         if self._canceled():   # before the first wait too: short calls would never notice
             future.cancel()
             raise GraphError(CheckParts.Response.CANCELED, f'canceled before {what}')
         while not done.wait(POLL):
-            now = time.monotonic()
             if self._canceled():
                 future.cancel()
                 raise GraphError(CheckParts.Response.CANCELED, f'canceled during {what}')
-            if now - start > self._call_timeout:
+            if time.monotonic() - start > self._call_timeout:
                 raise WorkerGone(CheckParts.Response.INTERNAL, (
                     f'{what}: no answer from {self._endpoint(client)} within call_timeout '
                     f'{self._call_timeout:g} s'))
-            missing = self._lost(serving)
-            if not missing:
-                absent_since = None
-            elif absent_since is None:
-                absent_since = now
-            elif now - absent_since > GONE_AFTER:
+            if gone := watch.gone():
                 raise WorkerGone(CheckParts.Response.INTERNAL, (
-                    f'{what}: {", ".join(self._endpoint(c) for c in missing)} left the graph '
+                    f'{what}: {", ".join(self._endpoint(c) for c in gone)} left the graph '
                     'while the worker was answering (its node died, was stopped or restarted)'))
         deadline = time.monotonic() + GONE_AFTER
-        while missing := self._lost(serving):
+        while lost := watch.lost():
             if time.monotonic() > deadline:
                 raise WorkerGone(CheckParts.Response.INTERNAL, (
-                    f'{what}: {", ".join(self._endpoint(c) for c in missing)} of this '
+                    f'{what}: {", ".join(self._endpoint(c) for c in lost)} of this '
                     'iteration left the graph (its node died, was stopped or restarted): the '
                     "answer may come from a node without the iteration's state"))
             time.sleep(POLL)
         return future.result()
 
     def _service(self, client, request, what: str):
-        if not self._ready(client):
+        if not server_ready(client):
             self.wait_for_servers()
         response = self._wait(client.call_async(request), client, what)
         self._raise_on_error(response, what)
         return response
 
     def _action(self, client: ActionClient, goal, what: str):
-        if not self._ready(client):
+        if not server_ready(client):
             self.wait_for_servers()
         handle = self._wait(client.send_goal_async(goal), client, what)
         if not handle.accepted:
@@ -258,21 +233,21 @@ class GraphBackend:
         """Raise the server's error. An INTERNAL error while endpoints of the worker are gone
         (the feeder_controller answers so when the world it waits on died) means the worker
         is lost, not the run: WorkerGone, and the iteration runs elsewhere."""
-        if answer.error_code == world_conv.ERROR_NONE:
+        if answer.error_code == common.ERROR_NONE:
             return
         missing = self._missing() if answer.error_code == CheckParts.Response.INTERNAL else []
         if missing:
             raise WorkerGone(answer.error_code, (
                 f'{what}: {answer.error_msg} ({", ".join(self._endpoint(c) for c in missing)} '
                 'left the graph)'))
-        if answer.error_code == world_conv.ERROR_PHYSICS_FAULT:
+        if answer.error_code == common.ERROR_PHYSICS_FAULT:
             raise GraphPhysicsFault(answer.error_code, f'{what}: {answer.error_msg}')
         raise GraphError(answer.error_code, f'{what}: {answer.error_msg}')
 
     # ------------------------------------------------------------------------- Backend
     def start(self, file: ExperimentFile) -> None:
         self._file = file
-        self._part_msg = world_conv.part_spec_to_msg(file.part)
+        self._part_msg = common.part_spec_to_msg(file.part)
         self._setup = validity_conv.Setup(file.gripper, file.grasps, file.place, file.check)
         self.wait_for_servers()
 
@@ -280,26 +255,26 @@ class GraphBackend:
         """Begin an iteration: its servers are the ones in the graph now."""
         if self._missing():
             self.wait_for_servers()
-        self._serving = {c: server_ids(self._node, c) for c in self._clients}
-        request = ResetScene.Request(container=world_conv.container_to_msg(container),
+        self._serving = serving(self._node, self._clients)
+        request = ResetScene.Request(container=common.container_to_msg(container),
                                      part_model=self._part_msg, instance_count=1, seed=seed)
         self._service(self._reset, request, 'reset_scene')
         self._parts_msg = PartArray()
 
     def _states(self, msg: PartArray) -> PartStates:
         self._parts_msg = msg
-        return world_conv.states_from_msg(msg)
+        return common.states_from_msg(msg)
 
     def drop(self, count: int, zone: str) -> tuple[PartStates, SettleReport]:
         goal = DropParts.Goal(count=count, zone=DropParts.Goal.ZONE_FEEDER if zone == 'feeder'
                               else DropParts.Goal.ZONE_CONTAINER)
         result = self._action(self._drop, goal, 'drop_parts')
-        return self._states(result.parts), world_conv.settle_from_msg(result.settle)
+        return self._states(result.parts), common.settle_from_msg(result.settle)
 
     def remove(self, ids: list[int], settle: bool = True) -> tuple[PartStates, SettleReport]:
         goal = RemoveParts.Goal(part_ids=[int(i) for i in ids], skip_settle=not settle)
         result = self._action(self._remove, goal, 'remove_parts')
-        return self._states(result.parts), world_conv.settle_from_msg(result.settle)
+        return self._states(result.parts), common.settle_from_msg(result.settle)
 
     def parts(self) -> PartStates:
         return self._states(self._service(self._get, GetParts.Request(), 'get_parts').parts)
@@ -313,7 +288,7 @@ class GraphBackend:
         if [p.id for p in parts] != states.ids.tolist():
             raise GraphError(CheckParts.Response.INTERNAL,
                              'check_parts: the parts to check are not among the last received')
-        request = CheckParts.Request(container=world_conv.container_to_msg(container),
+        request = CheckParts.Request(container=common.container_to_msg(container),
                                      part_model=self._part_msg, parts=parts,
                                      target_ids=[int(t) for t in targets],
                                      check_neighbours=neighbours)
@@ -322,12 +297,8 @@ class GraphBackend:
         return validity_conv.report_from_msg(response.report)
 
     def feed(self, valid: int, on_table: int, restart: FeederConfig | None) -> FeedStep:
-        v = self._file.vibration
         goal = FeedCycle.Goal(valid_parts=valid, parts_on_table=on_table,
-                              amplitude=Vector3(x=v.amplitude[0], y=v.amplitude[1],
-                                                z=v.amplitude[2]),
-                              frequency=v.frequency, duration=v.duration,
-                              direction=world_conv.direction_to_msg(v.direction))
+                              vibration=common.vibration_to_msg(self._file.vibration))
         if restart is not None:
             goal.restart = True
             goal.feeder_parts, goal.min_count = restart.feeder_parts, restart.min_count

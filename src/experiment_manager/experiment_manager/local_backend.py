@@ -5,13 +5,15 @@ the experiment logic and the benchmark's graph-against-core ratio run on it.
 """
 
 from feeder_controller.policy import FeederConfig, FeederPolicy
-from pick_sim_world.config import PhysicsConfig, SceneSpec
-from pick_sim_world.containers import ContainerSpec
-from pick_sim_world.world import PartStates, SettleReport, World
+from pick_common.containers import ContainerSpec
+from pick_common.specs import SceneSpec
+from pick_common.states import PartStates, SettleReport
+from pick_sim_world.config import PhysicsConfig
+from pick_sim_world.world import World
 from pick_validity.validity import Report, Validator
 
+from .backend import FeedStep
 from .config import ExperimentFile
-from .experiments import FeedStep
 
 
 class LocalBackend:

@@ -14,14 +14,14 @@ import os
 
 import matplotlib.image
 import numpy as np
-from pick_sim_world.config import SceneSpec
+from pick_common.specs import SceneSpec
 from pick_sim_world.world import Overlay, World
 from pick_validity.config import check_grasps, Gripper
 from pick_validity.validity import grasp_basis, STAGE_CONTAINER, STAGE_NEIGHBOUR
 from scipy.spatial.transform import Rotation
 
 from .config import BIN_EMPTYING, ExperimentFile, TABLE_SWEEP
-from .experiments import plan, Unit
+from .plan import plan, Unit
 
 SIZE = (800, 600)
 GREEN, RED = (0.1, 0.8, 0.1, 0.55), (0.9, 0.1, 0.1, 0.55)

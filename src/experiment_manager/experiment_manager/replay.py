@@ -21,7 +21,7 @@ import time
 
 from mcap.exceptions import McapError
 from mcap.reader import make_reader
-from pick_sim_world.node_runner import LATCHED
+from pick_common.node_runner import LATCHED
 import rclpy
 from rclpy.duration import Duration
 from rclpy.node import Node

@@ -2,10 +2,10 @@
 
 A run directory holds:
 - `experiment.yaml`: the experiment file as it was read;
-- `iterations.csv`: one row per iteration (ITERATION_COLUMNS);
-- `checks.csv`: one row per validity check (CHECK_COLUMNS);
-- `parts.csv`: one row per part per check, with its pose and stage (PART_COLUMNS);
-- `picks.csv`: one row per picked part, with the gripper pose (PICK_COLUMNS);
+- `iterations.csv`: one row per iteration (rows.ITERATION_COLUMNS);
+- `checks.csv`: one row per validity check (rows.CHECK_COLUMNS);
+- `parts.csv`: one row per part per check, with its pose and stage (rows.PART_COLUMNS);
+- `picks.csv`: one row per picked part, with the gripper pose (rows.PICK_COLUMNS);
 - `summary.json`: the metrics, rewritten (atomically) after each experiment.
 
 An iteration's rows are appended and flushed together, `iterations.csv` last: a run that stops
@@ -20,45 +20,12 @@ import json
 import os
 import tempfile
 
-from pick_sim_world.errors import InvalidArgument
+from pick_common.errors import InvalidArgument
 
-from .experiments import GRIPPER_POSE, POSE, Record
+from .rows import FILES, KEY, parse_row, Record
 
 UMASK = os.umask(0o022)
 os.umask(UMASK)
-KEY = ('experiment', 'group', 'iteration')
-ITERATION_COLUMNS = (
-    'experiment', 'type', 'group', 'iteration', 'seed', 'container_x', 'container_y',
-    'container_z', 'parts', 'checked', 'candidates', 'placeable', 'container_free', 'valid',
-    'checks', 'picks', 'settled', 'escaped', 'emptied', 'vibrations', 'feeds', 'lost', 'stop',
-    'fault', 'wall_time')
-CHECK_COLUMNS = (*KEY, 'check', 'parts_on_table', 'checked', 'candidates', 'placeable',
-                 'container_free', 'valid', 'picked_id', 'searches', 'vibrations', 'wall_time')
-PART_COLUMNS = (*KEY, 'check', 'part_id', *POSE, 'inside', 'stage', 'grasp', 'tilts')
-PICK_COLUMNS = (*KEY, 'pick', 'check', 'part_id', 'searches', 'vibrations', 'grasp',
-                *GRIPPER_POSE)
-FILES = {'iterations': ITERATION_COLUMNS, 'checks': CHECK_COLUMNS, 'parts': PART_COLUMNS,
-         'picks': PICK_COLUMNS}
-TEXT = {'experiment', 'type', 'stop', 'fault'}
-FLOAT = {'container_x', 'container_y', 'container_z', 'wall_time', *POSE, *GRIPPER_POSE}
-BOOL = {'settled', 'emptied', 'inside'}
-
-
-def parse_row(row: dict) -> dict:
-    """A CSV row with its values typed again."""
-    out = {}
-    for k, v in row.items():
-        if k in TEXT:
-            out[k] = v
-        elif k in FLOAT:
-            out[k] = float(v)
-        elif k in BOOL:
-            out[k] = v == 'True'
-        else:
-            out[k] = int(v)
-    return out
-
-
 def read_csv(path: str) -> list[dict]:
     """The rows of a results file, typed."""
     return [parse_row(r) for r in read_text_rows(path)]

@@ -3,9 +3,9 @@
 import os
 
 from experiment_manager import config
-from experiment_manager.experiments import Runner
 from experiment_manager.local_backend import LocalBackend
 from experiment_manager.results import ResultsWriter
+from experiment_manager.scheduler import Runner
 import pytest
 
 SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')

@@ -6,7 +6,7 @@ import os
 import re
 
 from experiment_manager import config
-from pick_sim_world.errors import InvalidArgument
+from pick_common.errors import InvalidArgument
 import pytest
 
 HERE = os.path.dirname(__file__)

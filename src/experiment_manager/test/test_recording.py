@@ -11,10 +11,11 @@ from mcap.reader import make_reader
 from mcap.records import Message
 from mcap.stream_reader import StreamReader
 from mcap_ros2.decoder import DecoderFactory
+from pick_common.containers import ContainerSpec
+from pick_common.conversions import states_to_msg
+from pick_common.specs import SceneSpec
 from pick_msgs.msg import FeederState, Part, PartArray, PartValidity, ValidityReport
-from pick_sim_world.config import SceneSpec
-from pick_sim_world.containers import ContainerSpec
-from pick_sim_world.conversions import markers_msg, scene_to_msg, states_to_msg
+from pick_sim_world.conversions import markers_msg, scene_to_msg
 from pick_sim_world.world import World
 import pytest
 from rclpy.serialization import deserialize_message

@@ -6,8 +6,8 @@ import json
 import os
 import shutil
 
-from experiment_manager import config, pictures, report
-from experiment_manager.report import FEASIBLE, NOT_ANALYSED, NOT_FEASIBLE
+from experiment_manager import config, pictures, report, verdicts
+from experiment_manager.verdicts import FEASIBLE, NOT_ANALYSED, NOT_FEASIBLE
 import pytest
 
 
@@ -46,19 +46,19 @@ def test_verdicts_follow_the_emptied_runs_and_the_capacity(run_dir):
     s['requirements']['capacity'] = 10
     s['experiments']['emptying'].update(emptied=1, iterations=1)
     s['experiments']['feeder'].update(emptied=1, iterations=1)
-    assert [v['verdict'] for v in report.verdicts(s, {})] == [FEASIBLE, FEASIBLE]
+    assert [v['verdict'] for v in verdicts.verdicts(s, {})] == [FEASIBLE, FEASIBLE]
     s['experiments']['feeder'].update(emptied=0, lost=1)
-    table = report.verdicts(s, {})[1]
+    table = verdicts.verdicts(s, {})[1]
     assert table['verdict'] == NOT_FEASIBLE and '1 part fell off the table' in table['reasons']
     s['experiments']['feeder']['stops'] = {'stop: empty': 1, 'stop: vibration limit': 2}
     assert 'runs ended by: feeder and table empty 1, vibration limit 2)' in \
-        report.verdicts(s, {})[1]['reasons'][0]
+        verdicts.verdicts(s, {})[1]['reasons'][0]
     s['requirements']['capacity'] = 480         # 30 parts cannot last a refill interval
-    bin_verdict = report.verdicts(s, {})[0]
+    bin_verdict = verdicts.verdicts(s, {})[0]
     assert bin_verdict['verdict'] == NOT_FEASIBLE
     assert 'fewer than the 480 a refill interval needs' in bin_verdict['reasons'][-1]
     del s['experiments']['emptying'], s['experiments']['feeder']
-    assert [v['verdict'] for v in report.verdicts(s, {})] == [NOT_ANALYSED, NOT_ANALYSED]
+    assert [v['verdict'] for v in verdicts.verdicts(s, {})] == [NOT_ANALYSED, NOT_ANALYSED]
 
 
 def test_the_papers_numbers_stand_beside_ours_for_its_test_case(run_dir, tmp_path):
@@ -97,9 +97,9 @@ def _as_paper_says(summary: dict, paper: dict) -> dict:
 
 
 def test_against_the_paper_says_which_findings_hold_and_why_figures_differ(run_dir):
-    paper = report.PAPER['pth0']
+    paper = verdicts.PAPER['pth0']
     s = _as_paper_says(_summary(run_dir), paper)
-    text = '\n'.join(report.against_paper(s, paper))
+    text = '\n'.join(verdicts.against_paper(s, paper))
     assert text.count('| agrees |') == 3 and '| differs |' not in text, text
     assert 'rise to n* = 49, then fall: 26 % below the peak at n = 100 (fit)' in text
     assert '| best bin (mm) | 100 x 175 x 15 | 100 x 175 x 15 | the same |' in text
@@ -111,7 +111,7 @@ def test_against_the_paper_says_which_findings_hold_and_why_figures_differ(run_d
     s['experiments']['feeder'].update(emptied=47, lost=4)
     s['experiments']['feeder']['faults']['escaped'] = 3
     s['experiments']['feeder']['vibrations_to_empty']['mean'] = 250.0
-    text = '\n'.join(report.against_paper(s, paper))
+    text = '\n'.join(verdicts.against_paper(s, paper))
     assert '| static bins never emptied (0 of 40) | 1 of 40 emptied | differs |' in text
     assert 'then level off: 1 % below the peak' in text
     assert '| the tray emptied in every feeder run (50 of 50) | 47 of 50 emptied | differs |' \
@@ -125,7 +125,7 @@ def test_against_the_paper_says_which_findings_hold_and_why_figures_differ(run_d
 
     s['experiments']['sweep'].update(n_star=100)
     assert "still rising at the sweep's last count, n = 100" in '\n'.join(
-        report.against_paper(s, paper))
+        verdicts.against_paper(s, paper))
     page = report.to_html(report.markdown(s, {}, {}), 'pth0')
     assert '<h2>Against the paper</h2>' in page and page.count('<li>') == 4
 

@@ -5,16 +5,21 @@ world's `drop_parts` (feeder zone) and `vibrate` actions by relative names, so i
 namespace it commands that worker's world. One goal at a time: another is answered BUSY.
 """
 
-from dataclasses import dataclass
 import threading
-import time
 
+from pick_common.conversions import ERROR_INTERNAL, ERROR_NONE
+from pick_common.errors import CodedError
+from pick_common.node_runner import (
+    answer_error,
+    declare,
+    LATCHED,
+    RESULT_KEEP,
+    run,
+    ServerWatch,
+    serving,
+)
 from pick_msgs.action import DropParts, FeedCycle, Vibrate
 from pick_msgs.msg import FeederState as FeederStateMsg
-from pick_sim_world import conversions as world_conversions
-from pick_sim_world.errors import WorldError
-from pick_sim_world.node_runner import LATCHED, RESULT_KEEP, run, server_ids
-from rcl_interfaces.msg import IntegerRange, ParameterDescriptor
 from rclpy.action import ActionClient, ActionServer
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import SingleThreadedExecutor
@@ -26,6 +31,7 @@ from .policy import (
     FEED_AND_VIBRATE,
     FeederConfig,
     FeederPolicy,
+    LIMITS,
     NAMES,
     PICK,
     STOP_EMPTY,
@@ -38,28 +44,7 @@ STATES = {-1: FeederStateMsg.STATE_IDLE, PICK: FeederStateMsg.STATE_PICKING,
           STOP_EMPTY: FeederStateMsg.STATE_DONE_EMPTY,
           STOP_VIBRATION_LIMIT: FeederStateMsg.STATE_DONE_VIBRATION_LIMIT}
 SERVER_WAIT = 5.0   # s to wait for the world's action server before answering an error
-GONE_AFTER = 2.0    # s the world's action server may be absent while a goal is in flight
 WATCH_PERIOD = 0.5  # s between checks that it is still there
-
-
-class WorldCommandError(Exception):
-    """The world did not do what the policy asked; carries the error code to report."""
-
-    def __init__(self, code: int, message: str) -> None:
-        self.code = code
-        super().__init__(message)
-
-
-@dataclass
-class WorldCall:
-    """The call to the world in flight, the ids of the server that took it, and since when
-    (monotonic s) that server is absent."""
-
-    future: Future
-    client: ActionClient
-    name: str
-    serving: frozenset[bytes]
-    absent_since: float | None = None
 
 
 class FeederControllerNode(Node):
@@ -69,17 +54,15 @@ class FeederControllerNode(Node):
         super().__init__('feeder_controller')
         d = FeederConfig()
 
-        def get(name, default, text, high):
-            return self.declare_parameter(name, default, ParameterDescriptor(
-                description=text, read_only=True,
-                integer_range=[IntegerRange(from_value=1, to_value=high)])).value
+        def get(name, default, text):
+            return declare(self, name, default, text, LIMITS[name])
 
         self._defaults = FeederConfig(
-            feeder_parts=get('feeder.parts', d.feeder_parts, 'parts loaded per run', 100_000),
-            min_count=get('feeder.min_count', d.min_count, 'min* of the optimal range', 5000),
-            max_count=get('feeder.max_count', d.max_count, 'max* of the optimal range', 5000),
+            feeder_parts=get('feeder.parts', d.feeder_parts, 'parts loaded per run'),
+            min_count=get('feeder.min_count', d.min_count, 'min* of the optimal range'),
+            max_count=get('feeder.max_count', d.max_count, 'max* of the optimal range'),
             max_vibrations=get('feeder.max_vibrations', d.max_vibrations,
-                               'vibrations before a run stops', 1_000_000))
+                               'vibrations before a run stops'))
         self._policy = FeederPolicy(self._defaults)
         self._lock = threading.Lock()
         group = ReentrantCallbackGroup()
@@ -88,7 +71,8 @@ class FeederControllerNode(Node):
         self._vibrate = ActionClient(self, Vibrate, 'vibrate', callback_group=group)
         ActionServer(self, FeedCycle, 'feed_cycle', execute_callback=self._feed_cycle,
                      callback_group=group, result_timeout=RESULT_KEEP)
-        self._in_flight: WorldCall | None = None
+        # the call to the world in flight and the watch on the server that took it
+        self._in_flight: tuple[Future, ServerWatch, str] | None = None
         self.create_timer(WATCH_PERIOD, self._watch, callback_group=group)
         self._publish_state()
 
@@ -104,42 +88,37 @@ class FeederControllerNode(Node):
         self._state_pub.publish(self._state_msg())
 
     async def _world(self, client: ActionClient, goal, name: str):
-        """Send a goal to the world's action `name` and await its result. Raises
-        WorldCommandError with the world's own error code, or INTERNAL when it is not there."""
+        """Send a goal to the world's action `name` and await its result. Raises CodedError
+        with the world's own error code, or INTERNAL when it is not there or leaves."""
         if not client.wait_for_server(timeout_sec=SERVER_WAIT):
-            raise WorldCommandError(FeedCycle.Result.INTERNAL, (
+            raise CodedError(ERROR_INTERNAL, (
                 f'the world action {name!r} in namespace {self.get_namespace()!r} did not '
                 f'answer within {SERVER_WAIT:g} s: is the world node running there?'))
         handle = await self._watched(client.send_goal_async(goal), client, name)
         if not handle.accepted:
-            raise WorldCommandError(FeedCycle.Result.INTERNAL, f'the world rejected {name}')
+            raise CodedError(ERROR_INTERNAL, f'the world rejected {name}')
         result = (await self._watched(handle.get_result_async(), client, name)).result
-        if result.error_code != world_conversions.ERROR_NONE:
-            raise WorldCommandError(result.error_code, f'world {name}: {result.error_msg}')
+        if result.error_code != ERROR_NONE:
+            raise CodedError(result.error_code, f'world {name}: {result.error_msg}')
         return result
 
-    def _watched(self, future, client: ActionClient, name: str):
-        """`future`, failed by _watch with WorldCommandError if the world's server leaves the
-        graph before it completes (a world that died never answers)."""
-        self._in_flight = WorldCall(future, client, name, server_ids(self, client))
+    def _watched(self, future: Future, client: ActionClient, name: str) -> Future:
+        """`future`, failed by _watch with CodedError if the world's server that took it leaves
+        the graph before it completes (a world that died never answers)."""
+        self._in_flight = (future, ServerWatch(self, serving(self, [client])), name)
         return future
 
     def _watch(self) -> None:
-        call, now = self._in_flight, time.monotonic()
-        if call is None:
+        if self._in_flight is None:
             return
-        if call.future.done():
+        future, watch, name = self._in_flight
+        if future.done():
             self._in_flight = None
-        elif (call.serving & server_ids(self, call.client) if call.serving
-              else call.client.server_is_ready()):   # the world that took it, not a new one
-            call.absent_since = None
-        elif call.absent_since is None:
-            call.absent_since = now
-        elif now - call.absent_since > GONE_AFTER:
+        elif watch.gone():
             self._in_flight = None
-            call.future.set_exception(WorldCommandError(FeedCycle.Result.INTERNAL, (
-                f'the world action {call.name!r} left the graph while answering (its node '
-                'died or was stopped)')))
+            future.set_exception(CodedError(ERROR_INTERNAL, (
+                f'the world action {name!r} left the graph while answering (its node died or '
+                'was stopped)')))
 
     async def _feed_cycle(self, goal_handle) -> FeedCycle.Result:
         goal = goal_handle.request
@@ -171,20 +150,12 @@ class FeederControllerNode(Node):
                 goal_handle.publish_feedback(FeedCycle.Feedback(
                     state=self._state_msg(), phase='vibrating'))
                 await self._world(self._vibrate, Vibrate.Goal(
-                    instances=[goal.instance], amplitude=goal.amplitude,
-                    frequency=goal.frequency, duration=goal.duration,
-                    direction=goal.direction), 'vibrate')
+                    instances=[goal.instance], vibration=goal.vibration), 'vibrate')
                 self._policy.vibrated()
             goal_handle.succeed()
             self.get_logger().debug(f'feed_cycle: {NAMES[step.decision]}')
-        except WorldError as exc:
-            result.error_code = world_conversions.error_code(exc)
-            result.error_msg = str(exc)
-            goal_handle.abort()
-        except WorldCommandError as exc:
-            result.error_code = exc.code
-            result.error_msg = str(exc)
-            self.get_logger().error(result.error_msg)
+        except Exception as exc:  # core errors and the world's get their code, bugs INTERNAL
+            answer_error(result, exc, self.get_logger(), 'feed_cycle')
             goal_handle.abort()
         finally:
             result.state = self._state_msg()

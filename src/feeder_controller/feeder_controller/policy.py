@@ -11,13 +11,20 @@ state true.
 
 from dataclasses import dataclass
 
-from pick_sim_world.errors import check_int, InvalidArgument
+from pick_common.errors import check_int, InvalidArgument, Limit
 
 PICK, VIBRATE, FEED_AND_VIBRATE, STOP_EMPTY, STOP_VIBRATION_LIMIT = range(5)
 NAMES = ('pick', 'vibrate', 'feed and vibrate', 'stop: empty', 'stop: vibration limit')
 MAX_FEEDER_PARTS = 100_000
 MAX_TABLE_PARTS = 5000
 MAX_VIBRATIONS = 1_000_000
+# The range of each setting, by the feeder_controller node's parameter name.
+LIMITS = {
+    'feeder.parts': Limit(1, MAX_FEEDER_PARTS, integer=True),
+    'feeder.max_count': Limit(1, MAX_TABLE_PARTS, integer=True),
+    'feeder.min_count': Limit(1, MAX_TABLE_PARTS, integer=True),    # and at most max_count
+    'feeder.max_vibrations': Limit(1, MAX_VIBRATIONS, integer=True),
+}
 
 
 @dataclass(frozen=True)
@@ -33,10 +40,10 @@ class FeederConfig:
 
 def check_feeder(cfg: FeederConfig) -> FeederConfig:
     """Check every field; raise InvalidArgument naming the first that is wrong."""
-    check_int('feeder_parts', cfg.feeder_parts, low=1, high=MAX_FEEDER_PARTS)
-    high = check_int('max_count', cfg.max_count, low=1, high=MAX_TABLE_PARTS)
+    LIMITS['feeder.parts'].check('feeder_parts', cfg.feeder_parts)
+    high = LIMITS['feeder.max_count'].check('max_count', cfg.max_count)
     check_int('min_count', cfg.min_count, low=1, high=high)
-    check_int('max_vibrations', cfg.max_vibrations, low=1, high=MAX_VIBRATIONS)
+    LIMITS['feeder.max_vibrations'].check('max_vibrations', cfg.max_vibrations)
     return cfg
 
 

@@ -10,7 +10,7 @@ from feeder_controller.policy import (
     VIBRATE,
 )
 import numpy as np
-from pick_sim_world.errors import InvalidArgument
+from pick_common.errors import InvalidArgument
 import pytest
 
 

@@ -1,38 +1,25 @@
-"""The physics world: containers, parts, dropping, settling, vibrating, feeding and removing.
+"""The physics world: one PyBullet client holding N independent instances side by side, each
+with its own container, parts and random generator (the paper's "demo instances", figure 10).
+It drops and feeds parts, vibrates trays, removes parts, and settles.
 
-Pure core: PyBullet (DIRECT mode), numpy and trimesh; no rclpy. One `World` owns one PyBullet
-client holding N independent instances side by side, each with its own container, parts and
-random generator (the paper's "demo instances", figure 10).
+Pure core: PyBullet (DIRECT mode), numpy and trimesh; no rclpy. `World` keeps the scene's
+state and delegates: bodies.py builds the scene, spawning.py places new parts, tray.py moves
+the trays, stepping.py steps until the parts rest, camera.py takes pictures.
 
 Poses are (N, 7) float64 arrays, xyz in metres then an xyzw unit quaternion, expressed in the
 instance frame (origin at the centre of the container's inner floor, +Z up).
 """
 
-from collections import deque
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
-import math
 import os
 import shutil
 import tempfile
-import time
 
 import numpy as np
-import pybullet as pb
-import trimesh
-
-from . import containers
-from .config import (
-    check_physics,
-    check_scene,
-    check_vibration,
-    MAX_PARTS_PER_INSTANCE,
-    PhysicsConfig,
-    RANDOM,
-    SceneSpec,
-    Vibration,
-)
-from .errors import (
+from pick_common import containers
+from pick_common.containers import check_fits
+from pick_common.errors import (
     check_int,
     check_number,
     InvalidArgument,
@@ -40,76 +27,22 @@ from .errors import (
     UnknownInstance,
     UnknownPart,
 )
-from .parts import build_part, PartGeometry
+from pick_common.parts import build_part, PartGeometry
+from pick_common.specs import (
+    check_scene,
+    check_vibration,
+    MAX_PARTS_PER_INSTANCE,
+    SceneSpec,
+    Vibration,
+)
+from pick_common.states import PartStates, SettleReport
+import pybullet as pb
 
-GRAVITY = 9.81                  # m/s^2
-INSTANCE_GAP = 0.05             # m between the outer walls of neighbouring instances
-SPAWN_GAP = 0.0005              # m of clearance between spawn spheres
-PACKING_LIMIT = 0.4             # largest fraction of a container's inner volume parts may fill
-TRAY_MASS = 3.0                 # kg; the tray is a dynamic body held by a driven constraint
-TRAY_MAX_FORCE = 5000.0         # N the constraint may apply to hold the tray on its trajectory
-
-ProgressCallback = Callable[['Progress'], bool]
-
-
-@dataclass(frozen=True)
-class Progress:
-    """Sent once per settle check. phase: 'dropping', 'vibrating' or 'settling'.
-
-    sim_time: s since the operation started. parts_moving: parts not at rest over the settle
-    window. max_displacement: largest position change of a part over the window, m.
-    """
-
-    phase: str
-    sim_time: float
-    parts_moving: int
-    max_displacement: float
-
-
-@dataclass
-class SettleReport:
-    """How an operation ended. Times in s; ids of parts still moving and outside containers."""
-
-    settled: bool
-    sim_time: float
-    wall_time: float
-    steps: int
-    unsettled_ids: list[int] = field(default_factory=list)
-    escaped_ids: list[int] = field(default_factory=list)
-    canceled: bool = False
-
-
-@dataclass(frozen=True)
-class Overlay:
-    """A shape drawn in a picture only (no physics). kind: 'box' (size = half extents x, y, z)
-    or 'cylinder' (size = radius, length, along its z); pose: (7,) xyz + xyzw, world frame, m;
-    rgba: colour, 0..1."""
-
-    kind: str
-    size: tuple[float, ...]
-    pose: tuple[float, ...]
-    rgba: tuple[float, float, float, float] = (0.2, 0.8, 0.2, 0.6)
-
-
-@dataclass(frozen=True, eq=False)
-class PartStates:
-    """A snapshot. ids, instances: (N,) int64; poses: (N, 7) float64 in each part's instance
-    frame; inside: (N,) bool, the part's origin is in its container; sim_time: s."""
-
-    ids: np.ndarray
-    instances: np.ndarray
-    poses: np.ndarray
-    inside: np.ndarray
-    sim_time: float
-
-    def select(self, instances: Iterable[int]) -> 'PartStates':
-        """The parts of the given instances only."""
-        return self.masked(np.isin(self.instances, np.fromiter(instances, dtype=np.int64)))
-
-    def masked(self, mask: np.ndarray) -> 'PartStates':
-        """The parts where `mask` (N,) is true."""
-        return PartStates(self.ids[mask], self.instances[mask], self.poses[mask],
-                          self.inside[mask], self.sim_time)
+from . import bodies, camera, spawning, stepping
+from .camera import Overlay
+from .config import check_physics, PhysicsConfig
+from .stepping import ProgressCallback
+from .tray import TrayDrive, vibration_amplitude
 
 
 @dataclass
@@ -123,41 +56,6 @@ class Instance:
     constraint: int | None
     rng: np.random.Generator
     part_ids: list[int] = field(default_factory=list)
-
-
-def instance_seed(seed: int, index: int) -> int:
-    """The seed of instance `index` derived from the scene's base seed (stable across runs)."""
-    return int(np.random.SeedSequence([seed, index]).generate_state(1, np.uint64)[0])
-
-
-def random_quaternions(rng: np.random.Generator, n: int) -> np.ndarray:
-    """n uniformly distributed unit quaternions, (n, 4) xyzw."""
-    q = rng.normal(size=(n, 4))
-    return q / np.linalg.norm(q, axis=1, keepdims=True)
-
-
-def rotate(quaternions: np.ndarray, vector: np.ndarray) -> np.ndarray:
-    """Rotate one vector (3,) by each quaternion (n, 4) xyzw; returns (n, 3)."""
-    xyz, w = quaternions[:, :3], quaternions[:, 3:4]
-    t = 2.0 * np.cross(xyz, vector)
-    return vector + w * t + np.cross(xyz, t)
-
-
-def vibration_amplitude(vibration: Vibration, rng: np.random.Generator) -> np.ndarray:
-    """The peak displacement (3,) of one vibration, m: as given (FIXED), or with its horizontal
-    part turned about +Z by an angle drawn uniformly from `rng` (RANDOM)."""
-    x, y, z = vibration.amplitude
-    if vibration.direction == RANDOM:
-        angle = rng.uniform(0.0, 2.0 * math.pi)
-        cos, sin = math.cos(angle), math.sin(angle)
-        x, y = cos * x - sin * y, sin * x + cos * y
-    return np.array([x, y, z])
-
-
-def quaternion_angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Rotation angle between quaternion pairs (n, 4) and (n, 4), rad."""
-    dot = np.abs(np.einsum('ij,ij->i', a, b))
-    return 2.0 * np.arccos(np.clip(dot, 0.0, 1.0))
 
 
 class World:
@@ -216,78 +114,21 @@ class World:
 
     def _build(self, scene: SceneSpec, part: PartGeometry) -> None:
         c = self._client
-        cfg = self._physics
-        pb.resetSimulation(physicsClientId=c)
-        pb.setGravity(0.0, 0.0, -GRAVITY, physicsClientId=c)
-        pb.setPhysicsEngineParameter(
-            fixedTimeStep=cfg.time_step, numSolverIterations=cfg.solver_iterations,
-            contactBreakingThreshold=cfg.contact_breaking_threshold,
-            deterministicOverlappingPairs=1, physicsClientId=c)
+        bodies.configure(c, self._physics)
         self._scene, self._part = scene, part
         self._instances, self._bodies, self._owner = [], {}, {}
         self._next_id, self._sim_time = 0, 0.0
         self._at_rest = True     # the last step run ended settled (the settle criterion)
-        self._part_shape = self._create_part_shape(part)
-        pitch = containers.outer_size(scene.container)[0] + INSTANCE_GAP
-        for k in range(scene.instance_count):
-            origin = np.array([k * pitch, 0.0, 0.0])
-            body, constraint = self._create_container(scene.container, origin)
-            seed = instance_seed(scene.seed, k)
-            self._instances.append(Instance(k, seed, origin, body, constraint,
-                                            np.random.default_rng(seed)))
-
-    def _create_part_shape(self, part: PartGeometry) -> int:
         shutil.rmtree(self._tmp, ignore_errors=True)
         os.makedirs(self._tmp)
-        kinds, radii, lengths, halves, files, positions, orientations = [], [], [], [], [], [], []
-        for i, p in enumerate(part.primitives):
-            radius = length = 0.0
-            half = [0.0, 0.0, 0.0]
-            path = ''
-            if p.kind == 'box':
-                kind, half = pb.GEOM_BOX, list(p.size)
-            elif p.kind == 'cylinder':
-                kind, (radius, length) = pb.GEOM_CYLINDER, p.size
-            else:
-                # pybullet takes convex hull vertices only from a file, one hull per file.
-                kind = pb.GEOM_MESH
-                path = os.path.join(self._tmp, f'hull_{i}.obj')
-                trimesh.Trimesh(p.vertices, p.faces, process=False).export(path)
-            kinds.append(kind)
-            radii.append(radius)
-            lengths.append(length)
-            halves.append(half)
-            files.append(path)
-            positions.append(list(p.position))
-            orientations.append(list(p.orientation))
-        return pb.createCollisionShapeArray(
-            kinds, radii=radii, lengths=lengths, halfExtents=halves, fileNames=files,
-            meshScales=[[1.0, 1.0, 1.0]] * len(kinds), collisionFramePositions=positions,
-            collisionFrameOrientations=orientations, physicsClientId=self._client)
-
-    def _create_container(self, spec: containers.ContainerSpec,
-                          origin: np.ndarray) -> tuple[int, int | None]:
-        c = self._client
-        boxes = containers.wall_boxes(spec)
-        shape = pb.createCollisionShapeArray(
-            [pb.GEOM_BOX] * len(boxes), halfExtents=[list(h) for h, _ in boxes],
-            collisionFramePositions=[list(p) for _, p in boxes], physicsClientId=c)
-        if spec.kind == containers.BIN:
-            body = pb.createMultiBody(0.0, shape, basePosition=origin.tolist(),
-                                      useMaximalCoordinates=True, physicsClientId=c)
-            pb.changeDynamics(body, -1, lateralFriction=0.5, physicsClientId=c)
-            return body, None
-        # The tray is dynamic and held on its trajectory by a fixed constraint whose pivot we
-        # drive: parts then feel its real velocity (a static body moved by resets does not
-        # push them). pybullet's constraints need a multibody base here.
-        body = pb.createMultiBody(TRAY_MASS, shape, basePosition=origin.tolist(),
-                                  physicsClientId=c)
-        pb.changeDynamics(body, -1, lateralFriction=0.5, linearDamping=0.0,
-                          angularDamping=0.0, physicsClientId=c)
-        constraint = pb.createConstraint(body, -1, -1, -1, pb.JOINT_FIXED, [0, 0, 0],
-                                         [0, 0, 0], origin.tolist(), physicsClientId=c)
-        pb.changeConstraint(constraint, maxForce=TRAY_MAX_FORCE, physicsClientId=c)
-        return body, constraint
+        self._part_shape = bodies.create_part_shape(c, part, self._tmp)
+        pitch = bodies.instance_pitch(scene.container)
+        for k in range(scene.instance_count):
+            origin = np.array([k * pitch, 0.0, 0.0])
+            body, constraint = bodies.create_container(c, scene.container, origin)
+            seed = bodies.instance_seed(scene.seed, k)
+            self._instances.append(Instance(k, seed, origin, body, constraint,
+                                            np.random.default_rng(seed)))
 
     def close(self) -> None:
         """Disconnect from PyBullet and remove temporary files. Idempotent."""
@@ -302,36 +143,9 @@ class World:
     def render(self, width: int, height: int, distance: float, yaw: float = 30.0,
                pitch: float = -60.0, target: Sequence[float] = (0.0, 0.0, 0.0),
                overlays: Sequence[Overlay] = ()) -> np.ndarray:
-        """A picture of the world from a camera orbiting `target` (world frame, m) at
-        `distance` m, `yaw` and `pitch` in degrees, with PyBullet's CPU renderer (no GPU).
-        `overlays` are drawn for this picture only (e.g. a gripper). Returns (height, width, 3)
-        uint8 RGB."""
-        width = check_int('width', width, low=16, high=4096)
-        height = check_int('height', height, low=16, high=4096)
-        c = self._client
-        bodies = []
-        try:
-            for o in overlays:
-                if o.kind == 'box':
-                    shape = pb.createVisualShape(pb.GEOM_BOX, halfExtents=list(o.size),
-                                                 rgbaColor=list(o.rgba), physicsClientId=c)
-                else:
-                    shape = pb.createVisualShape(pb.GEOM_CYLINDER, radius=o.size[0],
-                                                 length=o.size[1], rgbaColor=list(o.rgba),
-                                                 physicsClientId=c)
-                bodies.append(pb.createMultiBody(0.0, -1, shape, list(o.pose[:3]),
-                                                 list(o.pose[3:]), physicsClientId=c))
-            view = pb.computeViewMatrixFromYawPitchRoll(list(target), distance, yaw, pitch, 0.0,
-                                                        2, physicsClientId=c)
-            projection = pb.computeProjectionMatrixFOV(40.0, width / height, 0.01,
-                                                       10.0 * distance, physicsClientId=c)
-            _, _, rgba, _, _ = pb.getCameraImage(width, height, view, projection,
-                                                 renderer=pb.ER_TINY_RENDERER,
-                                                 physicsClientId=c)
-        finally:
-            for body in bodies:
-                pb.removeBody(body, physicsClientId=c)
-        return np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3]
+        """A picture of the world (camera.render): (height, width, 3) uint8 RGB."""
+        return camera.render(self._client, width, height, distance, yaw, pitch, target,
+                             overlays)
 
     def __enter__(self) -> 'World':
         return self
@@ -358,7 +172,7 @@ class World:
         wanted = self._instance_ids(instances)
         ids = [pid for k in wanted for pid in self._instances[k].part_ids]
         owners = np.array([self._owner[i] for i in ids], dtype=np.int64)
-        poses = self._world_poses(ids)
+        poses = bodies.base_poses(self._client, [self._bodies[i] for i in ids])
         if len(ids):
             poses[:, :3] -= np.array([self._instances[k].origin for k in owners])
         inside = np.zeros(len(ids), dtype=bool)
@@ -367,71 +181,22 @@ class World:
             inside[mask] = containers.inside(self._scene.container, poses[mask, :3])
         return PartStates(np.array(ids, dtype=np.int64), owners, poses, inside, self._sim_time)
 
-    def _world_poses(self, ids: Sequence[int]) -> np.ndarray:
-        poses = np.empty((len(ids), 7))
-        c = self._client
-        for row, pid in enumerate(ids):
-            position, orientation = pb.getBasePositionAndOrientation(self._bodies[pid],
-                                                                     physicsClientId=c)
-            poses[row, :3] = position
-            poses[row, 3:] = orientation
-        return poses
-
     # ----------------------------------------------------------------------------- drop
     def drop_region(self, instance: int, zone: str) -> tuple[float, float, float, float]:
         """Centre x, y and half extents x, y of where parts spawn, in the instance frame, m."""
-        spec = self._scene.container
-        if zone == 'container':
-            return 0.0, 0.0, spec.inner_size[0] / 2, spec.inner_size[1] / 2
-        if zone == 'feeder':
-            if spec.kind != containers.TRAY:
-                raise InvalidArgument('zone', zone, f'needs a tray; instance {instance} has a '
-                                      f'{spec.kind}, which has no feeder')
-            (cx, cy), (sx, sy) = spec.feeder_zone_center, spec.feeder_zone_size
-            return cx, cy, sx / 2, sy / 2
-        raise InvalidArgument('zone', zone, 'must be container or feeder')
+        return spawning.drop_region(self._scene.container, zone, instance)
 
     def spawn_poses(self, instance: int, count: int, zone: str = 'container') -> np.ndarray:
-        """Random, non-overlapping spawn poses (count, 7) in the instance frame.
-
-        Parts spawn in layers of a grid of cells as wide as the part's bounding sphere, above
-        the parts already there, each with a uniformly random orientation. The grid is shifted
-        at random within its slack and each layer takes a random subset of cells. No two
-        spawn spheres overlap, so nothing is blown apart (the paper's first problem).
-        """
-        cx, cy, hx, hy = self.drop_region(instance, zone)
-        inst = self._instances[instance]
-        rng = inst.rng
-        r = self._part.radius + SPAWN_GAP
-        cell = 2.0 * r
-        span_x, span_y = 2.0 * (hx - r), 2.0 * (hy - r)
-        if span_x < 0 or span_y < 0:
-            raise InvalidArgument(
-                'container.inner_size' if zone == 'container' else 'container.feeder_zone_size',
-                (2 * hx, 2 * hy), f'is smaller than the part ({2 * r:.4g} m across in any '
-                'orientation): parts cannot be dropped into it')
-        nx, ny = int(span_x // cell) + 1, int(span_y // cell) + 1
-        per_layer = nx * ny
+        """Random, non-overlapping spawn poses (count, 7) in the instance frame, above the parts
+        already in the instance (spawning.spawn_poses)."""
+        region = self.drop_region(instance, zone)
         state = self.snapshot([instance])
         top = 0.0
         if len(state.ids):
             top = float(state.poses[:, 2].max()) + self._part.radius + np.linalg.norm(
                 self._part.center)
-        centers = np.empty((count, 3))
-        for start in range(0, count, per_layer):
-            layer = start // per_layer
-            n = min(per_layer, count - start)
-            shift_x = rng.uniform(0.0, span_x - (nx - 1) * cell)
-            shift_y = rng.uniform(0.0, span_y - (ny - 1) * cell)
-            cells = rng.permutation(per_layer)[:n]
-            ix, iy = np.divmod(cells, ny)
-            centers[start:start + n, 0] = cx - hx + r + shift_x + ix * cell
-            centers[start:start + n, 1] = cy - hy + r + shift_y + iy * cell
-            centers[start:start + n, 2] = top + r + layer * cell
-        quats = random_quaternions(rng, count)
-        # The spawn sphere is centred on the compound's bounding-box centre, not the origin.
-        origins = centers - rotate(quats, self._part.center)
-        return np.hstack([origins, quats])
+        return spawning.spawn_poses(self._instances[instance].rng, self._part, region, top,
+                                    count, zone)
 
     def drop(self, count: int, instances: Iterable[int] | None = None, zone: str = 'container',
              max_settle_time: float | None = None,
@@ -443,18 +208,12 @@ class World:
         """
         targets = self._instance_ids(instances)
         count = check_int('count', count, low=1, high=MAX_PARTS_PER_INSTANCE)
-        inner = float(np.prod(self._scene.container.inner_size))
         for k in targets:
             total = count + len(self._instances[k].part_ids)
             if total > MAX_PARTS_PER_INSTANCE:
                 raise InvalidArgument('count', count, f'would put {total} parts in instance {k}'
                                       f' (limit {MAX_PARTS_PER_INSTANCE})')
-            if total * self._part.volume > PACKING_LIMIT * inner:
-                most = int(PACKING_LIMIT * inner / self._part.volume)
-                raise InvalidArgument(
-                    'count', count, f'does not fit: {total} parts of {self._part.volume * 1e9:.4g}'
-                    f' mm^3 in a container of {inner * 1e9:.4g} mm^3 exceed the packing limit '
-                    f'{PACKING_LIMIT:g} (at most {most} parts)')
+            check_fits('count', total, self._part.volume, self._scene.container)
         spawns = {k: self.spawn_poses(k, count, zone) for k in targets}
         new_ids = []
         for k, poses in spawns.items():
@@ -462,20 +221,11 @@ class World:
         return new_ids, self._settle('dropping', max_settle_time, progress)
 
     def _add_parts(self, inst: Instance, poses: np.ndarray) -> list[int]:
-        c = self._client
-        spec = self._part.spec
         ids = []
         self._at_rest = False
         for pose in poses:
-            body = pb.createMultiBody(
-                self._part.mass, self._part_shape, basePosition=(pose[:3] + inst.origin).tolist(),
-                baseOrientation=pose[3:].tolist(), useMaximalCoordinates=True,
-                physicsClientId=c)
-            pb.changeDynamics(
-                body, -1, lateralFriction=spec.lateral_friction,
-                rollingFriction=spec.rolling_friction, spinningFriction=spec.spinning_friction,
-                restitution=spec.restitution, ccdSweptSphereRadius=self._part.thinnest,
-                activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING, physicsClientId=c)
+            world_pose = np.concatenate([pose[:3] + inst.origin, pose[3:]])
+            body = bodies.create_part(self._client, self._part_shape, self._part, world_pose)
             pid = self._next_id
             self._next_id += 1
             self._bodies[pid] = body
@@ -497,34 +247,21 @@ class World:
         """
         targets = self._instance_ids(instances)
         check_vibration(vibration)
-        omega = 2.0 * math.pi * vibration.frequency
         for k in targets:
             if self._instances[k].constraint is None:
                 raise InvalidArgument('instances', k, f'is a {self._scene.container.kind}: '
                                       'only trays vibrate')
-        c = self._client
         trays = [self._instances[k] for k in targets]
         amplitudes = np.array([vibration_amplitude(vibration, inst.rng) for inst in trays])
         dt = self._physics.time_step
         steps = max(1, int(round(vibration.duration / dt)))
-        step = 0
-
-        def drive() -> None:
-            nonlocal step
-            step += 1
-            phase = math.sin(omega * step * dt)
-            for inst, amplitude in zip(trays, amplitudes, strict=True):
-                pb.changeConstraint(inst.constraint, jointChildPivot=(
-                    inst.origin + amplitude * phase).tolist(), maxForce=TRAY_MAX_FORCE,
-                    physicsClientId=c)
-
+        drive = TrayDrive(self._client, [inst.constraint for inst in trays],
+                          [inst.origin for inst in trays], amplitudes, vibration.frequency, dt)
         try:
             report = self._run('vibrating', steps * dt, progress, before_step=drive,
                                stop_when_settled=False)
         finally:
-            for inst in trays:
-                pb.changeConstraint(inst.constraint, jointChildPivot=inst.origin.tolist(),
-                                    maxForce=TRAY_MAX_FORCE, physicsClientId=c)
+            drive.home()
         if report.canceled:
             return report
         settle = self._settle('settling', max_settle_time, progress)
@@ -592,58 +329,18 @@ class World:
     def _run(self, phase: str, duration: float, progress: ProgressCallback | None,
              before_step: Callable[[], None] | None = None,
              stop_when_settled: bool = True) -> SettleReport:
-        """Step for up to `duration` s of simulated time, checking rest every check period.
-
-        A part rests when, over the settle window, its position changed by at most the linear
-        tolerance and its orientation by at most the angular tolerance; the scene is settled when
-        at most the moving fraction of its parts do not rest. Bullet's sleeping is not used for
-        this: it does not trigger for a jittering pile.
-        """
-        cfg = self._physics
-        c = self._client
-        dt = cfg.time_step
-        per_check = max(1, int(round(cfg.settle_check_period / dt)))
-        window = max(1, int(round(cfg.settle_window / cfg.settle_check_period)))
-        total_steps = max(1, int(math.ceil(duration / dt - 1e-9)))
+        """Step every part of the scene for up to `duration` s (stepping.step); a fault resets
+        the scene before it is raised."""
         ids = [pid for inst in self._instances for pid in inst.part_ids]
-        tolerated = int(cfg.settle_moving_fraction * len(ids))
-        history: deque[np.ndarray] = deque(maxlen=window + 1)
-        history.append(self._world_poses(ids))
-        start = time.perf_counter()
-        steps = 0
-        moving = np.ones(len(ids), dtype=bool)
-        settled = canceled = False
-        while steps < total_steps:
-            for _ in range(min(per_check, total_steps - steps)):
-                if before_step is not None:
-                    before_step()
-                pb.stepSimulation(physicsClientId=c)
-                steps += 1
-            poses = self._world_poses(ids)
-            if not np.isfinite(poses).all():
-                bad = [ids[i] for i in np.flatnonzero(~np.isfinite(poses).all(axis=1))]
-                self._build(self._scene, self._part)
-                raise PhysicsFault(f'parts {bad[:10]} got non-finite poses after '
-                                   f'{steps * dt:.3f} s of {phase}; the scene was reset')
-            history.append(poses)
-            old = history[0]
-            shift = np.linalg.norm(poses[:, :3] - old[:, :3], axis=1)
-            turn = quaternion_angles(poses[:, 3:], old[:, 3:])
-            moving = (shift > cfg.settle_linear_tolerance) | (turn > cfg.settle_angular_tolerance)
-            full = len(history) == history.maxlen
-            if progress is not None and not progress(Progress(
-                    phase, steps * dt, int(moving.sum()) if full else len(ids),
-                    float(shift.max()) if len(ids) else 0.0)):
-                canceled = True
-                break
-            if stop_when_settled and full and moving.sum() <= tolerated:
-                settled = True
-                break
-        self._sim_time += steps * dt
-        wall = time.perf_counter() - start
-        self._at_rest = settled
-        if not stop_when_settled:
-            settled = not canceled
-        unsettled = [ids[i] for i in np.flatnonzero(moving)]
-        return SettleReport(settled, steps * dt, wall, steps, unsettled, self._escaped(),
-                            canceled)
+        try:
+            out = stepping.step(self._client, ids, [self._bodies[i] for i in ids],
+                                self._physics, phase, duration, progress, before_step,
+                                stop_when_settled)
+        except PhysicsFault:
+            self._build(self._scene, self._part)
+            raise
+        self._sim_time += out.steps * self._physics.time_step
+        self._at_rest = out.settled
+        settled = out.settled if stop_when_settled else not out.canceled
+        return SettleReport(settled, out.steps * self._physics.time_step, out.wall_time,
+                            out.steps, out.moving_ids, self._escaped(), out.canceled)

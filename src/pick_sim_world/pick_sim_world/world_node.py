@@ -11,12 +11,25 @@ never waits for physics.
 
 from collections.abc import Callable
 import threading
-import traceback
 
+from pick_common import containers, parts, specs
+from pick_common import conversions as common
+from pick_common.containers import BIN, ContainerSpec, TRAY
+from pick_common.errors import InvalidArgument
+from pick_common.node_runner import (
+    answer_error,
+    declare,
+    declare_mesh_dirs,
+    LATCHED,
+    RESULT_KEEP,
+    run,
+)
+from pick_common.parts import BUILTIN_MODELS, PartSpec
+from pick_common.specs import check_vibration, FIXED, RANDOM, SceneSpec, Vibration
+from pick_common.states import Progress, SettleReport
 from pick_msgs.action import DropParts, RemoveParts, Vibrate
 from pick_msgs.msg import PartArray, Scene
 from pick_msgs.srv import GetParts, ResetScene
-from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import MultiThreadedExecutor
@@ -25,26 +38,11 @@ from rclpy.qos_overriding_options import QoSOverridingOptions
 from visualization_msgs.msg import MarkerArray
 
 from . import conversions as conv
-from .config import check_vibration, FIXED, PhysicsConfig, RANDOM, SceneSpec, Vibration
-from .containers import BIN, ContainerSpec, TRAY
-from .errors import InvalidArgument, WorldError
-from .node_runner import declare_mesh_dirs, LATCHED, RESULT_KEEP, run
-from .parts import BUILTIN_MODELS, PartSpec
-from .world import Progress, SettleReport, World
+from .config import LIMITS, PhysicsConfig
+from .world import World
 
 ZONES = {DropParts.Goal.ZONE_CONTAINER: 'container', DropParts.Goal.ZONE_FEEDER: 'feeder'}
 SHUTDOWN_WAIT = 10.0   # s a shutdown waits for a running physics operation
-
-
-def _describe(text: str, low: float | None = None, high: float | None = None,
-              integer: bool = False) -> ParameterDescriptor:
-    descriptor = ParameterDescriptor(description=text, read_only=True)
-    if low is not None and integer:
-        descriptor.integer_range = [IntegerRange(from_value=int(low), to_value=int(high))]
-    elif low is not None:
-        descriptor.floating_point_range = [FloatingPointRange(from_value=float(low),
-                                                              to_value=float(high))]
-    return descriptor
 
 
 class WorldNode(Node):
@@ -77,18 +75,15 @@ class WorldNode(Node):
         self._publish(scene_changed=True)
         self.get_logger().info(
             f'{scene.instance_count} instance(s) of a {scene.container.kind} with '
-            f'{scene.part.model} parts; frames {conv.instance_frame(self._prefix, 0)}...')
+            f'{scene.part.model} parts; frames {common.instance_frame(self._prefix, 0)}...')
 
     # ----------------------------------------------------------------------------- parameters
     def _declare_parameters(self) -> tuple[SceneSpec, PhysicsConfig, Vibration]:
-        """Declare every parameter with a descriptor and build the frozen configs.
-
-        The values are checked by the core (one place); declare only enforces ranges that ROS
-        can express.
-        """
-        def get(name, default, text, low=None, high=None, integer=False):
-            return self.declare_parameter(name, default,
-                                          _describe(text, low, high, integer)).value
+        """Declare every parameter with a descriptor that states the core's limit (one table
+        per core: LIMITS of config, containers, parts and specs) and build the frozen configs,
+        which the core checks again as a whole."""
+        def get(name, default, text, limit=None):
+            return declare(self, name, default, text, limit)
 
         self._frame_id = get('frame_id', 'world', 'frame of the scene and of instance frames')
         prefix = get('frame_prefix', '', 'prefix of instance frame names; empty: the node '
@@ -98,14 +93,15 @@ class WorldNode(Node):
 
         kind = get('container.kind', BIN, f'{BIN} or {TRAY}')
         base = ContainerSpec.tray() if kind == TRAY else ContainerSpec()
+        walls = containers.LIMITS
         container = ContainerSpec(
             kind=kind,
             inner_size=tuple(get('container.inner_size', list(base.inner_size),
                                  'inner length, width, height, m')),
             wall_thickness=get('container.wall_thickness', base.wall_thickness, 'm',
-                               0.0005, 0.1),
+                               walls['container.wall_thickness']),
             floor_thickness=get('container.floor_thickness', base.floor_thickness, 'm',
-                                0.001, 0.2),
+                                walls['container.floor_thickness']),
             feeder_zone_center=tuple(get('container.feeder_zone_center',
                                          list(base.feeder_zone_center),
                                          'centre x, y of the tray feeder zone, m')),
@@ -120,53 +116,61 @@ class WorldNode(Node):
             dims = {name: get(f'part.{name}', value, f'{model} dimension, m'
                               if name != 'pins_per_row' else 'pins per row')
                     for name, value in defaults.items()}
-        mass = get('part.mass', default_mass, 'kg (0 for the model default)', 0.0, 10.0)
-        spec = PartSpec()
+        mass = get('part.mass', default_mass, 'kg; 0 for the model default (checked when the '
+                   'part is built)')
+        spec, material = PartSpec(), parts.LIMITS
         part = PartSpec(
             model=model, dimensions=dims, mass=mass or None,
             lateral_friction=get('part.lateral_friction', spec.lateral_friction,
-                                 'Coulomb coefficient', 0.0, 10.0),
+                                 'Coulomb coefficient', material['part.lateral_friction']),
             rolling_friction=get('part.rolling_friction', spec.rolling_friction,
-                                 'rolling resistance arm, m', 0.0, 0.1),
+                                 'rolling resistance arm, m', material['part.rolling_friction']),
             spinning_friction=get('part.spinning_friction', spec.spinning_friction,
-                                  'torsional friction arm, m', 0.0, 0.1),
-            restitution=get('part.restitution', spec.restitution, '1', 0.0, 1.0),
+                                  'torsional friction arm, m',
+                                  material['part.spinning_friction']),
+            restitution=get('part.restitution', spec.restitution, '1',
+                            material['part.restitution']),
             mesh_path=get('part.mesh_path', '', 'STL/OBJ/PLY file for part.model mesh'),
-            scale=get('part.scale', 1.0, 'mesh scale to metres', 1e-6, 1e3))
+            scale=get('part.scale', 1.0, 'mesh scale to metres', material['part.scale']))
         scene = SceneSpec(container, part,
-                          get('instances', 1, 'independent instances', 1, 64, integer=True),
-                          get('seed', 0, 'base seed of the instances', 0, 2**62, integer=True))
+                          get('instances', 1, 'independent instances',
+                              specs.LIMITS['instance_count']),
+                          get('seed', 0, 'base seed of the instances', specs.LIMITS['seed']))
         cfg = PhysicsConfig()
+
+        def setting(name: str, default, text: str):
+            return get(name, default, text, LIMITS[name])
+
         physics = PhysicsConfig(
-            time_step=get('physics.time_step', cfg.time_step, 's', 1e-5, 0.01),
-            solver_iterations=get('physics.solver_iterations', cfg.solver_iterations,
-                                  'solver iterations per step', 1, 500, integer=True),
-            contact_breaking_threshold=get('physics.contact_breaking_threshold',
-                                           cfg.contact_breaking_threshold, 'm', 1e-5, 0.1),
-            settle_check_period=get('settle.check_period', cfg.settle_check_period,
-                                    'simulated s between rest checks', 1e-5, 1.0),
-            settle_window=get('settle.window', cfg.settle_window,
-                              'simulated s over which a part must stay put', 1e-5, 10.0),
-            settle_linear_tolerance=get('settle.linear_tolerance', cfg.settle_linear_tolerance,
-                                        'largest position change at rest over the window, m',
-                                        1e-7, 0.1),
-            settle_angular_tolerance=get('settle.angular_tolerance',
-                                         cfg.settle_angular_tolerance,
-                                         'largest rotation at rest over the window, rad',
-                                         1e-6, 3.2),
-            settle_moving_fraction=get('settle.moving_fraction', cfg.settle_moving_fraction,
-                                       'largest fraction of parts still moving when settled',
-                                       0.0, 0.5),
-            max_settle_time=get('settle.max_time', cfg.max_settle_time,
-                                'cap on simulated settle time, s', 1e-3, 600.0))
+            time_step=setting('physics.time_step', cfg.time_step, 's'),
+            solver_iterations=setting('physics.solver_iterations', cfg.solver_iterations,
+                                      'solver iterations per step'),
+            contact_breaking_threshold=setting('physics.contact_breaking_threshold',
+                                               cfg.contact_breaking_threshold, 'm'),
+            settle_check_period=setting('settle.check_period', cfg.settle_check_period,
+                                        'simulated s between rest checks'),
+            settle_window=setting('settle.window', cfg.settle_window,
+                                  'simulated s over which a part must stay put'),
+            settle_linear_tolerance=setting('settle.linear_tolerance',
+                                            cfg.settle_linear_tolerance,
+                                            'largest position change at rest over the '
+                                            'window, m'),
+            settle_angular_tolerance=setting('settle.angular_tolerance',
+                                             cfg.settle_angular_tolerance,
+                                             'largest rotation at rest over the window, rad'),
+            settle_moving_fraction=setting('settle.moving_fraction', cfg.settle_moving_fraction,
+                                           'largest fraction of parts still moving when '
+                                           'settled'),
+            max_settle_time=setting('settle.max_time', cfg.max_settle_time,
+                                    'cap on simulated settle time, s'))
         vib = Vibration()
         vibration = Vibration(
             amplitude=tuple(get('vibration.amplitude', list(vib.amplitude),
                                 'default peak tray displacement x, y, z, m')),
             frequency=get('vibration.frequency', vib.frequency, 'default frequency, Hz',
-                          0.1, 500.0),
+                          specs.LIMITS['vibration.frequency']),
             duration=get('vibration.duration', vib.duration, 'default duration, s',
-                         1e-3, 60.0),
+                         specs.LIMITS['vibration.duration']),
             direction=get('vibration.direction', vib.direction,
                           f'default direction: {FIXED} (the amplitude as given) or {RANDOM} '
                           '(its horizontal part turned by a random angle per vibration)'))
@@ -183,7 +187,7 @@ class WorldNode(Node):
             self._scene_msg = conv.scene_to_msg(self._world, stamp, self._frame_id,
                                                 self._prefix)
             self._scene_pub.publish(self._scene_msg)
-        parts = conv.states_to_msg(self._states, stamp, self._frame_id, self._prefix)
+        parts = common.states_to_msg(self._states, stamp, self._frame_id, self._prefix)
         self._parts_pub.publish(parts)
         if self._publish_markers:
             self._markers_pub.publish(conv.markers_msg(self._world, self._states, stamp,
@@ -192,7 +196,7 @@ class WorldNode(Node):
 
     def _parts_msg(self, instances) -> PartArray:
         states = self._states if instances is None else self._states.select(instances)
-        return conv.states_to_msg(states, self.get_clock().now().to_msg(), self._frame_id,
+        return common.states_to_msg(states, self.get_clock().now().to_msg(), self._frame_id,
                                   self._prefix)
 
     # ----------------------------------------------------------------------------- services
@@ -202,7 +206,7 @@ class WorldNode(Node):
         count = self._world.scene.instance_count
         unknown = [k for k in wanted if k >= count]
         if unknown:
-            response.error_code = conv.ERROR_UNKNOWN_INSTANCE
+            response.error_code = common.ERROR_UNKNOWN_INSTANCE
             response.error_msg = (f'instances: {unknown[0]} does not exist (the scene has '
                                   f'{count}: 0..{count - 1})')
             return response
@@ -216,8 +220,8 @@ class WorldNode(Node):
                 self._world.reset(seed=request.seed)
             else:
                 self._world.reset(SceneSpec(
-                    conv.container_from_msg(request.container),
-                    conv.part_spec_from_msg(request.part_model, self._mesh_dirs),
+                    common.container_from_msg(request.container),
+                    common.part_spec_from_msg(request.part_model, self._mesh_dirs),
                     request.instance_count,
                     request.seed))
 
@@ -234,23 +238,17 @@ class WorldNode(Node):
         else is a bug, logged with its traceback and answered INTERNAL: the node keeps serving.
         """
         if not self._lock.acquire(blocking=False):
-            response.error_code = conv.ERROR_BUSY
+            response.error_code = common.ERROR_BUSY
             response.error_msg = ('another physics operation is running; requests are not '
                                   'queued: retry when it ends')
             return False
         try:
             operation()
             return True
-        except WorldError as exc:
-            response.error_code = conv.error_code(exc)
-            response.error_msg = str(exc)
-            self.get_logger().warning(f'request refused: {exc}')
-        except Exception as exc:  # a bug: answer, log, keep serving
-            response.error_code = conv.ERROR_INTERNAL
-            response.error_msg = f'internal error: {type(exc).__name__}: {exc}'
-            self.get_logger().error(f'{response.error_msg}\n{traceback.format_exc()}')
+        except Exception as exc:  # core errors get their code, bugs INTERNAL (answer_error)
+            answer_error(response, exc, self.get_logger(), 'request')
         finally:
-            if response.error_code == conv.ERROR_PHYSICS_FAULT:
+            if response.error_code == common.ERROR_PHYSICS_FAULT:
                 self._states = self._world.snapshot()
                 self._publish(scene_changed=True)
             self._lock.release()
@@ -265,18 +263,18 @@ class WorldNode(Node):
         def progress(p: Progress) -> bool:
             if self._stopping:   # shutting down: end the operation at this settle check
                 return False
-            goal_handle.publish_feedback(action_type.Feedback(progress=conv.progress_to_msg(p)))
+            goal_handle.publish_feedback(action_type.Feedback(progress=common.progress_to_msg(p)))
             return not goal_handle.is_cancel_requested
 
         ok = self._guarded(lambda: settle.append(operation(progress)), result)
         if ok:
             report = settle[0]
-            result.settle = conv.settle_to_msg(report)
+            result.settle = common.settle_to_msg(report)
             self._states = self._world.snapshot()
             published = self._publish()
             result.parts = published if instances is None else self._parts_msg(instances)
             if report.canceled:
-                result.error_code = conv.ERROR_CANCELED
+                result.error_code = common.ERROR_CANCELED
                 result.error_msg = 'canceled: parts are where they stopped'
                 goal_handle.canceled()
                 return result
@@ -295,7 +293,7 @@ class WorldNode(Node):
                 raise InvalidArgument('zone', goal.zone, f'must be one of {sorted(ZONES)}')
             ids, report = self._world.drop(
                 goal.count, instances, ZONES[goal.zone],
-                conv.or_default('max_settle_time', goal.max_settle_time, None), progress)
+                common.or_default('max_settle_time', goal.max_settle_time, None), progress)
             result.part_ids = ids
             return report
 
@@ -311,13 +309,13 @@ class WorldNode(Node):
                 else self._vibration.amplitude
             vibration = Vibration(
                 amplitude=amplitude,
-                frequency=conv.or_default('frequency', goal.frequency,
+                frequency=common.or_default('frequency', goal.frequency,
                                           self._vibration.frequency),
-                duration=conv.or_default('duration', goal.duration, self._vibration.duration),
+                duration=common.or_default('duration', goal.duration, self._vibration.duration),
                 direction=conv.direction_from_msg(goal.direction, self._vibration.direction))
             return self._world.vibrate(
                 vibration, instances,
-                conv.or_default('max_settle_time', goal.max_settle_time, None), progress)
+                common.or_default('max_settle_time', goal.max_settle_time, None), progress)
 
         return self._execute(Vibrate, goal_handle, Vibrate.Result(), vibrate, instances)
 
@@ -328,7 +326,7 @@ class WorldNode(Node):
         def remove(progress) -> SettleReport:
             removed, report = self._world.remove(
                 list(goal.part_ids), not goal.skip_settle,
-                conv.or_default('max_settle_time', goal.max_settle_time, None), progress)
+                common.or_default('max_settle_time', goal.max_settle_time, None), progress)
             result.removed_ids = removed
             return report
 

@@ -6,10 +6,10 @@ import re
 from hypothesis import given, HealthCheck, settings
 from hypothesis import strategies as st
 import numpy as np
-from pick_sim_world.config import SceneSpec, Vibration
-from pick_sim_world.containers import ContainerSpec
-from pick_sim_world.errors import check_inside, InvalidArgument, UnknownInstance
-from pick_sim_world.parts import PartSpec
+from pick_common.containers import ContainerSpec
+from pick_common.errors import check_inside, InvalidArgument, UnknownInstance
+from pick_common.parts import PartSpec
+from pick_common.specs import SceneSpec, Vibration
 from pick_sim_world.world import World
 import pytest
 

@@ -2,10 +2,10 @@
 
 from builtin_interfaces.msg import Time
 import numpy as np
+from pick_common.containers import ContainerSpec
+from pick_common.parts import PartSpec
+from pick_common.specs import SceneSpec
 from pick_sim_world import conversions as conv
-from pick_sim_world.config import SceneSpec
-from pick_sim_world.containers import ContainerSpec
-from pick_sim_world.parts import PartSpec
 from pick_sim_world.world import World
 import pybullet as pb
 import pytest

@@ -3,14 +3,19 @@
 import math
 
 import numpy as np
-from pick_sim_world import containers
-from pick_sim_world.config import FIXED, PhysicsConfig, RANDOM, SceneSpec, Vibration
-from pick_sim_world.containers import ContainerSpec
-from pick_sim_world.errors import InvalidArgument, PhysicsFault, UnknownInstance, UnknownPart
-from pick_sim_world.parts import BUILTIN_MODELS, PartSpec
-from pick_sim_world.world import quaternion_angles, rotate, vibration_amplitude, World
+from pick_common import containers
+from pick_common.containers import ContainerSpec
+from pick_common.errors import InvalidArgument, PhysicsFault, UnknownInstance, UnknownPart
+from pick_common.parts import BUILTIN_MODELS, PartSpec
+from pick_common.specs import FIXED, RANDOM, SceneSpec, Vibration
+from pick_common.states import rotate
+from pick_sim_world.config import PhysicsConfig
+from pick_sim_world.stepping import quaternion_angles
+from pick_sim_world.tray import vibration_amplitude
+from pick_sim_world.world import World
 import pybullet as pb
 import pytest
+import trimesh
 
 SMALL_BIN = ContainerSpec(inner_size=(0.12, 0.10, 0.03))
 
@@ -296,7 +301,8 @@ def test_a_bin_too_small_for_the_parts_is_refused_before_any_physics():
         with pytest.raises(InvalidArgument, match='container.inner_size.*smaller than the part'):
             world.drop(1)
     with _world(ContainerSpec(inner_size=(0.05, 0.05, 0.01))) as world:
-        with pytest.raises(InvalidArgument, match=r'count: 500 does not fit.*at most \d+ parts'):
+        with pytest.raises(InvalidArgument,
+                           match=r'count: 500 parts do not fit.*at most \d+ within'):
             world.drop(500)
         assert len(world.snapshot().ids) == 0
 
@@ -342,3 +348,19 @@ def test_a_moving_fraction_ends_the_settle_earlier_and_names_the_parts_still_mov
     assert moved.max() > world.physics.settle_linear_tolerance
     with pytest.raises(InvalidArgument, match=r'settle.moving_fraction: 0.6 must be <= 0.5'):
         _world(settle_moving_fraction=0.6)
+
+
+def test_a_user_mesh_settles_in_a_bin(tmp_path):
+    # Two boxes of one mesh file, in mm: the world takes the convex hulls of its components.
+    mesh = trimesh.util.concatenate([
+        trimesh.creation.box(extents=[6.0, 4.0, 2.0]),
+        trimesh.creation.box(extents=[1.0, 1.0, 6.0], transform=trimesh.transformations
+                             .translation_matrix([0.0, 0.0, -4.0]))])
+    path = tmp_path / 'part.stl'
+    mesh.export(path)
+    spec = PartSpec(model='mesh', mesh_path=str(path), scale=0.001, mass=0.0003)
+    with World(SceneSpec(ContainerSpec(inner_size=(0.08, 0.08, 0.02)), spec)) as world:
+        assert [p.kind for p in world.part.primitives] == ['hull', 'hull']
+        _, report = world.drop(25)
+        assert report.settled and report.escaped_ids == []
+        assert world.snapshot().inside.all()

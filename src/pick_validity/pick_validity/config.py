@@ -8,11 +8,25 @@ from dataclasses import dataclass, field
 import math
 
 import numpy as np
-from pick_sim_world.errors import check_number, check_vector, InvalidArgument
+from pick_common.errors import check_vector, InvalidArgument, Limit
 
 MAX_GRASPS = 32
 MAX_TILTS = 361
 PARALLEL_LIMIT = math.radians(5.0)   # closing and up axes closer than this are "parallel"
+# The range of each setting, by the validity node's parameter name (a grasp's jaw_opening is
+# grasps.<name>.jaw_opening there). m and rad.
+LIMITS = {
+    'gripper.body_diameter': Limit(0.0, 1.0, low_open=True),
+    'gripper.body_length': Limit(0.0, 2.0, low_open=True),
+    'gripper.jaw_height': Limit(0.0, 1.0, low_open=True),
+    'gripper.jaw_depth': Limit(0.0, 1.0, low_open=True),
+    'jaw_opening': Limit(0.0, 1.0, low_open=True),
+    'place.seat_offset': Limit(-1.0, 1.0),
+    'check.tolerance': Limit(0.0, math.pi / 2, low_open=True),
+    'check.tilt_min': Limit(-math.pi / 2, math.pi / 2),
+    'check.tilt_max': Limit(-math.pi / 2, math.pi / 2),    # and at least tilt_min
+    'check.tilt_step': Limit(math.radians(0.1), math.pi),
+}
 
 
 @dataclass(frozen=True)
@@ -97,10 +111,8 @@ def _unit(field_name: str, values) -> np.ndarray:
 
 
 def check_gripper(gripper: Gripper) -> Gripper:
-    check_number('gripper.body_diameter', gripper.body_diameter, low=0.0, high=1.0, low_open=True)
-    check_number('gripper.body_length', gripper.body_length, low=0.0, high=2.0, low_open=True)
-    check_number('gripper.jaw_height', gripper.jaw_height, low=0.0, high=1.0, low_open=True)
-    check_number('gripper.jaw_depth', gripper.jaw_depth, low=0.0, high=1.0, low_open=True)
+    for name in ('body_diameter', 'body_length', 'jaw_height', 'jaw_depth'):
+        LIMITS[f'gripper.{name}'].check(f'gripper.{name}', getattr(gripper, name))
     return gripper
 
 
@@ -121,8 +133,7 @@ def check_grasps(grasps: list[GraspPose] | tuple[GraspPose, ...]) -> tuple[Grasp
                                   f'{math.degrees(PARALLEL_LIMIT):g} deg)')
         closing = closing - (closing @ up) * up
         closing /= np.linalg.norm(closing)
-        opening = check_number(f'{where}.jaw_opening', g.jaw_opening, low=0.0, high=1.0,
-                               low_open=True)
+        opening = LIMITS['jaw_opening'].check(f'{where}.jaw_opening', g.jaw_opening)
         point = np.array(check_vector(f'{where}.grasp_point', g.grasp_point, 3,
                                       low=-1.0, high=1.0))
         out.append(Grasp(g.name or f'grasp_{i}', up, closing, opening, point))
@@ -131,16 +142,15 @@ def check_grasps(grasps: list[GraspPose] | tuple[GraspPose, ...]) -> tuple[Grasp
 
 def check_place(place: PlaceSpec) -> tuple[np.ndarray, float]:
     axis = _unit('place.place_axis', place.place_axis)
-    return axis, check_number('place.seat_offset', place.seat_offset, low=-1.0, high=1.0)
+    return axis, LIMITS['place.seat_offset'].check('place.seat_offset', place.seat_offset)
 
 
 def tilts(cfg: CheckConfig) -> np.ndarray:
     """The tilt angles to try, rad, from tilt_min to tilt_max inclusive."""
-    check_number('check.tolerance', cfg.tolerance, low=0.0, high=math.pi / 2, low_open=True)
-    low = check_number('check.tilt_min', cfg.tilt_min, low=-math.pi / 2, high=math.pi / 2)
-    high = check_number('check.tilt_max', cfg.tilt_max, low=low, high=math.pi / 2)
-    step = check_number('check.tilt_step', cfg.tilt_step, low=math.radians(0.1),
-                        high=math.pi)
+    LIMITS['check.tolerance'].check('check.tolerance', cfg.tolerance)
+    low = LIMITS['check.tilt_min'].check('check.tilt_min', cfg.tilt_min)
+    high = LIMITS['check.tilt_max'].check('check.tilt_max', cfg.tilt_max, low=low)
+    step = LIMITS['check.tilt_step'].check('check.tilt_step', cfg.tilt_step)
     count = int(math.floor((high - low) / step + 1e-9)) + 1
     if count > MAX_TILTS:
         raise InvalidArgument('check.tilt_step', step, f'gives {count} tilts from tilt_min to '

@@ -1,20 +1,20 @@
 """The one place that maps check_parts requests and ValidityReport messages to and from the
-validity core. Container, part-model and part conversions are pick_sim_world's, reused."""
+validity core. Container, part-model and part conversions are pick_common's, reused."""
 
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 from builtin_interfaces.msg import Time
-from geometry_msgs.msg import Point, Pose, Quaternion, Vector3
+from geometry_msgs.msg import Point, Vector3
 import numpy as np
+from pick_common import conversions as common
+from pick_common.containers import ContainerSpec
+from pick_common.parts import PartSpec
 from pick_msgs.msg import CheckSettings, PartValidity, ValidityReport
 from pick_msgs.msg import GraspPose as GraspPoseMsg
 from pick_msgs.msg import Gripper as GripperMsg
 from pick_msgs.msg import PlaceSpec as PlaceSpecMsg
 from pick_msgs.srv import CheckParts
-from pick_sim_world import conversions as world_conversions
-from pick_sim_world.containers import ContainerSpec
-from pick_sim_world.parts import PartSpec
 from std_msgs.msg import Header
 
 from .config import CheckConfig, GraspPose, Gripper, PlaceSpec
@@ -35,10 +35,10 @@ def request_to_core(request: CheckParts.Request, mesh_dirs: Sequence[str]
                     ) -> tuple[ContainerSpec, PartSpec, list[int], object, list[int] | None]:
     """Container, part spec, ids, poses (N, 7) and targets (None for all) of a request; a
     mesh file must lie in one of `mesh_dirs`."""
-    ids, _, poses = world_conversions.parts_to_arrays(request.parts)
+    ids, _, poses = common.parts_to_arrays(request.parts)
     targets = [int(t) for t in request.target_ids] or None
-    return (world_conversions.container_from_msg(request.container),
-            world_conversions.part_spec_from_msg(request.part_model, mesh_dirs), ids.tolist(),
+    return (common.container_from_msg(request.container),
+            common.part_spec_from_msg(request.part_model, mesh_dirs), ids.tolist(),
             poses,
             targets)
 
@@ -96,12 +96,6 @@ def geometry_key(spec: PartSpec) -> tuple:
     return spec.model, tuple(sorted(spec.dimensions.items())), spec.mesh_path, spec.scale
 
 
-def _pose(values) -> Pose:
-    x, y, z, qx, qy, qz, qw = (float(v) for v in values)
-    return Pose(position=Point(x=x, y=y, z=z),
-                orientation=Quaternion(x=qx, y=qy, z=qz, w=qw))
-
-
 def report_to_msg(report: Report, validator: Validator, stamp: Time, frame_id: str,
                   instance: int) -> ValidityReport:
     msg = ValidityReport(header=Header(stamp=stamp, frame_id=frame_id), instance=instance,
@@ -120,7 +114,7 @@ def report_to_msg(report: Report, validator: Validator, stamp: Time, frame_id: s
             g = validator.grasps[r.grasp_index]
             item.grasp = _grasp_msg(g.name, g.up, g.closing, g.jaw_opening, g.point)
         if r.gripper_pose is not None:
-            item.gripper_pose = _pose(r.gripper_pose)
+            item.gripper_pose = common.pose_msg(r.gripper_pose[:3], r.gripper_pose[3:])
         msg.results.append(item)
     return msg
 

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import fcl
 import numpy as np
-from pick_sim_world.parts import PartGeometry
+from pick_common.parts import PartGeometry
 import trimesh
 
 from .config import Gripper

@@ -26,10 +26,10 @@ import time
 
 import fcl
 import numpy as np
-from pick_sim_world import containers
-from pick_sim_world.containers import ContainerSpec
-from pick_sim_world.errors import InvalidArgument, UnknownPart
-from pick_sim_world.parts import PartGeometry
+from pick_common import containers
+from pick_common.containers import ContainerSpec
+from pick_common.errors import InvalidArgument, UnknownPart
+from pick_common.parts import PartGeometry
 from scipy.spatial import cKDTree
 
 from .config import (

@@ -4,10 +4,10 @@ all-FCL loop on settled scenes from the real world."""
 import math
 
 import numpy as np
-from pick_sim_world.config import SceneSpec
-from pick_sim_world.containers import ContainerSpec
-from pick_sim_world.errors import InvalidArgument, UnknownPart
-from pick_sim_world.parts import build_part, PartSpec
+from pick_common.containers import ContainerSpec
+from pick_common.errors import InvalidArgument, UnknownPart
+from pick_common.parts import build_part, PartSpec
+from pick_common.specs import SceneSpec
 from pick_sim_world.world import World
 from pick_validity.config import CheckConfig, GraspPose, Gripper, PlaceSpec
 from pick_validity.validity import (

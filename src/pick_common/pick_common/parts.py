@@ -15,7 +15,7 @@ import os
 import numpy as np
 import trimesh
 
-from .errors import check_int, check_number, InvalidArgument, MeshError, UnknownPart
+from .errors import check_int, check_number, InvalidArgument, Limit, MeshError, UnknownPart
 
 # Largest part accepted: a sanity limit well above small parts, in metres.
 MAX_PART_SIZE = 0.5
@@ -23,6 +23,16 @@ MIN_PART_SIZE = 1e-4
 MAX_MESH_HULLS = 32
 MAX_MESH_FACES = 500_000
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
+# The range of each material setting and the mesh scale, by field name (the world node's
+# parameters of the same names state them).
+LIMITS = {
+    'part.mass': Limit(0.0, 10.0, low_open=True),                 # kg
+    'part.lateral_friction': Limit(0.0, 10.0),                    # Coulomb coefficient
+    'part.rolling_friction': Limit(0.0, 0.1),                     # m
+    'part.spinning_friction': Limit(0.0, 0.1),                    # m
+    'part.restitution': Limit(0.0, 1.0),
+    'part.scale': Limit(0.0, 1e3, low_open=True),                 # mesh units to m
+}
 
 
 @dataclass(frozen=True)
@@ -204,13 +214,11 @@ _BUILDERS = {'radial_capacitor': _radial_capacitor, 'to220': _to220, 'dip': _dip
 
 
 def _check_material(spec: PartSpec, default_mass: float) -> float:
-    check_number('part.lateral_friction', spec.lateral_friction, low=0.0, high=10.0)
-    check_number('part.rolling_friction', spec.rolling_friction, low=0.0, high=0.1)
-    check_number('part.spinning_friction', spec.spinning_friction, low=0.0, high=0.1)
-    check_number('part.restitution', spec.restitution, low=0.0, high=1.0)
+    for name in ('lateral_friction', 'rolling_friction', 'spinning_friction', 'restitution'):
+        LIMITS[f'part.{name}'].check(f'part.{name}', getattr(spec, name))
     if spec.mass is None:
         return default_mass
-    return check_number('part.mass', spec.mass, low=0.0, high=10.0, low_open=True)
+    return LIMITS['part.mass'].check('part.mass', spec.mass)
 
 
 def _finish(spec: PartSpec, dims: Mapping[str, float], mass: float,
@@ -254,7 +262,7 @@ def load_mesh(path: str, scale: float) -> trimesh.Trimesh:
     Raises MeshError for a missing file, an unreadable or empty mesh, out-of-range face indices,
     non-finite vertices or a mesh with no volume.
     """
-    scale = check_number('part.scale', scale, low=0.0, high=1e3, low_open=True)
+    scale = LIMITS['part.scale'].check('part.scale', scale)
     if not path:
         raise MeshError('part.mesh_path', path, 'is empty: a mesh part needs a file')
     if not os.path.isfile(path):

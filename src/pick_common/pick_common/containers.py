@@ -1,14 +1,16 @@
-"""Containers: a rectangular bin or the vibrating-table tray, in the instance frame.
+"""Containers: a rectangular bin or the vibrating-table tray, in the instance frame, and the
+packing rule (how many parts a container may be given).
 
 The instance frame has its origin at the centre of the inner floor, +Z up. The inner box spans
 [-x/2, x/2] x [-y/2, y/2] x [0, z]; walls and floor lie outside it. Units: metres.
 """
 
 from dataclasses import dataclass
+import math
 
 import numpy as np
 
-from .errors import check_number, check_vector, InvalidArgument
+from .errors import check_vector, InvalidArgument, Limit
 
 BIN = 'bin'
 TRAY = 'tray'
@@ -16,6 +18,11 @@ KINDS = (BIN, TRAY)
 MIN_INNER, MAX_INNER = 0.005, 2.0     # m, per dimension
 MAX_WALL, MAX_FLOOR = 0.1, 0.2        # m
 TRAY_DEFAULT_SIZE = (0.195, 0.150, 0.027)
+LIMITS = {    # m
+    'container.wall_thickness': Limit(0.0005, MAX_WALL),
+    'container.floor_thickness': Limit(0.001, MAX_FLOOR),
+}
+PACKING_LIMIT = 0.4     # largest fraction of a container's inner volume parts may fill
 
 
 @dataclass(frozen=True)
@@ -48,8 +55,9 @@ def check_container(spec: ContainerSpec) -> ContainerSpec:
     if spec.kind not in KINDS:
         raise InvalidArgument('container.kind', spec.kind, f'must be one of {", ".join(KINDS)}')
     check_vector('container.inner_size', spec.inner_size, 3, low=MIN_INNER, high=MAX_INNER)
-    check_number('container.wall_thickness', spec.wall_thickness, low=0.0005, high=MAX_WALL)
-    check_number('container.floor_thickness', spec.floor_thickness, low=0.001, high=MAX_FLOOR)
+    LIMITS['container.wall_thickness'].check('container.wall_thickness', spec.wall_thickness)
+    LIMITS['container.floor_thickness'].check('container.floor_thickness',
+                                              spec.floor_thickness)
     if spec.kind == TRAY:
         cx, cy = check_vector('container.feeder_zone_center', spec.feeder_zone_center, 2)
         sx, sy = check_vector('container.feeder_zone_size', spec.feeder_zone_size, 2,
@@ -60,6 +68,19 @@ def check_container(spec: ContainerSpec) -> ContainerSpec:
                                   f'at {cx:g}, {cy:g} reaches outside the inner floor '
                                   f'{x:g} x {y:g}')
     return spec
+
+
+def check_fits(field: str, count: int, part_volume: float, spec: ContainerSpec) -> None:
+    """The packing rule, for the world and the experiment file alike: `count` parts of
+    `part_volume` m^3 may fill at most PACKING_LIMIT of the container's inner volume. Raises
+    InvalidArgument naming field, the count and the most that fit otherwise."""
+    inner = math.prod(spec.inner_size)
+    if count * part_volume > PACKING_LIMIT * inner:
+        most = int(PACKING_LIMIT * inner / part_volume)
+        size = ' x '.join(f'{s * 1000:g}' for s in spec.inner_size)
+        raise InvalidArgument(field, count, (
+            f'parts do not fit a container of {size} mm: {part_volume * 1e9:.4g} mm^3 each, '
+            f'at most {most} within the packing limit {PACKING_LIMIT:g}'))
 
 
 def wall_boxes(spec: ContainerSpec) -> list[tuple[tuple[float, float, float],

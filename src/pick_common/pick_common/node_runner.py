@@ -1,14 +1,23 @@
-"""What every node of the workspace shares: the latched QoS profile, and a main() that starts
-rclpy, turns a bad configuration into one line and exit code 2 (never a traceback), spins, and
-shuts down cleanly on Ctrl-C or SIGINT (the Jazzy way: ros2/demos `qos_overrides_talker.py`)."""
+"""What every node of the workspace shares: the latched QoS profile; parameters declared from
+a table of limits (`declare`); one answer to a failed request (`answer_error`); one watch on
+the servers of a call in flight (`ServerWatch`); the probe that a server can answer us
+(`handshake`); and a main() that starts rclpy, turns a bad configuration into one line and
+exit code 2 (never a traceback), spins, and shuts down cleanly on Ctrl-C or SIGINT (the Jazzy
+way: ros2/demos `qos_overrides_talker.py`)."""
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Mapping
 import sys
 import time
+import traceback
 import uuid
 
 from action_msgs.srv import CancelGoal
-from rcl_interfaces.msg import ParameterDescriptor, ParameterType
+from rcl_interfaces.msg import (
+    FloatingPointRange,
+    IntegerRange,
+    ParameterDescriptor,
+    ParameterType,
+)
 import rclpy
 from rclpy.action import ActionClient
 from rclpy.exceptions import ParameterException
@@ -19,7 +28,8 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
-from .errors import WorldError
+from .conversions import error_code, ERROR_INTERNAL
+from .errors import CodedError, Limit, PickError
 
 # s an action server keeps a finished goal's result (rclpy's default: 900). Every status
 # message lists each goal kept, and every client decodes every status message: with the default,
@@ -46,6 +56,50 @@ def server_ids(node: Node, client) -> frozenset[bytes]:
 
 
 PROBE_WAIT = 1.0   # s for the answer to a probe before another is sent
+GONE_AFTER = 2.0   # s a server must stay absent from the graph before a call to it fails
+
+
+def server_ready(client) -> bool:
+    """Whether the graph has a server for an action or service client now."""
+    if isinstance(client, ActionClient):
+        return client.server_is_ready()
+    return client.service_is_ready()
+
+
+def serving(node: Node, clients: Iterable) -> dict:
+    """client -> the DDS ids of its servers now (server_ids), to hand a ServerWatch."""
+    return {c: server_ids(node, c) for c in clients}
+
+
+class ServerWatch:
+    """Whether the servers that took a call are still there while it is in flight.
+
+    A server whose node died never answers, and one started again answers from a new, empty
+    state, which must not pass for the old one's: `lost` names the clients none of whose
+    servers in `serving` (client -> server ids, taken when the work began; empty ids: any
+    server will do) is in the graph now; `gone` names them only once they have been lost for
+    `gone_after` s in a row (discovery can miss a live server for a moment). Used by the
+    manager's calls to a worker and by the feeder controller's calls to the world.
+    """
+
+    def __init__(self, node: Node, serving: Mapping, gone_after: float = GONE_AFTER) -> None:
+        self._node = node
+        self._serving = dict(serving)
+        self._gone_after = gone_after
+        self._lost_since: float | None = None
+
+    def lost(self) -> list:
+        return [c for c, ids in self._serving.items()
+                if not (ids & server_ids(self._node, c) if ids else server_ready(c))]
+
+    def gone(self) -> list:
+        lost, now = self.lost(), time.monotonic()
+        if not lost:
+            self._lost_since = None
+            return []
+        if self._lost_since is None:
+            self._lost_since = now
+        return lost if now - self._lost_since > self._gone_after else []
 
 
 def handshake(node: Node, clients, wait: Callable[[Future, float], bool], deadline: float,
@@ -85,6 +139,47 @@ def probe(node: Node, client) -> tuple[object, object]:
     return client, client.srv_type.Request()
 
 
+def describe(text: str, limit: Limit | None = None) -> ParameterDescriptor:
+    """A read-only parameter descriptor stating `limit` (the one the core checks)."""
+    descriptor = ParameterDescriptor(description=text, read_only=True)
+    if limit is not None and limit.integer:
+        descriptor.integer_range = [IntegerRange(from_value=int(limit.low),
+                                                 to_value=int(limit.high))]
+    elif limit is not None:
+        descriptor.floating_point_range = [FloatingPointRange(from_value=float(limit.low),
+                                                              to_value=float(limit.high))]
+    return descriptor
+
+
+def declare(node: Node, name: str, default, text: str, limit: Limit | None = None):
+    """Declare a read-only parameter and return its value, checked against `limit` (rclpy
+    refuses a value outside the range at declaration; the check also enforces an open lower
+    bound, which a descriptor cannot state). Every node declares its parameters this way, so
+    that each range is written once, in the core's table of limits."""
+    value = node.declare_parameter(name, default, describe(text, limit)).value
+    return value if limit is None else limit.check(name, value)
+
+
+def answer_error(response, exc: BaseException, logger, what: str) -> None:
+    """Fill a response's (or result's) error_code and error_msg from an exception raised while
+    serving `what`, and log it once: a core error (PickError) gets its code, a failed call to
+    another node (CodedError) the code it carries; anything else is a bug, answered INTERNAL
+    and logged with its traceback, and the node keeps serving."""
+    if isinstance(exc, PickError):
+        response.error_code = error_code(exc)
+        response.error_msg = str(exc)
+        logger.warning(f'{what} refused: {exc}')
+    elif isinstance(exc, CodedError):
+        response.error_code = exc.code
+        response.error_msg = str(exc)
+        logger.error(f'{what} failed: {exc}')
+    else:
+        response.error_code = ERROR_INTERNAL
+        response.error_msg = f'internal error: {type(exc).__name__}: {exc}'
+        logger.error(f'{what}: {response.error_msg}\n'
+                     f'{"".join(traceback.format_exception(exc))}')
+
+
 def declare_mesh_dirs(node: Node) -> list[str]:
     """The read-only `mesh_dirs` parameter of the nodes that load meshes named in requests:
     the directories those files may lie in (none by default)."""
@@ -106,7 +201,7 @@ def run(name: str, make_node: Callable[[], Node],
         sys.exit(2)
     try:
         node = make_node()
-    except (WorldError, ParameterException) as exc:
+    except (PickError, ParameterException) as exc:
         print(f'{name}: bad configuration: {exc}', file=sys.stderr)
         rclpy.try_shutdown()
         sys.exit(2)

@@ -1,19 +1,33 @@
-"""Exceptions of the world core and the checks that raise them.
+"""The exceptions every core of the workspace raises on purpose, and the checks that raise them.
 
-Every value is checked here before it reaches PyBullet: PyBullet accepts NaN silently and its
-state becomes NaN. The node turns these exceptions into an error code and a message.
+Every value is checked with these before it reaches PyBullet or FCL: PyBullet accepts NaN
+silently and its state becomes NaN. A node turns these exceptions into an error code and a
+message (`pick_common.conversions.error_code`, `pick_common.node_runner.answer_error`).
+
+A `Limit` is the range of one setting, written once: the core's check enforces it and the
+node's parameter descriptor states it (`pick_common.node_runner.declare`).
 """
 
 from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 import math
 import os
 
 
-class WorldError(Exception):
-    """Base class of the errors the world core raises on purpose."""
+class PickError(Exception):
+    """Base class of the errors the cores raise on purpose (bad input, physics faults)."""
 
 
-class InvalidArgument(WorldError):
+class CodedError(Exception):
+    """A failed call to another node: `code` is the pick_msgs error code to answer with (the
+    other node's own, or INTERNAL when it is missing or was lost, CANCELED when canceled)."""
+
+    def __init__(self, code: int, message: str) -> None:
+        self.code = code
+        super().__init__(message)
+
+
+class InvalidArgument(PickError):
     """A value is out of range, not finite, or inconsistent with another.
 
     The message names the field, the value and the rule it broke.
@@ -26,11 +40,11 @@ class InvalidArgument(WorldError):
         super().__init__(f'{field}: {value!r} {rule}')
 
 
-class UnknownInstance(WorldError):
+class UnknownInstance(PickError):
     """An instance id that the scene does not have."""
 
 
-class UnknownPart(WorldError):
+class UnknownPart(PickError):
     """A part id or a part model name that does not exist."""
 
 
@@ -38,7 +52,7 @@ class MeshError(InvalidArgument):
     """A user mesh that is missing, empty or degenerate."""
 
 
-class PhysicsFault(WorldError):
+class PhysicsFault(PickError):
     """The physics state became invalid (NaN or inf poses)."""
 
 
@@ -98,3 +112,24 @@ def check_inside(field: str, path: str, roots: Sequence[str], parameter: str) ->
     where = ', '.join(repr(r) for r in roots) if roots else 'none'
     raise InvalidArgument(field, path, f'is outside the directories this node may use '
                                        f'({parameter}: {where})')
+
+
+@dataclass(frozen=True)
+class Limit:
+    """The range of one setting: [low, high] (low excluded when `low_open`), whole numbers when
+    `integer`. `check` enforces it; a node's parameter descriptor states it."""
+
+    low: float
+    high: float
+    integer: bool = False
+    low_open: bool = False
+
+    def check(self, field: str, value, *, low: float | None = None):
+        """value as an int or a float if it lies within the limit; `low` raises the lower
+        bound for a rule that depends on another field. Raises InvalidArgument naming field,
+        value and limit otherwise."""
+        if self.integer:
+            return check_int(field, value, low=int(self.low if low is None else low),
+                             high=int(self.high))
+        return check_number(field, value, low=self.low if low is None else max(low, self.low),
+                            high=self.high, low_open=self.low_open)

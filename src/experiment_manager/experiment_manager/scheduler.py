@@ -1,0 +1,227 @@
+"""The scheduler of a run: spreads the iterations of a file's experiments over one or more
+workers (backends), each iteration as soon as its experiment is ready, and hands every finished
+iteration to the sink at once.
+
+An experiment is ready when the experiments it takes its bin or range from have finished (their
+metrics make its plan: plan.py); what one iteration does is procedures.py. A worker that is
+lost gives its iteration back to the queue and may come back (Backend.rejoin).
+"""
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+import heapq
+import threading
+import time
+from typing import Protocol
+
+from . import metrics
+from .backend import Backend, WorkerLost
+from .config import Experiment, ExperimentFile
+from .plan import count_iterations, plan, Unit
+from .procedures import run_unit
+from .rows import Record
+
+
+@dataclass(frozen=True)
+class Progress:
+    experiment_id: str
+    experiment_type: str
+    phase: str
+    done: int
+    total: int
+    elapsed: float          # s
+    eta: float              # s, 0 when unknown
+
+
+class Sink(Protocol):
+    def is_done(self, experiment_id: str, group: int, iteration: int) -> bool: ...
+    def write(self, record: Record) -> None: ...
+    def iterations(self, experiment_id: str) -> list[dict]: ...
+    def picks(self, experiment_id: str) -> list[dict]: ...
+    def write_summary(self, summary: dict) -> None: ...
+    def reorder(self, rank: dict[tuple, tuple[int, int]]) -> None: ...
+
+
+class Runner:
+    """Runs the experiments of a file over one or more backends (workers), writing each
+    iteration to the sink as it finishes.
+
+    The iterations are spread over the workers, each taking the first ready one in plan order
+    when it is free. An experiment is ready when the experiments it takes its bin or range from
+    have finished (their metrics make its plan); the others run alongside, so a long iteration
+    does not leave the other workers idle. When an experiment finishes, the sink puts the rows
+    in plan order, so the results do not depend on how many workers ran them or which. `abort`
+    is set when the run fails, so that the other workers' calls stop.
+    """
+
+    def __init__(self, file: ExperimentFile, backends: Sequence[Backend], sink: Sink,
+                 progress: Callable[[Progress], None] | None = None,
+                 abort: threading.Event | None = None) -> None:
+        if not backends:
+            raise ValueError('a run needs at least one backend')
+        self.file, self.backends, self.sink = file, list(backends), sink
+        self._progress = progress or (lambda p: None)
+        self._abort = abort or threading.Event()
+        self._cond = threading.Condition()
+        self._in_flight = 0
+        self._rejoining = 0
+        self._live = list(range(len(self.backends)))
+        self._total = count_iterations(file)
+        self._done = 0
+        self._ran = 0
+        self._start = time.monotonic()
+        self._summary: dict[str, dict] = {}
+        self._rank: dict[tuple, tuple[int, int]] = {}   # key -> (experiment, plan position)
+        self._ready: list[tuple[tuple[int, int], Unit]] = []    # a heap by rank
+        self._left: dict[str, int] = {}                # planned experiment -> units unwritten
+        self._waiting = list(file.experiments)         # not planned yet
+        self._errors: list[BaseException] = []
+        self.rejoined: list[int] = []     # indexes of the backends that came back, in order
+
+    @property
+    def lost_workers(self) -> list[int]:
+        """Indexes of the backends whose worker was missing at the start or lost since."""
+        return [k for k in range(len(self.backends)) if k not in self._live]
+
+    def run(self) -> dict:
+        """Run every experiment; returns the summary (also written to the sink). A worker
+        missing at the start is left out; the run fails when all are."""
+        missing = []
+        for k, backend in enumerate(self.backends):
+            try:
+                backend.start(self.file)
+            except WorkerLost as exc:
+                missing.append(exc)
+                self._live.remove(k)
+        if not self._live:
+            raise missing[0]
+        with self._cond:
+            self._guarded(self._release)
+        workers = [threading.Thread(target=self._work, args=(k,), name=f'worker {k}')
+                   for k in self._live]
+        if len(workers) == 1:
+            workers[0].run()
+        else:
+            for t in workers:
+                t.start()
+            for t in workers:
+                t.join()
+        if self._errors:
+            raise self._errors[0]
+        if self._waiting or any(self._left.values()):
+            raise AssertionError('the run ended with iterations left undone')
+        self._report(self.file.experiments[-1], 'done')
+        return metrics.file_summary(self.file, self._ordered_summary())
+
+    def _ordered_summary(self) -> dict:
+        return {e.id: self._summary[e.id] for e in self.file.experiments
+                if e.id in self._summary}
+
+    def _guarded(self, step: Callable[..., None], *args) -> None:
+        """Run a step under the lock; an error stops every worker and ends the run."""
+        try:
+            step(*args)
+        except BaseException as exc:
+            self._errors.append(exc)
+            self._abort.set()
+
+    def _release(self) -> None:
+        """Plan the experiments whose sources have finished (under the lock)."""
+        changed = True
+        while changed:
+            changed = False
+            for exp in list(self._waiting):
+                sources = [s for s in (exp.bin_from, exp.range_from) if s]
+                if exp not in self._waiting or not all(s in self._summary for s in sources):
+                    continue     # planned meanwhile (by the release a _finish made), or not yet
+                self._waiting.remove(exp)
+                index = self.file.experiments.index(exp)
+                units = plan(self.file, exp, self._summary)
+                left = 0
+                for i, u in enumerate(units):
+                    key = u.key
+                    self._rank[key] = (index, i)
+                    if self.sink.is_done(*key):
+                        self._done += 1
+                    else:
+                        heapq.heappush(self._ready, ((index, i), u))
+                        left += 1
+                self._left[exp.id] = left
+                if not left:
+                    self._finish(exp)
+                changed = True
+
+    def _finish(self, exp: Experiment) -> None:
+        """An experiment's last iteration is written: order the rows, summarise, release the
+        experiments waiting for it (under the lock)."""
+        self.sink.reorder(self._rank)
+        self._summary[exp.id] = metrics.summarise(
+            self.file, exp, self.sink.iterations(exp.id), self.sink.picks(exp.id),
+            self._summary)
+        self.sink.write_summary(metrics.file_summary(self.file, self._ordered_summary()))
+        self._release()
+
+    def _work(self, k: int) -> None:
+        """Worker k's loop: take the first ready iteration, run it, write it. While others are
+        in flight it waits rather than leave: their end may release an experiment, and a lost
+        worker's iteration comes back to the queue."""
+        backend = self.backends[k]
+        while True:
+            with self._cond:
+                while not self._ready and self._in_flight and not self._errors:
+                    self._cond.wait()
+                if self._errors or not self._ready or self._abort.is_set():
+                    return
+                _, u = heapq.heappop(self._ready)
+                self._in_flight += 1
+                self._report(u.experiment, f'{u.experiment.id}: {u.label}')
+            try:
+                record = run_unit(self.file, u, backend)
+            except WorkerLost as exc:
+                with self._cond:
+                    heapq.heappush(self._ready, (self._rank[u.key], u))
+                    self._live.remove(k)
+                    self._rejoining += 1
+                    self._in_flight -= 1
+                    self._cond.notify_all()
+                back = backend.rejoin(self._over)
+                with self._cond:
+                    self._rejoining -= 1
+                    if back and not self._over():
+                        self._live.append(k)
+                        self.rejoined.append(k)
+                        continue
+                    if not self._live and not self._rejoining and not self._errors:
+                        self._errors.append(exc)
+                        self._abort.set()
+                    self._cond.notify_all()
+                return
+            except BaseException as exc:
+                with self._cond:
+                    self._errors.append(exc)
+                    self._abort.set()
+                    self._in_flight -= 1
+                    self._cond.notify_all()
+                return
+            with self._cond:
+                self._in_flight -= 1
+                self._guarded(self._written, u, record)
+                self._cond.notify_all()
+
+    def _over(self) -> bool:
+        """The run has failed, or has nothing left to run: a lost worker stops waiting."""
+        return bool(self._errors) or self._abort.is_set() or not (
+            self._ready or self._in_flight or self._waiting)
+
+    def _written(self, u: Unit, record: Record) -> None:
+        self.sink.write(record)
+        self._done += 1
+        self._ran += 1
+        self._left[u.experiment.id] -= 1
+        if not self._left[u.experiment.id]:
+            self._finish(u.experiment)
+
+    def _report(self, exp: Experiment, phase: str) -> None:
+        elapsed = time.monotonic() - self._start
+        eta = elapsed / self._ran * (self._total - self._done) if self._ran else 0.0
+        self._progress(Progress(exp.id, exp.type, phase, self._done, self._total, elapsed, eta))

@@ -1,0 +1,198 @@
+"""The decisions of a run: a verdict per option (static bin, vibrating table) with its reasons,
+and, for the paper's test-case files, the paper's findings checked on the run (against_paper).
+Rendering them is report.py's job.
+
+Verdicts, per option:
+- static bin: feasible when every `bin_emptying` iteration emptied the bin and the bin holds a
+  refill interval's parts (requirements.parts_per_hour x refill_interval_h);
+- vibrating table: feasible when every `feeder_emptying` run emptied the feeder and the feeder
+  held a refill interval's parts; the report gives the time per vibration this leaves.
+An option whose experiment did not run is "not analysed".
+"""
+
+import numpy as np
+
+from .metrics import FAULTS
+from .wording import count, fmt, of_type, pct, table
+
+# The paper's results (section 5) for its test case, by experiment-file id.
+PAPER = {
+    'pth0': {'best_bin_mm': [100, 175, 15], 'container_free': 0.2502, 'valid_first': 0.0036,
+             'table2': {'iterations': 40, 'parts': 240, 'emptied': 0, 'mean': 0.8, 'min': 0,
+                        'max': 4, 'std': 0.92},
+             'n_star': 49, 'range': [44, 54],
+             'table3': {'iterations': 50, 'parts': 240, 'emptied': 50, 'vibrations': 123.14}},
+    'pth1': {'best_bin_mm': [300, 300, 26], 'container_free': 0.3477, 'valid_first': 0.0047,
+             'table2': {'iterations': 40, 'parts': 480, 'emptied': 0, 'mean': 2.7, 'min': 0,
+                        'max': 6, 'std': 1.67},
+             'n_star': 22, 'range': [17, 27],
+             'table3': {'iterations': 50, 'parts': 480, 'emptied': 50, 'vibrations': 166.96}},
+    'pth2': {'best_bin_mm': [300, 300, 22], 'container_free': 0.388, 'valid_first': 0.0127,
+             'table2': {'iterations': 40, 'parts': 480, 'emptied': 0, 'mean': 7.5, 'min': 2,
+                        'max': 11, 'std': 2.28},
+             'n_star': 27, 'range': [22, 32],
+             'table3': {'iterations': 50, 'parts': 480, 'emptied': 50, 'vibrations': 139.07}},
+}
+DIFFERS = 1.25     # a figure differs from the paper's when ours is over 1.25x or under 0.8x it
+FALLS = 0.05       # past n*, the sweep's fit "falls" when it ends at least 5 % below its peak
+FEASIBLE, NOT_FEASIBLE, NOT_ANALYSED = 'FEASIBLE', 'NOT FEASIBLE', 'not analysed'
+# the feeder policy's stop decisions (feeder_controller.policy.NAMES), as a report says them
+_STOPS = {'stop: empty': 'feeder and table empty', 'stop: vibration limit': 'vibration limit'}
+
+
+def verdicts(summary: dict, spec: dict) -> list[dict]:
+    """The decision per option: option, verdict, and the reasons (for people)."""
+    capacity = summary['requirements']['capacity']
+    out = []
+    emptying = of_type(summary, 'bin_emptying')
+    if emptying:
+        _, s = emptying[-1]
+        reasons = [f'{s["emptied"]} of {s["iterations"]} bins emptied; parts removed per bin: '
+                   f'mean {fmt(s["removed"]["mean"])}, max {fmt(s["removed"]["max"])} '
+                   f'of {s["parts"]}']
+        ok = s['iterations'] > 0 and s['emptied'] == s['iterations']
+        reasons += _fault_reason(s)
+        if s['parts'] < capacity:
+            ok = False
+            reasons.append(f'the bin was filled with {s["parts"]} parts, fewer than the '
+                           f'{capacity} a refill interval needs')
+        out.append({'option': f'static bin {fmt(s["bin_mm"])} mm',
+                    'verdict': FEASIBLE if ok else NOT_FEASIBLE, 'reasons': reasons})
+    else:
+        out.append({'option': 'static bin', 'verdict': NOT_ANALYSED,
+                    'reasons': ['no bin_emptying experiment in the file']})
+    feeder = of_type(summary, 'feeder_emptying')
+    if feeder:
+        _, s = feeder[-1]
+        v = s['vibrations_to_empty']
+        reasons = [f'{s["emptied"]} of {s["iterations"]} feeder runs emptied '
+                   f'(optimal range {s["optimal_range"][0]}-{s["optimal_range"][1]} parts on '
+                   f'the table; runs ended by: '
+                   f'{", ".join(f"{_STOPS.get(k, k)} {n}" for k, n in s["stops"].items())})']
+        if v['mean'] is not None:
+            reasons.append(f'vibrations to empty the feeder: mean {fmt(v["mean"], 4)}; the '
+                           f'refill interval allows one vibration every '
+                           f'{fmt(s["minutes_per_vibration_allowed"])} min')
+        if s['lost']:
+            reasons.append(f'{count(s["lost"], "part")} fell off the table')
+        ok = s['iterations'] > 0 and s['emptied'] == s['iterations']
+        reasons += _fault_reason(s)
+        if s['parts'] < capacity:
+            ok = False
+            reasons.append(f'the feeder held {s["parts"]} parts, fewer than the {capacity} a '
+                           'refill interval needs')
+        out.append({'option': 'vibrating table', 'verdict': FEASIBLE if ok else NOT_FEASIBLE,
+                    'reasons': reasons})
+    else:
+        out.append({'option': 'vibrating table', 'verdict': NOT_ANALYSED,
+                    'reasons': ['no feeder_emptying experiment in the file']})
+    return out
+
+
+def _fault_reason(s: dict) -> list[str]:
+    f = s['faults']
+    if not f['flagged']:
+        return []
+    return [f'{count(len(f["flagged"]), "iteration")} flagged: ' + ', '.join(
+        f'{k} {f[k]}' for k in FAULTS if f[k])
+        + ' (see Physics faults)']
+
+
+def _last(summary: dict, kind: str) -> dict | None:
+    """The summary of the file's last experiment of this type (the one the report shows)."""
+    found = of_type(summary, kind)
+    return found[-1][1] if found else None
+
+
+def _ratio(ours, paper) -> str:
+    return '-' if ours is None or not paper else f'{ours / paper:.2f}'
+
+
+def _differs(ours, paper) -> bool:
+    return ours is not None and bool(paper) and not 1 / DIFFERS <= ours / paper <= DIFFERS
+
+
+def _sweep_shape(s: dict) -> tuple[str, bool]:
+    """How valid parts go with the parts on the tray (the fit), and whether that is the
+    paper's shape: up to a peak inside the sweep, then down by at least FALLS."""
+    last = s['per_n'][-1]['n']
+    if s['n_star'] >= last:
+        return f"still rising at the sweep's last count, n = {last}", False
+    fall = 1 - float(np.polyval(s['coefficients'], last)) / s['fit_max']
+    shape = 'then fall' if fall >= FALLS else 'then level off'
+    return (f'rise to n* = {s["n_star"]}, {shape}: {100 * fall:.0f} % below the peak at '
+            f'n = {last} (fit)'), fall >= FALLS
+
+
+def against_paper(summary: dict, paper: dict) -> list[str]:
+    """The paper's three findings and its figures beside this run's, and where and why ours
+    differ. The reasons are what we know differs between the two set-ups, not measured causes."""
+    findings, figures, differ = [], [], set()
+    e, b, w, f = (_last(summary, kind) for kind in (
+        'bin_emptying', 'bin_static', 'table_sweep', 'feeder_emptying'))
+    t2, t3 = paper['table2'], paper['table3']
+    if b and b['best_bin'] is not None:
+        best = b['bins'][b['best_bin']]
+        free = best['fractions']['container_free']['mean']
+        same = [float(x) for x in paper['best_bin_mm']] == [float(x) for x in b['best_bin_mm']]
+        figures += [['best bin (mm)', ' x '.join(fmt(x) for x in b['best_bin_mm']),
+                     ' x '.join(fmt(x) for x in paper['best_bin_mm']),
+                     'the same' if same else 'another'],
+                    ['its parts free of the bin (bin collision free)', pct(free),
+                     pct(paper['container_free']), _ratio(free, paper['container_free'])]]
+        if not same or _differs(free, paper['container_free']):
+            differ.add('bins')
+    if e:
+        agrees = e['emptied'] == 0
+        findings.append([f'static bins never emptied ({t2["emptied"]} of {t2["iterations"]})',
+                         f'{e["emptied"]} of {e["iterations"]} emptied',
+                         'agrees' if agrees else 'differs'])
+        ours_valid, ours_removed = e['first_check']['valid']['mean'], e['removed']['mean']
+        figures += [['valid at the first check of a full bin', pct(ours_valid),
+                     pct(paper['valid_first']), _ratio(ours_valid, paper['valid_first'])],
+                    ['parts removed per bin (mean)', fmt(ours_removed), fmt(t2['mean']),
+                     _ratio(ours_removed, t2['mean'])]]
+        if not agrees or _differs(ours_valid, paper['valid_first']) \
+                or _differs(ours_removed, t2['mean']):
+            differ.add('bins')
+    if w and 'n_star' in w:
+        shape, agrees = _sweep_shape(w)
+        findings.append([f'valid parts rise with the parts on the tray, then fall (n* = '
+                         f'{paper["n_star"]})', shape, 'agrees' if agrees else 'differs'])
+        figures.append(['parts on the table at the optimum, n*', w['n_star'], paper['n_star'],
+                        _ratio(w['n_star'], paper['n_star'])])
+        if not agrees or _differs(w['n_star'], paper['n_star']):
+            differ.add('table')
+    if f:
+        agrees = f['iterations'] > 0 and f['emptied'] == f['iterations']
+        findings.append([f'the tray emptied in every feeder run ({t3["emptied"]} of '
+                         f'{t3["iterations"]})', f'{f["emptied"]} of {f["iterations"]} emptied',
+                         'agrees' if agrees else 'differs'])
+        vib = f['vibrations_to_empty']['mean']
+        figures.append(['vibrations to empty the feeder (mean)', fmt(vib, 4),
+                        fmt(t3['vibrations'], 4), _ratio(vib, t3['vibrations'])])
+        if not agrees or _differs(vib, t3['vibrations']):
+            differ.add('feeder')
+    lines = ['', '## Against the paper', '']
+    lines += table(['the paper found', 'this run', 'agrees?'], findings) + ['']
+    lines += table(['figure', 'ours', 'the paper', 'ours / paper'], figures)
+    why = {
+        'bins': "Static bins: our part models stand in for the paper's figure 13 and the "
+                "gripper is ours (the paper gives the dimensions of neither; see the README's "
+                'part table). Which parts a grasp can reach free of the walls and of their '
+                'neighbours, and so the parts removed, follow from both.',
+        'table': 'Table optimum: n* counts parts of our models on the tray, each with the '
+                 'clearance our gripper needs: both are ours.',
+        'feeder': "Feeder: the table's motion is a model of ours (the paper does not say how "
+                  'its table moves); the vibrations to empty the feeder follow from it and from '
+                  'the load, n* above.'}
+    lines += ['', f'A figure differs when ours is over {DIFFERS:g} times or under '
+              f"{1 / DIFFERS:g} times the paper's."
+              + (' Where this run differs, and why:' if differ else ' None does.')]
+    lines += [f'- {why[k]}' for k in ('bins', 'table', 'feeder') if k in differ]
+    if f and f['lost']:
+        lines.append(f'- {count(f["lost"], "part")} fell over the tray\'s wall, in '
+                     f'{f["faults"]["escaped"]} of {f["iterations"]} feeder runs; a run that '
+                     'loses a part has not emptied the feeder.')
+    lines += ['', 'No setting of the simulation was tuned to agree with the paper.']
+    return lines

@@ -1,0 +1,122 @@
+"""Building a PyBullet scene: the engine's settings, the part's collision shape, containers
+(a static bin, or a tray held on its trajectory by a driven constraint) and part bodies.
+
+Every function takes the PyBullet client it works on; the World owns the client.
+"""
+
+import os
+
+import numpy as np
+from pick_common import containers
+from pick_common.containers import ContainerSpec
+from pick_common.parts import PartGeometry
+import pybullet as pb
+import trimesh
+
+from .config import PhysicsConfig
+
+GRAVITY = 9.81                  # m/s^2
+INSTANCE_GAP = 0.05             # m between the outer walls of neighbouring instances
+TRAY_MASS = 3.0                 # kg; the tray is a dynamic body held by a driven constraint
+TRAY_MAX_FORCE = 5000.0         # N the constraint may apply to hold the tray on its trajectory
+CONTAINER_FRICTION = 0.5        # Coulomb coefficient of the bin and tray walls and floors
+
+
+def instance_seed(seed: int, index: int) -> int:
+    """The seed of instance `index` derived from the scene's base seed (stable across runs)."""
+    return int(np.random.SeedSequence([seed, index]).generate_state(1, np.uint64)[0])
+
+
+def instance_pitch(spec: ContainerSpec) -> float:
+    """Distance along x between the origins of neighbouring instances, m."""
+    return containers.outer_size(spec)[0] + INSTANCE_GAP
+
+
+def configure(client: int, physics: PhysicsConfig) -> None:
+    """Empty the simulation and set gravity and the solver settings."""
+    pb.resetSimulation(physicsClientId=client)
+    pb.setGravity(0.0, 0.0, -GRAVITY, physicsClientId=client)
+    pb.setPhysicsEngineParameter(
+        fixedTimeStep=physics.time_step, numSolverIterations=physics.solver_iterations,
+        contactBreakingThreshold=physics.contact_breaking_threshold,
+        deterministicOverlappingPairs=1, physicsClientId=client)
+
+
+def create_part_shape(client: int, part: PartGeometry, directory: str) -> int:
+    """The part's collision compound as one PyBullet shape. Convex hulls are written as OBJ
+    files into `directory` (pybullet takes hull vertices only from a file, one hull each)."""
+    kinds, radii, lengths, halves, files, positions, orientations = [], [], [], [], [], [], []
+    for i, p in enumerate(part.primitives):
+        radius = length = 0.0
+        half = [0.0, 0.0, 0.0]
+        path = ''
+        if p.kind == 'box':
+            kind, half = pb.GEOM_BOX, list(p.size)
+        elif p.kind == 'cylinder':
+            kind, (radius, length) = pb.GEOM_CYLINDER, p.size
+        else:
+            kind = pb.GEOM_MESH
+            path = os.path.join(directory, f'hull_{i}.obj')
+            trimesh.Trimesh(p.vertices, p.faces, process=False).export(path)
+        kinds.append(kind)
+        radii.append(radius)
+        lengths.append(length)
+        halves.append(half)
+        files.append(path)
+        positions.append(list(p.position))
+        orientations.append(list(p.orientation))
+    return pb.createCollisionShapeArray(
+        kinds, radii=radii, lengths=lengths, halfExtents=halves, fileNames=files,
+        meshScales=[[1.0, 1.0, 1.0]] * len(kinds), collisionFramePositions=positions,
+        collisionFrameOrientations=orientations, physicsClientId=client)
+
+
+def create_container(client: int, spec: ContainerSpec,
+                     origin: np.ndarray) -> tuple[int, int | None]:
+    """The container's body at `origin` (world frame, m) and, for a tray, the constraint that
+    holds it on its trajectory (None for a bin)."""
+    boxes = containers.wall_boxes(spec)
+    shape = pb.createCollisionShapeArray(
+        [pb.GEOM_BOX] * len(boxes), halfExtents=[list(h) for h, _ in boxes],
+        collisionFramePositions=[list(p) for _, p in boxes], physicsClientId=client)
+    if spec.kind == containers.BIN:
+        body = pb.createMultiBody(0.0, shape, basePosition=origin.tolist(),
+                                  useMaximalCoordinates=True, physicsClientId=client)
+        pb.changeDynamics(body, -1, lateralFriction=CONTAINER_FRICTION, physicsClientId=client)
+        return body, None
+    # The tray is dynamic and held on its trajectory by a fixed constraint whose pivot we
+    # drive: parts then feel its real velocity (a static body moved by resets does not push
+    # them). pybullet's constraints need a multibody base here.
+    body = pb.createMultiBody(TRAY_MASS, shape, basePosition=origin.tolist(),
+                              physicsClientId=client)
+    pb.changeDynamics(body, -1, lateralFriction=CONTAINER_FRICTION, linearDamping=0.0,
+                      angularDamping=0.0, physicsClientId=client)
+    constraint = pb.createConstraint(body, -1, -1, -1, pb.JOINT_FIXED, [0, 0, 0],
+                                     [0, 0, 0], origin.tolist(), physicsClientId=client)
+    pb.changeConstraint(constraint, maxForce=TRAY_MAX_FORCE, physicsClientId=client)
+    return body, constraint
+
+
+def create_part(client: int, shape: int, part: PartGeometry, pose: np.ndarray) -> int:
+    """A part body of `shape` at `pose` (7,) in the world frame, with the part's material.
+    Continuous collision detection sweeps a sphere of the part's thinnest half-thickness."""
+    spec = part.spec
+    body = pb.createMultiBody(part.mass, shape, basePosition=pose[:3].tolist(),
+                              baseOrientation=pose[3:].tolist(), useMaximalCoordinates=True,
+                              physicsClientId=client)
+    pb.changeDynamics(
+        body, -1, lateralFriction=spec.lateral_friction, rollingFriction=spec.rolling_friction,
+        spinningFriction=spec.spinning_friction, restitution=spec.restitution,
+        ccdSweptSphereRadius=part.thinnest,
+        activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING, physicsClientId=client)
+    return body
+
+
+def base_poses(client: int, bodies: list[int]) -> np.ndarray:
+    """World-frame poses (N, 7) of bodies, xyz + xyzw."""
+    poses = np.empty((len(bodies), 7))
+    for row, body in enumerate(bodies):
+        position, orientation = pb.getBasePositionAndOrientation(body, physicsClientId=client)
+        poses[row, :3] = position
+        poses[row, 3:] = orientation
+    return poses

@@ -1,0 +1,76 @@
+"""Where dropped and fed parts appear: the drop region of a container and non-overlapping spawn
+poses above the parts already there.
+
+Pure: numpy only. Poses are (N, 7) float64, xyz in metres then an xyzw unit quaternion, in the
+instance frame (origin at the centre of the container's inner floor, +Z up).
+"""
+
+import numpy as np
+from pick_common import containers
+from pick_common.containers import ContainerSpec
+from pick_common.errors import InvalidArgument
+from pick_common.parts import PartGeometry
+from pick_common.states import rotate
+
+SPAWN_GAP = 0.0005              # m of clearance between spawn spheres
+ZONES = ('container', 'feeder')
+
+
+def random_quaternions(rng: np.random.Generator, n: int) -> np.ndarray:
+    """n uniformly distributed unit quaternions, (n, 4) xyzw."""
+    q = rng.normal(size=(n, 4))
+    return q / np.linalg.norm(q, axis=1, keepdims=True)
+
+
+def drop_region(spec: ContainerSpec, zone: str,
+                instance: int = 0) -> tuple[float, float, float, float]:
+    """Centre x, y and half extents x, y of where parts spawn in `zone` ('container': the whole
+    inner floor; 'feeder': the tray's feeder zone), in the instance frame, m."""
+    if zone == 'container':
+        return 0.0, 0.0, spec.inner_size[0] / 2, spec.inner_size[1] / 2
+    if zone == 'feeder':
+        if spec.kind != containers.TRAY:
+            raise InvalidArgument('zone', zone, f'needs a tray; instance {instance} has a '
+                                  f'{spec.kind}, which has no feeder')
+        (cx, cy), (sx, sy) = spec.feeder_zone_center, spec.feeder_zone_size
+        return cx, cy, sx / 2, sy / 2
+    raise InvalidArgument('zone', zone, f'must be {" or ".join(ZONES)}')
+
+
+def spawn_poses(rng: np.random.Generator, part: PartGeometry,
+                region: tuple[float, float, float, float], top: float, count: int,
+                zone: str = 'container') -> np.ndarray:
+    """Random, non-overlapping spawn poses (count, 7) in the instance frame.
+
+    Parts spawn in layers of a grid of cells as wide as the part's bounding sphere, from `top`
+    (m, the highest point of the parts already there, 0 for none) up, each with a uniformly
+    random orientation. The grid is shifted at random within its slack and each layer takes a
+    random subset of cells. No two spawn spheres overlap, so nothing is blown apart (the
+    paper's first problem).
+    """
+    cx, cy, hx, hy = region
+    r = part.radius + SPAWN_GAP
+    cell = 2.0 * r
+    span_x, span_y = 2.0 * (hx - r), 2.0 * (hy - r)
+    if span_x < 0 or span_y < 0:
+        raise InvalidArgument(
+            'container.inner_size' if zone == 'container' else 'container.feeder_zone_size',
+            (2 * hx, 2 * hy), f'is smaller than the part ({2 * r:.4g} m across in any '
+            'orientation): parts cannot be dropped into it')
+    nx, ny = int(span_x // cell) + 1, int(span_y // cell) + 1
+    per_layer = nx * ny
+    centers = np.empty((count, 3))
+    for start in range(0, count, per_layer):
+        layer = start // per_layer
+        n = min(per_layer, count - start)
+        shift_x = rng.uniform(0.0, span_x - (nx - 1) * cell)
+        shift_y = rng.uniform(0.0, span_y - (ny - 1) * cell)
+        cells = rng.permutation(per_layer)[:n]
+        ix, iy = np.divmod(cells, ny)
+        centers[start:start + n, 0] = cx - hx + r + shift_x + ix * cell
+        centers[start:start + n, 1] = cy - hy + r + shift_y + iy * cell
+        centers[start:start + n, 2] = top + r + layer * cell
+    quats = random_quaternions(rng, count)
+    # The spawn sphere is centred on the compound's bounding-box centre, not the origin.
+    origins = centers - rotate(quats, part.center)
+    return np.hstack([origins, quats])

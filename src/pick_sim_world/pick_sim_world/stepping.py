@@ -1,0 +1,89 @@
+"""Stepping the physics until the parts rest: the settle criterion and its loop.
+
+A part rests when, over the settle window, its position changed by at most the linear tolerance
+and its orientation by at most the angular tolerance; the scene is settled when at most the
+moving fraction of its parts do not rest. Bullet's sleeping is not used for this: it does not
+trigger for a jittering pile.
+"""
+
+from collections import deque
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+import math
+import time
+
+import numpy as np
+from pick_common.errors import PhysicsFault
+from pick_common.states import Progress
+import pybullet as pb
+
+from .bodies import base_poses
+from .config import PhysicsConfig
+
+ProgressCallback = Callable[[Progress], bool]
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """How a run of steps ended: settled (or, without a stop at rest, not canceled), canceled
+    by the progress callback, steps taken, wall time (s) and the ids still moving."""
+
+    settled: bool
+    canceled: bool
+    steps: int
+    wall_time: float
+    moving_ids: list[int]
+
+
+def quaternion_angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Rotation angle between quaternion pairs (n, 4) and (n, 4), rad."""
+    dot = np.abs(np.einsum('ij,ij->i', a, b))
+    return 2.0 * np.arccos(np.clip(dot, 0.0, 1.0))
+
+
+def step(client: int, ids: Sequence[int], bodies: Sequence[int], cfg: PhysicsConfig,
+         phase: str, duration: float, progress: ProgressCallback | None,
+         before_step: Callable[[], None] | None = None,
+         stop_when_settled: bool = True) -> Outcome:
+    """Step for up to `duration` s of simulated time, checking rest every check period; the
+    parts are `ids` with their `bodies`. progress() is called once per check and cancels by
+    returning False. Raises PhysicsFault naming the parts whose poses became non-finite."""
+    dt = cfg.time_step
+    per_check = max(1, int(round(cfg.settle_check_period / dt)))
+    window = max(1, int(round(cfg.settle_window / cfg.settle_check_period)))
+    total_steps = max(1, int(math.ceil(duration / dt - 1e-9)))
+    bodies = list(bodies)
+    tolerated = int(cfg.settle_moving_fraction * len(ids))
+    history: deque[np.ndarray] = deque(maxlen=window + 1)
+    history.append(base_poses(client, bodies))
+    start = time.perf_counter()
+    steps = 0
+    moving = np.ones(len(ids), dtype=bool)
+    settled = canceled = False
+    while steps < total_steps:
+        for _ in range(min(per_check, total_steps - steps)):
+            if before_step is not None:
+                before_step()
+            pb.stepSimulation(physicsClientId=client)
+            steps += 1
+        poses = base_poses(client, bodies)
+        if not np.isfinite(poses).all():
+            bad = [ids[i] for i in np.flatnonzero(~np.isfinite(poses).all(axis=1))]
+            raise PhysicsFault(f'parts {bad[:10]} got non-finite poses after '
+                               f'{steps * dt:.3f} s of {phase}; the scene was reset')
+        history.append(poses)
+        old = history[0]
+        shift = np.linalg.norm(poses[:, :3] - old[:, :3], axis=1)
+        turn = quaternion_angles(poses[:, 3:], old[:, 3:])
+        moving = (shift > cfg.settle_linear_tolerance) | (turn > cfg.settle_angular_tolerance)
+        full = len(history) == history.maxlen
+        if progress is not None and not progress(Progress(
+                phase, steps * dt, int(moving.sum()) if full else len(ids),
+                float(shift.max()) if len(ids) else 0.0)):
+            canceled = True
+            break
+        if stop_when_settled and full and moving.sum() <= tolerated:
+            settled = True
+            break
+    wall = time.perf_counter() - start
+    return Outcome(settled, canceled, steps, wall, [ids[i] for i in np.flatnonzero(moving)])
