@@ -17,7 +17,7 @@ from geometry_msgs.msg import Vector3
 from graph import Client, NodeProcess, stop_all, unique_namespace
 from hypothesis import given, HealthCheck, settings
 from pick_msgs.action import DropParts, FeedCycle, RemoveParts, RunExperiment, Vibrate
-from pick_msgs.msg import ContainerGeometry, PartModel
+from pick_msgs.msg import ContainerGeometry, PartModel, Vibration
 from pick_msgs.srv import CheckParts, GetParts, ResetScene
 import pytest
 from rclpy.action import ActionClient
@@ -187,7 +187,7 @@ def test_reset_scene(cell, places):
 
 @pytest.mark.parametrize(('name', 'template'), [
     ('w/drop_parts', DropParts.Goal(count=3, zone=DropParts.Goal.ZONE_FEEDER)),
-    ('w/vibrate', Vibrate.Goal(duration=0.2)),
+    ('w/vibrate', Vibrate.Goal(vibration=Vibration(duration=0.2))),
     ('w/remove_parts', RemoveParts.Goal(part_ids=[0, 1], skip_settle=True)),
 ])
 def test_world_actions(cell, name, template):
@@ -228,7 +228,8 @@ def test_check_parts(cell, places):
 def test_feed_cycle(cell):
     cell.fresh(1)
     template = FeedCycle.Goal(instance=0, restart=True, feeder_parts=10, min_count=2,
-                              max_count=4, max_vibrations=5, duration=0.2)
+                              max_count=4, max_vibrations=5,
+                              vibration=Vibration(duration=0.2))
 
     @FUZZ
     @given(requests(template))

@@ -10,7 +10,7 @@ from graph import NodeProcess, stop_all, unique_namespace
 import numpy as np
 from pick_common.node_runner import LATCHED
 from pick_msgs.action import DropParts, RemoveParts, Vibrate
-from pick_msgs.msg import ContainerGeometry, PartArray, Scene
+from pick_msgs.msg import ContainerGeometry, PartArray, Scene, Vibration
 from pick_msgs.srv import GetParts, ResetScene
 import pytest
 from rclpy.action import ActionClient
@@ -136,11 +136,13 @@ def test_feed_drops_into_the_feeder_zone(cell):
     (DropParts, DropParts.Goal(count=3, instances=[7]), DropParts.Result.UNKNOWN_INSTANCE,
      'instances: 7 does not exist'),
     (DropParts, DropParts.Goal(count=3, zone=9), DropParts.Result.INVALID_ARGUMENT, 'zone: 9'),
-    (Vibrate, Vibrate.Goal(amplitude=Vector3(x=math.inf)), Vibrate.Result.INVALID_ARGUMENT,
+    (Vibrate, Vibrate.Goal(vibration=Vibration(amplitude=Vector3(x=math.inf))),
+     Vibrate.Result.INVALID_ARGUMENT,
      r'vibration.amplitude[0]: inf must be finite'),
-    (Vibrate, Vibrate.Goal(frequency=-1.0), Vibrate.Result.INVALID_ARGUMENT,
+    (Vibrate, Vibrate.Goal(vibration=Vibration(frequency=-1.0)), Vibrate.Result.INVALID_ARGUMENT,
      'vibration.frequency: -1.0'),
-    (Vibrate, Vibrate.Goal(direction=3), Vibrate.Result.INVALID_ARGUMENT, 'direction: 3 must be'),
+    (Vibrate, Vibrate.Goal(vibration=Vibration(direction=3)), Vibrate.Result.INVALID_ARGUMENT,
+     'vibration.direction: 3 must be'),
     (RemoveParts, RemoveParts.Goal(part_ids=[123456]), RemoveParts.Result.UNKNOWN_PART,
      'part_ids: 123456 is not a part'),
     (RemoveParts, RemoveParts.Goal(), RemoveParts.Result.INVALID_ARGUMENT, 'part_ids: [] is'),

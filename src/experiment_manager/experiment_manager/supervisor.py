@@ -87,17 +87,17 @@ class Graph:
         return new
 
 
-def _reportdead(node: Node, done, graph: Graph, timeout: float, bar) -> bool:
+def report_dead(node: Node, done, graph: Graph, timeout: float, bar) -> bool:
     """Spin until done() or timeout, reporting each watched process that dies. A worker
     node is started again (the manager runs the iteration it lost again and takes the worker
     back). False when the manager died."""
-    while (dead := spin_until(node, done, graph.watched, timeout)):
+    while (gone := spin_until(node, done, graph.watched, timeout)):
         bar.close()
-        print(f'run: {dead.describe_exit()}:\n{dead.output(20)}', file=sys.stderr)
-        if dead is graph.manager:
+        print(f'run: {gone.describe_exit()}:\n{gone.output(20)}', file=sys.stderr)
+        if gone is graph.manager:
             return False
-        if graph.replace(dead):
-            print(f'run: {dead.name} started again ({graph.respawns[dead.name]} of '
+        if graph.replace(gone):
+            print(f'run: {gone.name} started again ({graph.respawns[gone.name]} of '
                   f'{graph.limit}); its iteration runs again, on it or another worker',
                   file=sys.stderr)
         else:

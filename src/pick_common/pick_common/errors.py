@@ -126,10 +126,11 @@ class Limit:
 
     def check(self, field: str, value, *, low: float | None = None):
         """value as an int or a float if it lies within the limit; `low` raises the lower
-        bound for a rule that depends on another field. Raises InvalidArgument naming field,
-        value and limit otherwise."""
+        bound (included) for a rule that depends on another field. Raises InvalidArgument
+        naming field, value and limit otherwise."""
+        bound, low_open = self.low, self.low_open
+        if low is not None and low > self.low:
+            bound, low_open = low, False
         if self.integer:
-            return check_int(field, value, low=int(self.low if low is None else low),
-                             high=int(self.high))
-        return check_number(field, value, low=self.low if low is None else max(low, self.low),
-                            high=self.high, low_open=self.low_open)
+            return check_int(field, value, low=int(bound), high=int(self.high))
+        return check_number(field, value, low=bound, high=self.high, low_open=low_open)

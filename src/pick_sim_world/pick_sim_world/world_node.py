@@ -304,15 +304,7 @@ class WorldNode(Node):
         instances = list(goal.instances) or None
 
         def vibrate(progress) -> SettleReport:
-            a = goal.amplitude
-            amplitude = (a.x, a.y, a.z) if (a.x, a.y, a.z) != (0.0, 0.0, 0.0) \
-                else self._vibration.amplitude
-            vibration = Vibration(
-                amplitude=amplitude,
-                frequency=common.or_default('frequency', goal.frequency,
-                                          self._vibration.frequency),
-                duration=common.or_default('duration', goal.duration, self._vibration.duration),
-                direction=conv.direction_from_msg(goal.direction, self._vibration.direction))
+            vibration = common.vibration_from_msg(goal.vibration, self._vibration)
             return self._world.vibrate(
                 vibration, instances,
                 common.or_default('max_settle_time', goal.max_settle_time, None), progress)
