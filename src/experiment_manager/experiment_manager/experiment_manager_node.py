@@ -2,11 +2,11 @@
 
 Action `run_experiment` (feedback: ExperimentProgress); topic `progress`. It drives one or more
 workers, each a `world`, `validity` and `feeder_controller` under its own namespace
-(graph_backend.py), with the experiment logic of experiments.py: iterations are spread over the
-workers, and one whose worker dies or stops answering runs again on another. It writes results
-as iterations finish (results.py), and records every topic of the workers, its own progress, the
-experiment file and the results into one MCAP file per run (recording.py). One run at a time: a
-second goal is answered BUSY, not queued.
+(graph_backend.py). A goal becomes a run session (session.py): iterations are spread over the
+workers (scheduler.py), and one whose worker dies or stops answering runs again on another;
+results are written as iterations finish (results.py); every topic of the workers, its own
+progress, the experiment file and the results go into one MCAP file per run (recording.py).
+One run at a time: a second goal is answered BUSY, not queued.
 """
 
 import json
@@ -46,7 +46,7 @@ LIMITS = {
 
 
 class ExperimentManagerNode(Node):
-    """Translates run_experiment goals into runs of experiments.Runner on the graph."""
+    """Translates run_experiment goals into run sessions (session.py) on the graph."""
 
     def __init__(self) -> None:
         super().__init__('experiment_manager')

@@ -79,7 +79,7 @@ class LockedActionClient(ActionClient):
 
 
 class GraphBackend:
-    """Implements experiments.Backend with service and action calls to one worker."""
+    """Implements backend.Backend with service and action calls to one worker."""
 
     def __init__(self, node: Node, worker: str, callback_group, call_timeout: float,
                  server_timeout: float, canceled: Callable[[], bool],

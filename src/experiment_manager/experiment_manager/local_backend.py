@@ -17,7 +17,7 @@ from .config import ExperimentFile
 
 
 class LocalBackend:
-    """Implements experiments.Backend with the cores. Call close() (or use `with`)."""
+    """Implements backend.Backend with the cores. Call close() (or use `with`)."""
 
     def __init__(self, physics: PhysicsConfig | None = None) -> None:
         self._physics = physics
