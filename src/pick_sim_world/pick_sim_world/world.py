@@ -213,7 +213,10 @@ class World:
             if total > MAX_PARTS_PER_INSTANCE:
                 raise InvalidArgument('count', count, f'would put {total} parts in instance {k}'
                                       f' (limit {MAX_PARTS_PER_INSTANCE})')
-            check_fits('count', total, self._part.volume, self._scene.container)
+            # The rule is on the instance's total: name what the number is when parts are there.
+            held = total - count
+            check_fits('count' if not held else f'count + the {held} parts in instance {k}',
+                       total, self._part.volume, self._scene.container)
         spawns = {k: self.spawn_poses(k, count, zone) for k in targets}
         new_ids = []
         for k, poses in spawns.items():

@@ -305,6 +305,11 @@ def test_a_bin_too_small_for_the_parts_is_refused_before_any_physics():
                            match=r'count: 500 parts do not fit.*at most \d+ within'):
             world.drop(500)
         assert len(world.snapshot().ids) == 0
+        world.drop(30)      # the rule is on the total: the error says which number it is
+        with pytest.raises(InvalidArgument, match=r'count \+ the 30 parts in instance 0: 50 '
+                                                  r'parts do not fit.*at most \d+ within'):
+            world.drop(20)
+        assert len(world.snapshot().ids) == 30
 
 
 @pytest.mark.parametrize(('vibration', 'rule'), [
