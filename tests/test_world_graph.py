@@ -207,7 +207,9 @@ def test_a_second_goal_while_one_runs_is_busy_and_cancel_stops_the_first(cell, c
     client.result(first.cancel_goal_async())
     result = client.result(first.get_result_async(), 60.0).result
     assert result.error_code == DropParts.Result.CANCELED
-    assert len(result.parts.parts) == 300
+    # The parts stream in by layers: those spawned before the cancel stay, where they stopped.
+    assert 0 < len(result.part_ids) <= 300
+    assert sorted(p.id for p in result.parts.parts) == sorted(result.part_ids)
 
 
 @pytest.mark.parametrize(('args', 'text'), [

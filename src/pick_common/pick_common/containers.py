@@ -113,3 +113,20 @@ def inside(spec: ContainerSpec, points: np.ndarray, tolerance: float = 0.001) ->
     p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     return ((np.abs(p[:, 0]) <= x / 2 + tolerance) & (np.abs(p[:, 1]) <= y / 2 + tolerance)
             & (p[:, 2] >= -tolerance) & (p[:, 2] <= 2 * z + tolerance))
+
+
+def tunnelled(spec: ContainerSpec, points: np.ndarray) -> np.ndarray:
+    """Which points (N, 3) in the instance frame lie in or under the floor or inside a wall,
+    (N,) bool: where the centre of a solid part can only be if it passed through the container
+    (a physics fault), not over a wall.
+
+    Under the floor: within the outer footprint and below the floor's top face. In a wall:
+    between a wall's inner and outer faces and below its top.
+    """
+    x, y, z = spec.inner_size
+    t = spec.wall_thickness
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    ax, ay = np.abs(p[:, 0]), np.abs(p[:, 1])
+    footprint = (ax <= x / 2 + t) & (ay <= y / 2 + t)
+    in_walls = footprint & ((ax > x / 2) | (ay > y / 2)) & (p[:, 2] <= z)
+    return (footprint & (p[:, 2] < 0.0)) | in_walls

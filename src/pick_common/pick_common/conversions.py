@@ -13,6 +13,7 @@ from geometry_msgs.msg import Point, Pose, Quaternion, Vector3
 import numpy as np
 from pick_msgs.msg import ContainerGeometry, Part, PartArray, PartModel, PhysicsProgress
 from pick_msgs.msg import SettleReport as SettleReportMsg
+from pick_msgs.msg import TrayMotion as TrayMotionMsg
 from pick_msgs.msg import Vibration as VibrationMsg
 from pick_msgs.srv import GetParts
 from std_msgs.msg import Header
@@ -30,7 +31,7 @@ from .errors import (
 )
 from .parts import PartSpec
 from .specs import FIXED, RANDOM, Vibration
-from .states import PartStates, Progress, SettleReport
+from .states import PartStates, Progress, SettleReport, TrayMotion
 
 # Error codes are the same in every pick_msgs service and action.
 ERROR_NONE = GetParts.Response.NONE
@@ -184,23 +185,46 @@ def states_from_msg(msg: PartArray) -> PartStates:
     return PartStates(ids, instances, poses, inside, msg.sim_time)
 
 
+def tray_from_msg(msg: TrayMotionMsg) -> TrayMotion | None:
+    """None for the all-zero message of an operation that did not vibrate."""
+    if not msg.amplitude:
+        return None
+    return TrayMotion(msg.amplitude, msg.delivered_amplitude, msg.peak_velocity,
+                      msg.delivered_peak_velocity)
+
+
+def tray_to_msg(motion: TrayMotion | None) -> TrayMotionMsg:
+    if motion is None:
+        return TrayMotionMsg()
+    return TrayMotionMsg(amplitude=motion.amplitude,
+                         delivered_amplitude=motion.delivered_amplitude,
+                         peak_velocity=motion.peak_velocity,
+                         delivered_peak_velocity=motion.delivered_peak_velocity)
+
+
 def settle_from_msg(msg: SettleReportMsg) -> SettleReport:
     return SettleReport(settled=msg.settled, sim_time=msg.sim_time, wall_time=msg.wall_time,
                         steps=msg.steps, unsettled_ids=list(msg.unsettled_ids),
-                        escaped_ids=list(msg.escaped_ids))
+                        escaped_ids=list(msg.escaped_ids),
+                        tunnelled_ids=list(msg.tunnelled_ids),
+                        max_penetration=msg.max_penetration, tray=tray_from_msg(msg.tray))
 
 
 def settle_to_msg(report: SettleReport) -> SettleReportMsg:
     return SettleReportMsg(settled=report.settled, sim_time=report.sim_time,
                            wall_time=report.wall_time, steps=report.steps,
                            unsettled_ids=list(report.unsettled_ids),
-                           escaped_ids=list(report.escaped_ids))
+                           escaped_ids=list(report.escaped_ids),
+                           tunnelled_ids=list(report.tunnelled_ids),
+                           max_penetration=report.max_penetration,
+                           tray=tray_to_msg(report.tray))
 
 
 def progress_to_msg(progress: Progress) -> PhysicsProgress:
     return PhysicsProgress(phase=PHASES[progress.phase], sim_time=progress.sim_time,
                            parts_moving=progress.parts_moving,
-                           max_displacement=progress.max_displacement)
+                           max_displacement=progress.max_displacement,
+                           tray=tray_to_msg(progress.tray))
 
 
 # ----------------------------------------------------------------------------- vibrations

@@ -11,22 +11,50 @@ import numpy as np
 
 
 @dataclass(frozen=True)
+class TrayMotion:
+    """The motion a vibration commanded and the one the tray delivered: peak displacement
+    (m) and peak velocity (m/s) of the sinusoid at the vibration's frequency, the delivered
+    ones fitted to the tray's states after each physics step. With several trays, the one
+    that tracked its command worst."""
+
+    amplitude: float
+    delivered_amplitude: float
+    peak_velocity: float
+    delivered_peak_velocity: float
+
+    @property
+    def error(self) -> float:
+        """The larger relative error of the delivered amplitude and peak velocity (0.05: 5 %)."""
+        return max(abs(self.delivered_amplitude / self.amplitude - 1.0),
+                   abs(self.delivered_peak_velocity / self.peak_velocity - 1.0))
+
+
+@dataclass(frozen=True)
 class Progress:
-    """Sent once per settle check. phase: 'dropping', 'vibrating' or 'settling'.
+    """Sent once per settle check. phase: 'dropping', 'feeding', 'vibrating' or 'settling'.
 
     sim_time: s since the operation started. parts_moving: parts not at rest over the settle
-    window. max_displacement: largest position change of a part over the window, m.
+    window. max_displacement: largest position change of a part over the window, m. tray: while
+    vibrating, the motion the tray delivered so far (None otherwise).
     """
 
     phase: str
     sim_time: float
     parts_moving: int
     max_displacement: float
+    tray: TrayMotion | None = None
 
 
 @dataclass
 class SettleReport:
-    """How an operation ended. Times in s; ids of parts still moving and outside containers."""
+    """How an operation ended and the health of its physics. Times in s.
+
+    unsettled_ids: parts still moving at the end. escaped_ids: parts whose centre is outside
+    their container's inner volume; of them, tunnelled_ids are in or under the floor or inside
+    a wall (a physics fault: solid bodies passed through each other), and the rest spilled over
+    a wall. max_penetration: the deepest overlap of two bodies at the end, m. tray: for a
+    vibration, the motion the trays delivered (TrayMotion), else None.
+    """
 
     settled: bool
     sim_time: float
@@ -35,6 +63,15 @@ class SettleReport:
     unsettled_ids: list[int] = field(default_factory=list)
     escaped_ids: list[int] = field(default_factory=list)
     canceled: bool = False
+    tunnelled_ids: list[int] = field(default_factory=list)
+    max_penetration: float = 0.0
+    tray: TrayMotion | None = None
+
+    @property
+    def spilled_ids(self) -> list[int]:
+        """Parts outside their container that did not tunnel: they went over a wall."""
+        tunnelled = set(self.tunnelled_ids)
+        return [i for i in self.escaped_ids if i not in tunnelled]
 
 
 @dataclass(frozen=True, eq=False)

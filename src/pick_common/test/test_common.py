@@ -1,10 +1,13 @@
 """The shared checks and conversions: a limit is enforced as stated, the packing rule names the
-most that fit, a vibration round-trips through its message and its defaults."""
+most that fit, a vibration round-trips through its message and its defaults, tunnelled points
+are told from spilled ones."""
 
-from pick_common import conversions
+import numpy as np
+from pick_common import containers, conversions
 from pick_common.containers import check_fits, ContainerSpec
 from pick_common.errors import InvalidArgument, Limit
 from pick_common.specs import FIXED, RANDOM, Vibration
+from pick_common.states import SettleReport, TrayMotion
 from pick_msgs.msg import Vibration as VibrationMsg
 import pytest
 
@@ -37,3 +40,27 @@ def test_a_vibration_round_trips_and_zeros_take_the_defaults():
         conversions.vibration_from_msg(VibrationMsg(direction=7), Vibration())
     assert conversions.vibration_from_msg(
         VibrationMsg(direction=VibrationMsg.DIRECTION_RANDOM), v).direction == RANDOM
+
+
+def test_tunnelled_points_are_in_or_under_the_floor_or_in_a_wall():
+    spec = ContainerSpec(inner_size=(0.1, 0.08, 0.02), wall_thickness=0.003)
+    points = [(0.0, 0.0, 0.005),      # on the floor: inside
+              (0.0, 0.0, -0.001),     # under the floor's top face
+              (0.03, 0.02, -0.5),     # fallen through, within the footprint
+              (0.0515, 0.0, 0.01),    # in the +x wall
+              (0.0, -0.0415, 0.019),  # in the -y wall, below its top
+              (0.0515, 0.0, 0.03),    # above the +x wall: spilling over it, not in it
+              (0.2, 0.0, -0.5)]       # beside the container, fallen: spilled
+    assert containers.tunnelled(spec, np.array(points)).tolist() == [
+        False, True, True, True, True, False, False]
+
+
+def test_a_settle_report_tells_spilled_from_tunnelled_and_round_trips():
+    report = SettleReport(True, 1.0, 0.5, 240, escaped_ids=[3, 5, 8], tunnelled_ids=[5],
+                          max_penetration=2e-4, tray=TrayMotion(0.003, 0.00297, 0.5, 0.49))
+    assert report.spilled_ids == [3, 8]
+    assert report.tray.error == pytest.approx(0.02)
+    again = conversions.settle_from_msg(conversions.settle_to_msg(report))
+    assert again == report
+    assert conversions.settle_from_msg(conversions.settle_to_msg(
+        SettleReport(True, 0.0, 0.0, 0))).tray is None

@@ -1,5 +1,5 @@
 """Building a PyBullet scene: the engine's settings, the part's collision shape, containers
-(a static bin, or a tray held on its trajectory by a driven constraint) and part bodies.
+(a static bin, or a tray whose motion tray.py prescribes) and part bodies.
 
 Every function takes the PyBullet client it works on; the World owns the client.
 """
@@ -13,12 +13,10 @@ from pick_common.parts import PartGeometry
 import pybullet as pb
 import trimesh
 
-from .config import PhysicsConfig
+from .config import GRAVITY, PhysicsConfig
 
-GRAVITY = 9.81                  # m/s^2
 INSTANCE_GAP = 0.05             # m between the outer walls of neighbouring instances
-TRAY_MASS = 3.0                 # kg; the tray is a dynamic body held by a driven constraint
-TRAY_MAX_FORCE = 5000.0         # N the constraint may apply to hold the tray on its trajectory
+TRAY_MASS = 3.0                 # kg; the tray is a dynamic body whose motion is prescribed
 CONTAINER_FRICTION = 0.5        # Coulomb coefficient of the bin and tray walls and floors
 
 
@@ -71,30 +69,20 @@ def create_part_shape(client: int, part: PartGeometry, directory: str) -> int:
         collisionFrameOrientations=orientations, physicsClientId=client)
 
 
-def create_container(client: int, spec: ContainerSpec,
-                     origin: np.ndarray) -> tuple[int, int | None]:
-    """The container's body at `origin` (world frame, m) and, for a tray, the constraint that
-    holds it on its trajectory (None for a bin)."""
+def create_container(client: int, spec: ContainerSpec, origin: np.ndarray) -> int:
+    """The container's body at `origin` (world frame, m): a static bin, or a tray of TRAY_MASS
+    whose state tray.TrayDrive prescribes before every step (so parts feel its velocity)."""
     boxes = containers.wall_boxes(spec)
     shape = pb.createCollisionShapeArray(
         [pb.GEOM_BOX] * len(boxes), halfExtents=[list(h) for h, _ in boxes],
         collisionFramePositions=[list(p) for _, p in boxes], physicsClientId=client)
-    if spec.kind == containers.BIN:
-        body = pb.createMultiBody(0.0, shape, basePosition=origin.tolist(),
-                                  useMaximalCoordinates=True, physicsClientId=client)
-        pb.changeDynamics(body, -1, lateralFriction=CONTAINER_FRICTION, physicsClientId=client)
-        return body, None
-    # The tray is dynamic and held on its trajectory by a fixed constraint whose pivot we
-    # drive: parts then feel its real velocity (a static body moved by resets does not push
-    # them). pybullet's constraints need a multibody base here.
-    body = pb.createMultiBody(TRAY_MASS, shape, basePosition=origin.tolist(),
-                              physicsClientId=client)
+    mass = 0.0 if spec.kind == containers.BIN else TRAY_MASS
+    body = pb.createMultiBody(mass, shape, basePosition=origin.tolist(),
+                              useMaximalCoordinates=True, physicsClientId=client)
     pb.changeDynamics(body, -1, lateralFriction=CONTAINER_FRICTION, linearDamping=0.0,
-                      angularDamping=0.0, physicsClientId=client)
-    constraint = pb.createConstraint(body, -1, -1, -1, pb.JOINT_FIXED, [0, 0, 0],
-                                     [0, 0, 0], origin.tolist(), physicsClientId=client)
-    pb.changeConstraint(constraint, maxForce=TRAY_MAX_FORCE, physicsClientId=client)
-    return body, constraint
+                      angularDamping=0.0, activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING,
+                      physicsClientId=client)
+    return body
 
 
 def create_part(client: int, shape: int, part: PartGeometry, pose: np.ndarray) -> int:
@@ -120,3 +108,9 @@ def base_poses(client: int, bodies: list[int]) -> np.ndarray:
         poses[row, :3] = position
         poses[row, 3:] = orientation
     return poses
+
+
+def max_penetration(client: int) -> float:
+    """The deepest overlap of any two bodies in contact now, m (0 when none overlap)."""
+    contacts = pb.getContactPoints(physicsClientId=client)
+    return max(0.0, -min((c[8] for c in contacts), default=0.0))

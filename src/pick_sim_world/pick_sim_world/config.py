@@ -9,6 +9,8 @@ from dataclasses import dataclass
 
 from pick_common.errors import Limit
 
+GRAVITY = 9.81                  # m/s^2, standard gravity
+
 # The range of every physics and settle setting, by parameter name.
 LIMITS = {
     'physics.time_step': Limit(1e-5, 0.01),

@@ -5,12 +5,16 @@ Pure: numpy only. Poses are (N, 7) float64, xyz in metres then an xyzw unit quat
 instance frame (origin at the centre of the container's inner floor, +Z up).
 """
 
+import math
+
 import numpy as np
 from pick_common import containers
 from pick_common.containers import ContainerSpec
 from pick_common.errors import InvalidArgument
 from pick_common.parts import PartGeometry
 from pick_common.states import rotate
+
+from .config import GRAVITY
 
 SPAWN_GAP = 0.0005              # m of clearance between spawn spheres
 ZONES = ('container', 'feeder')
@@ -37,6 +41,28 @@ def drop_region(spec: ContainerSpec, zone: str,
     raise InvalidArgument('zone', zone, f'must be {" or ".join(ZONES)}')
 
 
+def grid(part: PartGeometry, region: tuple[float, float, float, float],
+         zone: str = 'container') -> tuple[int, int]:
+    """Cells along x and y of one spawn layer over `region`: cells as wide as the part's
+    bounding sphere. Raises InvalidArgument when the region is narrower than one cell."""
+    _, _, hx, hy = region
+    r = part.radius + SPAWN_GAP
+    span_x, span_y = 2.0 * (hx - r), 2.0 * (hy - r)
+    if span_x < 0 or span_y < 0:
+        raise InvalidArgument(
+            'container.inner_size' if zone == 'container' else 'container.feeder_zone_size',
+            (2 * hx, 2 * hy), f'is smaller than the part ({2 * r:.4g} m across in any '
+            'orientation): parts cannot be dropped into it')
+    return int(span_x // (2.0 * r)) + 1, int(span_y // (2.0 * r)) + 1
+
+
+def layer_interval(part: PartGeometry) -> float:
+    """Simulated time between two spawn layers of a drop, s: the free fall of one layer's
+    height (a bounding-sphere diameter) plus a fifth of it again, so that each layer has landed
+    on the pile before the next one appears just above it."""
+    return 1.2 * math.sqrt(2.0 * 2.0 * (part.radius + SPAWN_GAP) / GRAVITY)
+
+
 def spawn_poses(rng: np.random.Generator, part: PartGeometry,
                 region: tuple[float, float, float, float], top: float, count: int,
                 zone: str = 'container') -> np.ndarray:
@@ -52,12 +78,7 @@ def spawn_poses(rng: np.random.Generator, part: PartGeometry,
     r = part.radius + SPAWN_GAP
     cell = 2.0 * r
     span_x, span_y = 2.0 * (hx - r), 2.0 * (hy - r)
-    if span_x < 0 or span_y < 0:
-        raise InvalidArgument(
-            'container.inner_size' if zone == 'container' else 'container.feeder_zone_size',
-            (2 * hx, 2 * hy), f'is smaller than the part ({2 * r:.4g} m across in any '
-            'orientation): parts cannot be dropped into it')
-    nx, ny = int(span_x // cell) + 1, int(span_y // cell) + 1
+    nx, ny = grid(part, region, zone)
     per_layer = nx * ny
     centers = np.empty((count, 3))
     for start in range(0, count, per_layer):

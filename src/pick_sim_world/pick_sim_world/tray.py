@@ -1,14 +1,25 @@
-"""The vibrating table's motion: the displacement of one vibration and the drive that moves
-each tray's constraint along it, step by step."""
+"""The vibrating table's motion: the displacement of one vibration, and the drive that holds
+each tray on its commanded trajectory and measures the motion it delivered.
+
+Each tray is a dynamic body whose state is prescribed before every physics step: its pose is
+set to the command at the step's start and its velocity to the command's mean velocity over
+the step, and a force cancels gravity. Bullet then integrates it exactly onto the next command
+point, and parts in contact feel the tray's real velocity, so the tray delivers the commanded
+motion at any time step (a tray on a driven constraint lags its anchor: 1.18 mm of a 3 mm
+command at 1/240 s). Between vibrations the same drive holds each tray at its origin.
+"""
 
 from collections.abc import Sequence
 import math
 
 import numpy as np
 from pick_common.specs import RANDOM, Vibration
+from pick_common.states import TrayMotion
 import pybullet as pb
 
-from .bodies import TRAY_MAX_FORCE
+from .config import GRAVITY
+
+MIN_STEPS_PER_CYCLE = 8     # physics steps per vibration period; fewer and the world sub-steps
 
 
 def vibration_amplitude(vibration: Vibration, rng: np.random.Generator) -> np.ndarray:
@@ -22,30 +33,106 @@ def vibration_amplitude(vibration: Vibration, rng: np.random.Generator) -> np.nd
     return np.array([x, y, z])
 
 
+def vibration_substeps(frequency: float, time_step: float) -> int:
+    """How many sub-steps each physics step is cut into while vibrating at `frequency` (Hz), so
+    that one period has at least MIN_STEPS_PER_CYCLE steps (1 when it already has)."""
+    return max(1, math.ceil(MIN_STEPS_PER_CYCLE * frequency * time_step - 1e-9))
+
+
+def fundamental(times: np.ndarray, samples: np.ndarray, omega: float) -> np.ndarray:
+    """Amplitude (3,) of the sinusoid at `omega` (rad/s) fitted by least squares to `samples`
+    (n, 3) taken at `times` (n,), per axis (a constant offset is fitted too)."""
+    basis = np.column_stack([np.sin(omega * times), np.cos(omega * times), np.ones_like(times)])
+    coef, *_ = np.linalg.lstsq(basis, samples, rcond=None)
+    return np.hypot(coef[0], coef[1])
+
+
 class TrayDrive:
-    """Moves each tray's constraint pivot to origin + amplitude * sin(2 pi f t), one call per
-    physics step (the World's `before_step`); `home` puts every pivot back at its origin.
+    """Holds each tray (bodies, at origins in the world frame, m; mass in kg) on its trajectory:
+    call it before every physics step. `start` begins a vibration of some trays, `stop` ends it
+    and returns the motion they delivered, measured from their states after each step."""
 
-    constraints, origins: the trays' constraints and origins (world frame, m); amplitudes:
-    (N, 3) peak displacements, m; frequency: Hz; time_step: s.
-    """
-
-    def __init__(self, client: int, constraints: Sequence[int], origins: Sequence[np.ndarray],
-                 amplitudes: np.ndarray, frequency: float, time_step: float) -> None:
+    def __init__(self, client: int, bodies: Sequence[int], origins: Sequence[np.ndarray],
+                 mass: float) -> None:
         self._client = client
-        self._trays = list(zip(constraints, origins, amplitudes, strict=True))
-        self._omega = 2.0 * math.pi * frequency
-        self._dt = time_step
+        self._bodies = list(bodies)
+        self._origins = [np.asarray(o, dtype=float) for o in origins]
+        self._lift = [0.0, 0.0, mass * GRAVITY]
+        self._amplitudes = np.zeros((len(self._bodies), 3))
+        self._moving: list[int] = []
+        self._omega = self._dt = 0.0
         self._step = 0
+        self._positions: list[np.ndarray] = []
+        self._velocities: list[np.ndarray] = []
+
+    def start(self, trays: Sequence[int], amplitudes: np.ndarray, frequency: float,
+              time_step: float) -> None:
+        """Move trays (indices) along amplitude[k] * sin(2 pi frequency t), t from 0 at the next
+        step of `time_step` s; the others stay at their origins."""
+        self._amplitudes[:] = 0.0
+        self._amplitudes[list(trays)] = amplitudes
+        self._moving = list(trays)
+        self._omega, self._dt = 2.0 * math.pi * frequency, time_step
+        self._step = 0
+        self._positions, self._velocities = [], []
+
+    def _command(self, step: int) -> np.ndarray:
+        return self._amplitudes * math.sin(self._omega * step * self._dt)
+
+    def _measure(self) -> None:
+        positions, velocities = [], []
+        for k in self._moving:
+            p, _ = pb.getBasePositionAndOrientation(self._bodies[k], physicsClientId=self._client)
+            v, _ = pb.getBaseVelocity(self._bodies[k], physicsClientId=self._client)
+            positions.append(np.subtract(p, self._origins[k]))
+            velocities.append(v)
+        self._positions.append(np.array(positions))
+        self._velocities.append(np.array(velocities))
 
     def __call__(self) -> None:
-        self._step += 1
-        phase = math.sin(self._omega * self._step * self._dt)
-        for constraint, origin, amplitude in self._trays:
-            pb.changeConstraint(constraint, jointChildPivot=(origin + amplitude * phase).tolist(),
-                                maxForce=TRAY_MAX_FORCE, physicsClientId=self._client)
+        if self._moving and self._step:
+            self._measure()
+        if self._moving:
+            here, there = self._command(self._step), self._command(self._step + 1)
+            velocity = (there - here) / self._dt
+            self._step += 1
+        else:
+            here = velocity = self._amplitudes      # zeros: held at the origins
+        for k, body in enumerate(self._bodies):
+            pb.resetBasePositionAndOrientation(body, (self._origins[k] + here[k]).tolist(),
+                                               (0.0, 0.0, 0.0, 1.0),
+                                               physicsClientId=self._client)
+            pb.resetBaseVelocity(body, velocity[k].tolist(), (0.0, 0.0, 0.0),
+                                 physicsClientId=self._client)
+            pb.applyExternalForce(body, -1, self._lift, (0.0, 0.0, 0.0), pb.LINK_FRAME,
+                                  physicsClientId=self._client)
 
-    def home(self) -> None:
-        for constraint, origin, _ in self._trays:
-            pb.changeConstraint(constraint, jointChildPivot=origin.tolist(),
-                                maxForce=TRAY_MAX_FORCE, physicsClientId=self._client)
+    def motion(self) -> TrayMotion | None:
+        """The motion delivered so far, of the tray that tracked its command worst; None before
+        three steps of a vibration."""
+        if len(self._positions) < 3:
+            return None
+        n = len(self._positions)
+        times = np.arange(1, n + 1) * self._dt                 # each state is after its step
+        mid = times - 0.5 * self._dt                           # a step's velocity: its middle
+        positions, velocities = np.array(self._positions), np.array(self._velocities)
+        worst = None
+        for i, k in enumerate(self._moving):
+            commanded = float(np.linalg.norm(self._amplitudes[k]))
+            shown = TrayMotion(
+                commanded, float(np.linalg.norm(fundamental(times, positions[:, i], self._omega))),
+                commanded * self._omega,
+                float(np.linalg.norm(fundamental(mid, velocities[:, i], self._omega))))
+            if worst is None or shown.error > worst.error:
+                worst = shown
+        return worst
+
+    def stop(self) -> TrayMotion | None:
+        """End the vibration: measure the last step, hold every tray at its origin again, and
+        return the delivered motion (motion())."""
+        if self._moving and self._step:
+            self._measure()
+        delivered = self.motion()
+        self._amplitudes[:] = 0.0
+        self._moving = []
+        return delivered

@@ -10,8 +10,8 @@ Poses are (N, 7) float64 arrays, xyz in metres then an xyzw unit quaternion, exp
 instance frame (origin at the centre of the container's inner floor, +Z up).
 """
 
-from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field, replace
 import os
 import shutil
 import tempfile
@@ -35,14 +35,14 @@ from pick_common.specs import (
     SceneSpec,
     Vibration,
 )
-from pick_common.states import PartStates, SettleReport
+from pick_common.states import PartStates, Progress, rotate, SettleReport
 import pybullet as pb
 
 from . import bodies, camera, spawning, stepping
 from .camera import Overlay
 from .config import check_physics, PhysicsConfig
 from .stepping import ProgressCallback
-from .tray import TrayDrive, vibration_amplitude
+from .tray import TrayDrive, vibration_amplitude, vibration_substeps
 
 
 @dataclass
@@ -53,7 +53,6 @@ class Instance:
     seed: int
     origin: np.ndarray
     body: int
-    constraint: int | None
     rng: np.random.Generator
     part_ids: list[int] = field(default_factory=list)
 
@@ -125,10 +124,13 @@ class World:
         pitch = bodies.instance_pitch(scene.container)
         for k in range(scene.instance_count):
             origin = np.array([k * pitch, 0.0, 0.0])
-            body, constraint = bodies.create_container(c, scene.container, origin)
+            body = bodies.create_container(c, scene.container, origin)
             seed = bodies.instance_seed(scene.seed, k)
-            self._instances.append(Instance(k, seed, origin, body, constraint,
-                                            np.random.default_rng(seed)))
+            self._instances.append(Instance(k, seed, origin, body, np.random.default_rng(seed)))
+        self._drive = None
+        if scene.container.kind == containers.TRAY:
+            self._drive = TrayDrive(c, [i.body for i in self._instances],
+                                    [i.origin for i in self._instances], bodies.TRAY_MASS)
 
     def close(self) -> None:
         """Disconnect from PyBullet and remove temporary files. Idempotent."""
@@ -188,23 +190,32 @@ class World:
 
     def spawn_poses(self, instance: int, count: int, zone: str = 'container') -> np.ndarray:
         """Random, non-overlapping spawn poses (count, 7) in the instance frame, above the parts
-        already in the instance (spawning.spawn_poses)."""
+        already over the region (spawning.spawn_poses)."""
         region = self.drop_region(instance, zone)
         state = self.snapshot([instance])
         top = 0.0
         if len(state.ids):
-            top = float(state.poses[:, 2].max()) + self._part.radius + np.linalg.norm(
-                self._part.center)
+            cx, cy, hx, hy = region
+            reach = 2.0 * self._part.radius
+            centres = state.poses[:, :3] + rotate(state.poses[:, 3:], self._part.center)
+            over = ((np.abs(centres[:, 0] - cx) <= hx + reach)
+                    & (np.abs(centres[:, 1] - cy) <= hy + reach))
+            if over.any():
+                top = max(0.0, float(centres[over, 2].max()) + self._part.radius)
         return spawning.spawn_poses(self._instances[instance].rng, self._part, region, top,
                                     count, zone)
 
     def drop(self, count: int, instances: Iterable[int] | None = None, zone: str = 'container',
              max_settle_time: float | None = None,
              progress: ProgressCallback | None = None) -> tuple[list[int], SettleReport]:
-        """Drop `count` parts into each instance (or its feeder zone), then settle.
+        """Drop `count` parts into each instance (or its feeder zone) as a stream, then settle.
 
-        Returns the new part ids and the settle report. Raises InvalidArgument when the count
-        is out of range or the parts do not fit, UnknownInstance for a bad instance id.
+        The parts come one spawn layer at a time, each layer just above the parts already over
+        the region, the next one when it has landed (spawning.layer_interval): nothing falls
+        from higher than about a layer above the pile, as from a hopper's lip, never from a
+        tall column (which at 1/240 s sent parts through a 10 mm floor). Returns the new part
+        ids and the report of the whole operation. Raises InvalidArgument when the count is
+        out of range or the parts do not fit, UnknownInstance for a bad instance id.
         """
         targets = self._instance_ids(instances)
         count = check_int('count', count, low=1, high=MAX_PARTS_PER_INSTANCE)
@@ -217,11 +228,24 @@ class World:
             held = total - count
             check_fits('count' if not held else f'count + the {held} parts in instance {k}',
                        total, self._part.volume, self._scene.container)
-        spawns = {k: self.spawn_poses(k, count, zone) for k in targets}
-        new_ids = []
-        for k, poses in spawns.items():
-            new_ids += self._add_parts(self._instances[k], poses)
-        return new_ids, self._settle('dropping', max_settle_time, progress)
+        per_layer = {k: int(np.prod(spawning.grid(self._part, self.drop_region(k, zone), zone)))
+                     for k in targets}
+        left = dict.fromkeys(targets, count)
+        new_ids: list[int] = []
+        stream: list[SettleReport] = []
+        while True:
+            for k in targets:
+                n = min(per_layer[k], left[k])
+                if n:
+                    new_ids += self._add_parts(self._instances[k], self.spawn_poses(k, n, zone))
+                    left[k] -= n
+            if not any(left.values()):
+                break
+            stream.append(self._run('dropping', spawning.layer_interval(self._part), progress,
+                                    stop_when_settled=False))
+            if stream[-1].canceled:
+                return new_ids, _joined(stream[-1], stream[:-1])
+        return new_ids, _joined(self._settle('dropping', max_settle_time, progress), stream)
 
     def _add_parts(self, inst: Instance, poses: np.ndarray) -> list[int]:
         ids = []
@@ -250,27 +274,32 @@ class World:
         """
         targets = self._instance_ids(instances)
         check_vibration(vibration)
-        for k in targets:
-            if self._instances[k].constraint is None:
-                raise InvalidArgument('instances', k, f'is a {self._scene.container.kind}: '
-                                      'only trays vibrate')
-        trays = [self._instances[k] for k in targets]
-        amplitudes = np.array([vibration_amplitude(vibration, inst.rng) for inst in trays])
-        dt = self._physics.time_step
+        if self._drive is None:
+            raise InvalidArgument('instances', targets[0], f'is a {self._scene.container.kind}'
+                                  ': only trays vibrate')
+        amplitudes = np.array([vibration_amplitude(vibration, self._instances[k].rng)
+                               for k in targets])
+        # A period gets at least MIN_STEPS_PER_CYCLE steps: finer steps while vibrating when
+        # the physics step is too coarse for the frequency.
+        dt = self._physics.time_step / vibration_substeps(vibration.frequency,
+                                                          self._physics.time_step)
         steps = max(1, int(round(vibration.duration / dt)))
-        drive = TrayDrive(self._client, [inst.constraint for inst in trays],
-                          [inst.origin for inst in trays], amplitudes, vibration.frequency, dt)
+        self._drive.start(targets, amplitudes, vibration.frequency, dt)
+        drive = self._drive
+
+        def tell(p: Progress) -> bool:
+            return progress(replace(p, tray=drive.motion()))
+
         try:
-            report = self._run('vibrating', steps * dt, progress, before_step=drive,
-                               stop_when_settled=False)
+            report = self._run('vibrating', steps * dt, tell if progress else None,
+                               stop_when_settled=False, time_step=dt)
         finally:
-            drive.home()
+            delivered = self._drive.stop()
+        report.tray = delivered
         if report.canceled:
             return report
-        settle = self._settle('settling', max_settle_time, progress)
-        settle.sim_time += report.sim_time
-        settle.wall_time += report.wall_time
-        settle.steps += report.steps
+        settle = _joined(self._settle('settling', max_settle_time, progress), [report])
+        settle.tray = delivered
         return settle
 
     # ----------------------------------------------------------------------------- remove
@@ -299,7 +328,7 @@ class World:
         if settle and (touched or not self._at_rest):
             return ids, self._settle('settling', max_settle_time, progress)
         self._at_rest = self._at_rest and not touched
-        return ids, SettleReport(True, 0.0, 0.0, 0, escaped_ids=self._escaped())
+        return ids, self._health(SettleReport(True, 0.0, 0.0, 0))
 
     def _touch_other_parts(self, ids: list[int]) -> bool:
         """Whether a part of `ids` touches (is within the contact-breaking threshold of) a part
@@ -325,25 +354,49 @@ class World:
             'max_settle_time', max_settle_time, low=self._physics.settle_window, high=600.0)
         return self._run(phase, cap, progress)
 
-    def _escaped(self) -> list[int]:
+    def _health(self, report: SettleReport) -> SettleReport:
+        """Fill in where the parts ended: outside their containers, tunnelled (centre in or
+        under the floor or in a wall), and the deepest penetration."""
         state = self.snapshot()
-        return [int(i) for i in state.ids[~state.inside]]
+        report.escaped_ids = [int(i) for i in state.ids[~state.inside]]
+        if len(state.ids):
+            centres = state.poses[:, :3] + rotate(state.poses[:, 3:], self._part.center)
+            gone = containers.tunnelled(self._scene.container, centres)
+            report.tunnelled_ids = [int(i) for i in state.ids[gone]]
+        report.max_penetration = bodies.max_penetration(self._client)
+        return report
 
     def _run(self, phase: str, duration: float, progress: ProgressCallback | None,
-             before_step: Callable[[], None] | None = None,
-             stop_when_settled: bool = True) -> SettleReport:
-        """Step every part of the scene for up to `duration` s (stepping.step); a fault resets
-        the scene before it is raised."""
+             stop_when_settled: bool = True, time_step: float | None = None) -> SettleReport:
+        """Step every part of the scene for up to `duration` s (stepping.step) at `time_step`
+        (the physics step when None); a fault resets the scene before it is raised."""
         ids = [pid for inst in self._instances for pid in inst.part_ids]
+        physics = self._physics
+        if time_step is not None and time_step != physics.time_step:
+            physics = replace(physics, time_step=time_step)
+        c = self._client
+        pb.setPhysicsEngineParameter(fixedTimeStep=physics.time_step, physicsClientId=c)
         try:
-            out = stepping.step(self._client, ids, [self._bodies[i] for i in ids],
-                                self._physics, phase, duration, progress, before_step,
-                                stop_when_settled)
+            out = stepping.step(c, ids, [self._bodies[i] for i in ids], physics, phase,
+                                duration, progress, self._drive, stop_when_settled)
         except PhysicsFault:
             self._build(self._scene, self._part)
             raise
-        self._sim_time += out.steps * self._physics.time_step
+        finally:
+            pb.setPhysicsEngineParameter(fixedTimeStep=self._physics.time_step,
+                                         physicsClientId=c)
+        self._sim_time += out.steps * physics.time_step
         self._at_rest = out.settled
         settled = out.settled if stop_when_settled else not out.canceled
-        return SettleReport(settled, out.steps * self._physics.time_step, out.wall_time,
-                            out.steps, out.moving_ids, self._escaped(), out.canceled)
+        return self._health(SettleReport(settled, out.steps * physics.time_step, out.wall_time,
+                                         out.steps, out.moving_ids, canceled=out.canceled))
+
+
+def _joined(last: SettleReport, before: list[SettleReport]) -> SettleReport:
+    """The report of an operation run in parts: `last` (how it ended) with the times and steps
+    of the parts `before` it added in."""
+    for r in before:
+        last.sim_time += r.sim_time
+        last.wall_time += r.wall_time
+        last.steps += r.steps
+    return last
