@@ -32,8 +32,10 @@ from pick_common.node_runner import handshake
 from pick_msgs.action import RunExperiment
 import rclpy
 from rclpy.action import ActionClient
+from rclpy.exceptions import InvalidNamespaceException
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
+from rclpy.validate_namespace import validate_namespace
 
 from . import config, interrupt
 from .claim import claim, NamespaceInUse
@@ -122,6 +124,10 @@ def _parse(argv: list[str]) -> argparse.Namespace:
         parser.error(f'--respawns {args.respawns} must be within [0, 100]')
     if not 1 <= args.workers <= MAX_WORKERS:
         parser.error(f'--workers {args.workers} must be within [1, {MAX_WORKERS}]')
+    try:
+        validate_namespace(args.namespace)
+    except InvalidNamespaceException as exc:
+        parser.error(f'--namespace {args.namespace!r}: {exc}')
     return args
 
 
