@@ -1,11 +1,13 @@
 """The real `feeder_controller` commanding the real `world` (a tray) over DDS."""
 
+import math
 import time
 
+from geometry_msgs.msg import Vector3
 from graph import NodeProcess, stop_all, unique_namespace
 from pick_common.node_runner import LATCHED
 from pick_msgs.action import FeedCycle, RemoveParts
-from pick_msgs.msg import FeederState
+from pick_msgs.msg import FeederState, Vibration
 from pick_msgs.srv import GetParts
 import pytest
 from rclpy.action import ActionClient
@@ -53,10 +55,18 @@ class Feeder:
 
 def test_a_run_feeds_vibrates_picks_and_stops_at_the_limit(client, nodes):
     feeder = Feeder(client, nodes)
+    # One cycle of two moves: a flip of the given stroke, then the world's default vibration.
+    flip = Vibration(amplitude=Vector3(z=0.001), direction=Vibration.DIRECTION_FIXED)
     first = feeder.cycle(restart=True, feeder_parts=30, min_count=5, max_count=10,
-                         max_vibrations=3, valid_parts=0, parts_on_table=0)
+                         max_vibrations=3, valid_parts=0, parts_on_table=0,
+                         moves=[flip, Vibration()])
     assert first.error_code == OK, first.error_msg
     assert first.decision == FeedCycle.Result.DECISION_FEED_AND_VIBRATE and first.parts_fed == 10
+    drop, flipped, default = first.reports      # the world's reports of the cycle, in order
+    assert drop.tray.amplitude == 0 and flipped.tray.amplitude == pytest.approx(0.001)
+    assert default.tray.amplitude == pytest.approx(math.hypot(0.0014, 0.0014))
+    for r in (flipped, default):
+        assert abs(r.tray.delivered_amplitude / r.tray.amplitude - 1) < 0.05
     on_table = feeder.parts()
     assert len(on_table) == 10, 'the world has the fed parts'
     assert (first.state.parts_in_feeder, first.state.parts_on_table,
@@ -80,6 +90,9 @@ def test_impossible_counts_and_bad_ranges_are_refused(client, nodes):
     bad = feeder.cycle(restart=True, min_count=40, max_count=30)
     assert bad.error_code == FeedCycle.Result.INVALID_ARGUMENT
     assert 'min_count: 40 must be within [1, 30]' in bad.error_msg
+    many = feeder.cycle(restart=True, moves=[Vibration()] * 17)
+    assert many.error_code == FeedCycle.Result.INVALID_ARGUMENT
+    assert 'moves: 17 moves in one cycle must be at most 16' in many.error_msg
     good = feeder.cycle(restart=True, feeder_parts=5, min_count=2, max_count=3,
                         parts_on_table=0)
     assert good.error_code == OK and good.parts_fed == 3

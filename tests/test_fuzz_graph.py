@@ -229,7 +229,7 @@ def test_feed_cycle(cell):
     cell.fresh(1)
     template = FeedCycle.Goal(instance=0, restart=True, feeder_parts=10, min_count=2,
                               max_count=4, max_vibrations=5,
-                              vibration=Vibration(duration=0.2))
+                              moves=[Vibration(duration=0.2)])
 
     @FUZZ
     @given(requests(template))

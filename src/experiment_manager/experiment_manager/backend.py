@@ -21,13 +21,14 @@ from .config import ExperimentFile
 @dataclass(frozen=True)
 class FeedStep:
     """What one feed_cycle did: the decision (feeder_controller.policy constants), parts fed,
-    and the feeder's counts afterwards."""
+    the feeder's counts afterwards, and the world's reports of its feed and vibration."""
 
     decision: int
     fed: int
     vibrations: int
     feeds: int
     in_feeder: int
+    reports: tuple[SettleReport, ...] = ()
 
 
 class WorkerLost(Exception):

@@ -20,8 +20,10 @@ from pick_common.parts import build_part, BUILTIN_MODELS, PartSpec
 from pick_common.specs import (
     check_vibration,
     DIRECTIONS,
+    MAX_MOVES,
     MAX_PARTS_PER_INSTANCE,
     MAX_SEED,
+    MOVES,
     Vibration,
 )
 from pick_validity.config import (
@@ -51,11 +53,13 @@ ID_CHARS = set('abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-
 @dataclass(frozen=True)
 class Requirements:
     """The production requirement: parts of this type per hour, hours between refills of a bin
-    or the feeder, and the largest bin length in any dimension, m."""
+    or the feeder, the largest bin length in any dimension, m, and the parts a feeder run may
+    spill over the tray's walls (a cell catches none by default: a spilled part is lost)."""
 
     parts_per_hour: float = 60.0
     refill_interval: float = 4.0 * 3600.0      # s
     max_dimension: float = 0.3                 # m
+    max_spilled: int = 0                       # parts per feeder run
 
     @property
     def capacity(self) -> int:
@@ -101,7 +105,7 @@ class ExperimentFile:
     check: CheckConfig
     search_order: str
     tray: ContainerSpec
-    vibration: Vibration
+    moves: tuple[Vibration, ...]
     bin_wall: float
     requirements: Requirements
     experiments: tuple[Experiment, ...]
@@ -359,6 +363,32 @@ def _experiment(m: _Map, f: dict, earlier: dict[str, Experiment]) -> Experiment:
     return Experiment(**out)
 
 
+def _moves(m: _Map) -> tuple[Vibration, ...]:
+    """The feeder's moves per vibration cycle: a list of MOVES names, or mappings with an
+    optional `move` (the name it starts from, default spread) and any of amplitude_mm,
+    frequency_hz, duration_s, direction."""
+    key = 'moves'
+    items = m.get(key, ['spread'])
+    if not isinstance(items, list) or not items or len(items) > MAX_MOVES:
+        raise InvalidArgument(m.where(key), _short(items),
+                              f'must be a list of 1 to {MAX_MOVES} moves')
+    out = []
+    for i, item in enumerate(items):
+        where = f'{m.where(key)}[{i}]'
+        if isinstance(item, str):
+            item = {'move': item}
+        v = _Map(item, where)
+        base = MOVES[v.text('move', 'spread', tuple(MOVES))]
+        move = Vibration(
+            amplitude=v.vector('amplitude_mm', [a / MM for a in base.amplitude], 3, scale=MM),
+            frequency=v.number('frequency_hz', base.frequency),
+            duration=v.number('duration_s', base.duration),
+            direction=v.text('direction', base.direction, DIRECTIONS))
+        v.done()
+        out.append(_checked(check_vibration, move, where))
+    return tuple(out)
+
+
 def parse(text: str, path: str = '') -> ExperimentFile:
     """Read and check an experiment file's text. Raises InvalidArgument on the first error."""
     try:
@@ -395,20 +425,13 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         refill_interval=r.number('refill_interval_h', 4.0, low=0.0, high=1000.0,
                                  low_open=True, scale=3600.0),
         max_dimension=r.number('max_dimension_mm', 300.0, low=0.0, high=2000.0,
-                               low_open=True, scale=MM))
+                               low_open=True, scale=MM),
+        max_spilled=r.integer('max_spilled_parts', 0, low=0, high=100_000))
     r.done()
     tray = ContainerSpec.tray(m.vector('tray_mm', [s / MM for s in TRAY_DEFAULT_SIZE], 3,
                                        low=0.0, low_open=True, scale=MM))
     _checked(check_container, tray, 'tray_mm')
-    v = m.sub('vibration')
-    d = Vibration()
-    vibration = Vibration(
-        amplitude=v.vector('amplitude_mm', [a / MM for a in d.amplitude], 3, scale=MM),
-        frequency=v.number('frequency_hz', d.frequency),
-        duration=v.number('duration_s', d.duration),
-        direction=v.text('direction', d.direction, DIRECTIONS))
-    v.done()
-    _checked(check_vibration, vibration, 'vibration')
+    moves = _moves(m)
     bin_wall = m.number('bin_wall_mm', 3.0, low=0.5, high=100.0, scale=MM)
     # The core's own checks, under the file's names.
     _checked(check_gripper, gripper, 'gripper')
@@ -432,7 +455,7 @@ def parse(text: str, path: str = '') -> ExperimentFile:
     m.done()
     return ExperimentFile(
         id=file_id, seed=seed, output_dir=output_dir, part=part, gripper=gripper, grasps=grasps,
-        place=place, check=check, search_order=search_order, tray=tray, vibration=vibration,
+        place=place, check=check, search_order=search_order, tray=tray, moves=moves,
         bin_wall=bin_wall, requirements=requirements, experiments=tuple(experiments.values()),
         path=os.path.abspath(path) if path else '', text=text)
 

@@ -298,7 +298,7 @@ class GraphBackend:
 
     def feed(self, valid: int, on_table: int, restart: FeederConfig | None) -> FeedStep:
         goal = FeedCycle.Goal(valid_parts=valid, parts_on_table=on_table,
-                              vibration=common.vibration_to_msg(self._file.vibration))
+                              moves=[common.vibration_to_msg(m) for m in self._file.moves])
         if restart is not None:
             goal.restart = True
             goal.feeder_parts, goal.min_count = restart.feeder_parts, restart.min_count
@@ -306,4 +306,5 @@ class GraphBackend:
         result = self._action(self._feed, goal, 'feed_cycle')
         s = result.state
         return FeedStep(result.decision, result.parts_fed, s.vibrations, s.feeds,
-                        s.parts_in_feeder)
+                        s.parts_in_feeder,
+                        tuple(common.settle_from_msg(r) for r in result.reports))

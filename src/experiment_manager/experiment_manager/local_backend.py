@@ -56,14 +56,16 @@ class LocalBackend:
             self._policy = FeederPolicy(restart)
         policy = self._policy
         step = policy.decide(valid, on_table)
+        reports = []
         if step.feed:
-            self._world.drop(step.feed, zone='feeder')
+            reports.append(self._world.drop(step.feed, zone='feeder')[1])
             policy.fed(step.feed)
         if step.vibrates:
-            self._world.vibrate(self._file.vibration)
+            reports += [self._world.vibrate(move) for move in self._file.moves]
             policy.vibrated()
         s = policy.state
-        return FeedStep(step.decision, step.feed, s.vibrations, s.feeds, s.in_feeder)
+        return FeedStep(step.decision, step.feed, s.vibrations, s.feeds, s.in_feeder,
+                        tuple(reports))
 
     def rejoin(self, stop) -> bool:
         """Cores in this process do not come back once lost."""

@@ -12,9 +12,11 @@ import numpy as np
 
 from .config import BIN_EMPTYING, BIN_STATIC, Experiment, ExperimentFile, TABLE_SWEEP
 
-# The physics faults an iteration is flagged with (experiments.faults).
-PHYSICS_FAULT, UNSETTLED, ESCAPED = 'physics_fault', 'unsettled', 'escaped'
-FAULTS = (PHYSICS_FAULT, UNSETTLED, ESCAPED)
+# The physics faults an iteration is flagged with (procedures.faults); the first two leave it
+# out of the figures.
+PHYSICS_FAULT, TUNNELLED, UNSETTLED = 'physics_fault', 'tunnelled', 'unsettled'
+FAULTS = (PHYSICS_FAULT, TUNNELLED, UNSETTLED)
+EXCLUDED = (PHYSICS_FAULT, TUNNELLED)
 
 FIT_ORDER = 4
 
@@ -44,7 +46,7 @@ def bin_static(exp: Experiment, rows: list[dict]) -> dict:
         bins.append({'index': b, 'size_mm': [round(s * 1000, 6) for s in spec.inner_size],
                      'xy_area_mm2': round(spec.inner_size[0] * spec.inner_size[1] * 1e6, 3),
                      'iterations': len(mine), 'fractions': _fractions(mine),
-                     'escaped': stats([r['escaped'] for r in mine])})
+                     'spilled': stats([r['spilled'] for r in mine])})
     scored = [(b['fractions']['container_free']['mean'], -b['index']) for b in bins
               if b['fractions']['container_free']['mean'] is not None]
     best = -max(scored)[1] if scored else None
@@ -96,22 +98,37 @@ def table_sweep(exp: Experiment, rows: list[dict]) -> dict:
 
 def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
                     optimal_range) -> dict:
+    """`emptied`: runs that emptied the feeder and the table; `accepted`: of them, those that
+    spilled at most requirements.max_spilled_parts over the tray's walls."""
     emptied = [r for r in rows if r['emptied']]
+    tolerated = file.requirements.max_spilled
     vibrations = stats([r['vibrations'] for r in emptied])
     interval = file.requirements.refill_interval
     per_vibration = (interval / vibrations['mean'] / 60.0
                      if vibrations['mean'] else None)
     return {'iterations': len(rows), 'parts': exp.parts, 'optimal_range': list(optimal_range),
             'max_vibrations': exp.max_vibrations, 'emptied': len(emptied),
+            'accepted': sum(r['spilled'] <= tolerated for r in emptied),
+            'max_spilled': tolerated, 'runs_spilling': sum(r['spilled'] > 0 for r in rows),
             'vibrations_to_empty': vibrations, 'feeds': stats([r['feeds'] for r in rows]),
-            'lost': sum(r['lost'] for r in rows),
             'stops': {s: sum(r['stop'] == s for r in rows) for s in sorted({r['stop']
                                                                             for r in rows})},
             'minutes_per_vibration_allowed': per_vibration}
 
 
+def physics(rows: list[dict]) -> dict:
+    """The physics health of every iteration (left-out ones too): parts spilled and tunnelled
+    (totals), the most parts left moving at a settle's end, the deepest penetration (m) and
+    the worst tray tracking error (fraction of the command)."""
+    return {'spilled': sum(r['spilled'] for r in rows),
+            'tunnelled': sum(r['tunnelled'] for r in rows),
+            'unsettled': max((r['unsettled'] for r in rows), default=0),
+            'max_penetration': max((r['max_penetration'] for r in rows), default=0.0),
+            'tray_error': max((r['tray_error'] for r in rows), default=0.0)}
+
+
 def fault_counts(rows: list[dict]) -> dict:
-    """How many iterations each physics fault flagged (experiments.faults), and which."""
+    """How many iterations each physics fault flagged (procedures.faults), and which."""
     flagged = [r for r in rows if r['fault']]
     return {**{name: sum(name in r['fault'].split('+') for r in rows) for name in FAULTS},
             'flagged': [{'group': r['group'], 'iteration': r['iteration'],
@@ -122,9 +139,12 @@ def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: li
               earlier: dict | None = None) -> dict:
     """The metrics of one experiment. `earlier`: the summaries of the experiments before it
     (for feeder_emptying's range taken from a table_sweep). Iterations that ended in a physics
-    fault have no figures and are left out; every flagged iteration is listed in `faults`."""
+    fault or with a tunnelled part have no figures and are left out; every flagged iteration is
+    listed in `faults`, and `physics` tells the health of all."""
     faults = fault_counts(rows)
-    faulted = {(r['group'], r['iteration']) for r in rows if r['fault'] == PHYSICS_FAULT}
+    health = physics(rows)
+    faulted = {(r['group'], r['iteration']) for r in rows
+               if set(r['fault'].split('+')) & set(EXCLUDED)}
     rows = [r for r in rows if (r['group'], r['iteration']) not in faulted]
     picks = [p for p in picks if (p['group'], p['iteration']) not in faulted]
     if exp.type == BIN_STATIC:
@@ -136,7 +156,7 @@ def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: li
     else:
         low_high = exp.optimal_range or (earlier or {})[exp.range_from]['optimal_range']
         out = feeder_emptying(file, exp, rows, low_high)
-    return {'type': exp.type, **out, 'faults': faults}
+    return {'type': exp.type, **out, 'faults': faults, 'physics': health}
 
 
 def file_summary(file: ExperimentFile, summaries: dict) -> dict:

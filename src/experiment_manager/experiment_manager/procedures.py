@@ -43,14 +43,15 @@ def search_order(order: str, states: PartStates, targets: np.ndarray, seed: int)
 
 def faults(row: dict) -> str:
     """The physics faults of an iteration, '+'-joined ('' for none): `physics_fault` (NaN
-    state; the iteration stopped there and gives no figures), `unsettled` (a settle hit its
-    cap with more than the moving fraction of parts still moving), `escaped` (parts left the
-    container). The last two are results, flagged; metrics.py counts all three."""
+    state; the iteration stopped there), `tunnelled` (a part ended in or under the floor or in
+    a wall: solid bodies passed through each other), both of which leave the iteration out of
+    the figures; `unsettled` (a settle hit its cap with more than the moving fraction of parts
+    still moving), flagged and counted. A spill (a part over a wall) is a result, not a fault:
+    its own column. metrics.py counts them."""
     if row['stop'].startswith(metrics.PHYSICS_FAULT):
         return metrics.PHYSICS_FAULT
-    return '+'.join(name for name, bad in ((metrics.UNSETTLED, not row['settled']),
-                                           (metrics.ESCAPED, row['escaped'] or row['lost']))
-                    if bad)
+    return '+'.join(name for name, bad in ((metrics.TUNNELLED, row['tunnelled']),
+                                           (metrics.UNSETTLED, not row['settled'])) if bad)
 
 
 def run_unit(file: ExperimentFile, u: Unit, backend: Backend) -> Record:
@@ -63,8 +64,8 @@ def run_unit(file: ExperimentFile, u: Unit, backend: Backend) -> Record:
     try:
         row = run[u.experiment.type]()
     except PhysicsFault as exc:    # its seed would fault again: marked, not run again
-        row = {'settled': False, 'escaped': 0, 'emptied': False, 'vibrations': 0,
-               'feeds': 0, 'lost': 0, 'stop': f'{metrics.PHYSICS_FAULT}: {exc}'}
+        row = {**iteration.health(), 'emptied': False, 'vibrations': 0, 'feeds': 0,
+               'stop': f'{metrics.PHYSICS_FAULT}: {exc}'}
     record = iteration.record
     first = record.checks[0] if record.checks else {}
     x, y, z = u.container.inner_size
@@ -79,11 +80,6 @@ def run_unit(file: ExperimentFile, u: Unit, backend: Backend) -> Record:
     return record
 
 
-def _physics(reports: list[SettleReport]) -> dict:
-    return {'settled': all(r.settled for r in reports),
-            'escaped': len({i for r in reports for i in r.escaped_ids})}
-
-
 class Iteration:
     """One iteration in progress: the procedures of the four types and the rows they record."""
 
@@ -91,6 +87,20 @@ class Iteration:
         self.file, self.u, self.backend = file, u, backend
         self.record = Record(iteration={})
         self.key = {'experiment': u.experiment.id, 'group': u.group, 'iteration': u.iteration}
+        self.reports: list[SettleReport] = []
+
+    def health(self) -> dict:
+        """The physics of the iteration's world operations so far: whether every settle
+        rested, the most parts left moving, parts spilled over a wall and tunnelled (ids
+        counted once), the deepest penetration (m) and the worst tray tracking (fraction)."""
+        r = self.reports
+        tunnelled = {i for x in r for i in x.tunnelled_ids}
+        spilled = {i for x in r for i in x.spilled_ids} - tunnelled
+        return {'settled': all(x.settled for x in r),
+                'unsettled': max((len(x.unsettled_ids) for x in r), default=0),
+                'spilled': len(spilled), 'tunnelled': len(tunnelled),
+                'max_penetration': max((x.max_penetration for x in r), default=0.0),
+                'tray_error': max((x.tray.error for x in r if x.tray), default=0.0)}
 
     def check(self, states: PartStates, neighbours: bool,
               vibrations: int = 0) -> tuple[Report | None, np.ndarray]:
@@ -145,15 +155,15 @@ class Iteration:
     def static(self) -> dict:
         """bin_static (stages 1-3) and table_sweep (all four stages): drop, settle, check."""
         states, settle = self.backend.drop(self.u.parts, 'container')
+        self.reports.append(settle)
         self.check(states, neighbours=self.u.experiment.type == TABLE_SWEEP)
-        return {**_physics([settle]), 'emptied': False, 'vibrations': 0, 'feeds': 0,
-                'lost': 0, 'stop': ''}
+        return {**self.health(), 'emptied': False, 'vibrations': 0, 'feeds': 0, 'stop': ''}
 
     def emptying(self) -> dict:
         """bin_emptying: check in search order, remove the first valid part, settle, repeat
         until none is valid or the bin is empty."""
         states, settle = self.backend.drop(self.u.parts, 'container')
-        settles = [settle]
+        self.reports.append(settle)
         stop = 'empty'
         while states.inside.any():
             report, order = self.check(states, neighbours=True)
@@ -162,34 +172,34 @@ class Iteration:
                 break
             pid = self.pick(report, order)
             states, settle = self.backend.remove([pid])
-            settles.append(settle)
-        return {**_physics(settles), 'emptied': not states.inside.any(), 'vibrations': 0,
-                'feeds': 0, 'lost': int((~states.inside).sum()), 'stop': stop}
+            self.reports.append(settle)
+        return {**self.health(), 'emptied': not states.inside.any(), 'vibrations': 0,
+                'feeds': 0, 'stop': stop}
 
     def feeder(self) -> dict:
         """feeder_emptying: the feeder loads the table up to max* and vibrates; then after each
         check the policy picks, vibrates, or feeds and vibrates, until it stops."""
         backend = self.backend
         step = backend.feed(0, 0, self.u.feeder)
+        self.reports += step.reports
         states = backend.parts()
-        settles: list[SettleReport] = []
-        lost = 0
         for _ in range(MAX_FEED_CYCLES):
             outside = states.ids[~states.inside].tolist()
-            if outside:     # over the edge: gone from the table, counted as lost
-                lost += len(outside)
+            if outside:     # spilled or tunnelled (the reports tell which): off the table
                 states, settle = backend.remove(outside, settle=False)
             report, order = self.check(states, neighbours=True, vibrations=step.vibrations)
             valid = report.counts['valid'] if report else 0
             step = backend.feed(valid, int(states.inside.sum()), None)
+            self.reports += step.reports
             if step.decision == PICK:
                 pid = self.pick(report, order, step.vibrations)
                 states, settle = backend.remove([pid])
-                settles.append(settle)
+                self.reports.append(settle)
             elif step.decision in (STOP_EMPTY, STOP_VIBRATION_LIMIT):
                 break
             else:
                 states = backend.parts()
-        return {**_physics(settles), 'emptied': step.decision == STOP_EMPTY and lost == 0,
-                'vibrations': step.vibrations, 'feeds': step.feeds, 'lost': lost,
+        # emptied: the feeder and the table are empty; what spilled is its own figure.
+        return {**self.health(), 'emptied': step.decision == STOP_EMPTY,
+                'vibrations': step.vibrations, 'feeds': step.feeds,
                 'stop': DECISION_NAMES[step.decision]}

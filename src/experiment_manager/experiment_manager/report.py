@@ -83,18 +83,24 @@ def plot_sweep(summary: dict, path: str) -> bool:
 
 
 def _faults(summary: dict) -> list[str]:
-    """Iterations flagged per experiment: a NaN state (left out of the figures), a settle
-    that hit its cap with parts still moving, parts that left the container (both counted)."""
+    """Per experiment: iterations flagged (a NaN state and a tunnelled part leave an iteration
+    out of the figures; a settle that hit its cap is counted) and the physics of all of them:
+    parts spilled over a wall and tunnelled, the deepest penetration, the worst tray tracking."""
     rows = [[f'`{exp_id}`', len(s['faults']['flagged']), s['faults']['physics_fault'],
-             s['faults']['unsettled'], s['faults']['escaped']]
-            for exp_id, s in summary['experiments'].items() if s['faults']['flagged']]
-    if not rows:
-        return ['No iteration was flagged: every settle ended within its cap, no part left its '
-                'container, no physics state became NaN.']
-    return table(['experiment', 'iterations flagged', 'physics fault (NaN; left out of the '
-                   'figures)', 'unsettled at the cap (counted)', 'parts escaped (counted)'],
-                  rows) + ['', 'Each flagged iteration has its fault in the `fault` column of '
-                           '`iterations.csv`.']
+             s['faults']['tunnelled'], s['faults']['unsettled'], s['physics']['spilled'],
+             s['physics']['tunnelled'], fmt(1000 * s['physics']['max_penetration'], 3),
+             pct(s['physics']['tray_error'])]
+            for exp_id, s in summary['experiments'].items()]
+    flagged = any(s['faults']['flagged'] for s in summary['experiments'].values())
+    lead = [] if flagged else ['No iteration was flagged: every settle ended within its cap, '
+                               'no part tunnelled, no physics state became NaN.', '']
+    return lead + table(['experiment', 'iterations flagged', 'NaN state (left out)',
+                  'tunnelled (left out)', 'unsettled at the cap (counted)', 'parts spilled',
+                  'parts tunnelled', 'deepest penetration (mm)', 'worst tray tracking error'],
+                 rows) + ['', 'Tunnelled: a part ended in or under the floor or in a wall, '
+                          'which solid bodies cannot do; spilled: a part went over a wall. '
+                          'Each flagged iteration has its fault in the `fault` column of '
+                          '`iterations.csv`.']
 
 
 def markdown(summary: dict, spec: dict, figures: dict[str, bool],
@@ -175,11 +181,12 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
         lines += table(['', 'iterations', 'parts', 'optimal range', 'emptied',
                          'av. vibrations to empty'], rows)
         lines += ['', f'Time per vibration the refill interval allows: '
-                  f'{fmt(s["minutes_per_vibration_allowed"])} min. Parts lost over the edge: '
-                  f'{s["lost"]}.']
+                  f'{fmt(s["minutes_per_vibration_allowed"])} min. Parts spilled over the '
+                  f'walls: {s["physics"]["spilled"]} (in {s["runs_spilling"]} runs; a run may '
+                  f'spill {s["max_spilled"]}); runs emptied within that: {s["accepted"]}.']
     if paper:
         lines += against_paper(summary, paper)
-    lines += ['', '## Physics faults', ''] + _faults(summary)
+    lines += ['', '## Physics health', ''] + _faults(summary)
     if pictures:
         lines += ['', '## Pictures']
         for name, caption in pictures.items():

@@ -14,8 +14,8 @@ KEY = ('experiment', 'group', 'iteration')
 ITERATION_COLUMNS = (
     'experiment', 'type', 'group', 'iteration', 'seed', 'container_x', 'container_y',
     'container_z', 'parts', 'checked', 'candidates', 'placeable', 'container_free', 'valid',
-    'checks', 'picks', 'settled', 'escaped', 'emptied', 'vibrations', 'feeds', 'lost', 'stop',
-    'fault', 'wall_time')
+    'checks', 'picks', 'settled', 'unsettled', 'spilled', 'tunnelled', 'max_penetration',
+    'tray_error', 'emptied', 'vibrations', 'feeds', 'stop', 'fault', 'wall_time')
 CHECK_COLUMNS = (*KEY, 'check', 'parts_on_table', 'checked', 'candidates', 'placeable',
                  'container_free', 'valid', 'picked_id', 'searches', 'vibrations', 'wall_time')
 PART_COLUMNS = (*KEY, 'check', 'part_id', *POSE, 'inside', 'stage', 'grasp', 'tilts')
@@ -24,7 +24,8 @@ PICK_COLUMNS = (*KEY, 'pick', 'check', 'part_id', 'searches', 'vibrations', 'gra
 FILES = {'iterations': ITERATION_COLUMNS, 'checks': CHECK_COLUMNS, 'parts': PART_COLUMNS,
          'picks': PICK_COLUMNS}
 TEXT = {'experiment', 'type', 'stop', 'fault'}
-FLOAT = {'container_x', 'container_y', 'container_z', 'wall_time', *POSE, *GRIPPER_POSE}
+FLOAT = {'container_x', 'container_y', 'container_z', 'max_penetration', 'tray_error',
+         'wall_time', *POSE, *GRIPPER_POSE}
 BOOL = {'settled', 'emptied', 'inside'}
 
 

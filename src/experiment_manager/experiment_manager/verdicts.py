@@ -5,14 +5,16 @@ Rendering them is report.py's job.
 Verdicts, per option:
 - static bin: feasible when every `bin_emptying` iteration emptied the bin and the bin holds a
   refill interval's parts (requirements.parts_per_hour x refill_interval_h);
-- vibrating table: feasible when every `feeder_emptying` run emptied the feeder and the feeder
-  held a refill interval's parts; the report gives the time per vibration this leaves.
+- vibrating table: feasible when every `feeder_emptying` run emptied the feeder spilling no more
+  than requirements.max_spilled_parts over the tray's walls, and the feeder held a refill
+  interval's parts; the report gives the time per vibration this leaves.
+Iterations left out of the figures (a NaN state, a tunnelled part) make no option feasible.
 An option whose experiment did not run is "not analysed".
 """
 
 import numpy as np
 
-from .metrics import FAULTS
+from .metrics import EXCLUDED, FAULTS
 from .wording import count, fmt, of_type, pct, table
 
 # The paper's results (section 5) for its test case, by experiment-file id.
@@ -50,7 +52,7 @@ def verdicts(summary: dict, spec: dict) -> list[dict]:
         reasons = [f'{s["emptied"]} of {s["iterations"]} bins emptied; parts removed per bin: '
                    f'mean {fmt(s["removed"]["mean"])}, max {fmt(s["removed"]["max"])} '
                    f'of {s["parts"]}']
-        ok = s['iterations'] > 0 and s['emptied'] == s['iterations']
+        ok = s['iterations'] > 0 and s['emptied'] == s['iterations'] and not _left_out(s)
         reasons += _fault_reason(s)
         if s['parts'] < capacity:
             ok = False
@@ -73,9 +75,13 @@ def verdicts(summary: dict, spec: dict) -> list[dict]:
             reasons.append(f'vibrations to empty the feeder: mean {fmt(v["mean"], 4)}; the '
                            f'refill interval allows one vibration every '
                            f'{fmt(s["minutes_per_vibration_allowed"])} min')
-        if s['lost']:
-            reasons.append(f'{count(s["lost"], "part")} fell off the table')
-        ok = s['iterations'] > 0 and s['emptied'] == s['iterations']
+        spilled = s['physics']['spilled']
+        if spilled:
+            reasons.append(f'{count(spilled, "part")} spilled over the tray\'s walls, in '
+                           f'{s["runs_spilling"]} runs; a run may spill {s["max_spilled"]} '
+                           f'(requirements.max_spilled_parts): {s["accepted"]} of the '
+                           f'{s["emptied"]} emptied runs met it')
+        ok = s['iterations'] > 0 and s['accepted'] == s['iterations'] and not _left_out(s)
         reasons += _fault_reason(s)
         if s['parts'] < capacity:
             ok = False
@@ -89,13 +95,20 @@ def verdicts(summary: dict, spec: dict) -> list[dict]:
     return out
 
 
+def _left_out(s: dict) -> int:
+    """Iterations left out of the figures (a NaN state or a tunnelled part)."""
+    return sum(s['faults'][k] for k in EXCLUDED)
+
+
 def _fault_reason(s: dict) -> list[str]:
+    """The flagged iterations, in words. Caller: an option is not feasible when any iteration
+    was left out (its figures are missing)."""
     f = s['faults']
     if not f['flagged']:
         return []
     return [f'{count(len(f["flagged"]), "iteration")} flagged: ' + ', '.join(
         f'{k} {f[k]}' for k in FAULTS if f[k])
-        + ' (see Physics faults)']
+        + ' (see Physics health)']
 
 
 def _last(summary: dict, kind: str) -> dict | None:
@@ -190,9 +203,9 @@ def against_paper(summary: dict, paper: dict) -> list[str]:
               f"{1 / DIFFERS:g} times the paper's."
               + (' Where this run differs, and why:' if differ else ' None does.')]
     lines += [f'- {why[k]}' for k in ('bins', 'table', 'feeder') if k in differ]
-    if f and f['lost']:
-        lines.append(f'- {count(f["lost"], "part")} fell over the tray\'s wall, in '
-                     f'{f["faults"]["escaped"]} of {f["iterations"]} feeder runs; a run that '
-                     'loses a part has not emptied the feeder.')
+    if f and f['physics']['spilled']:
+        lines.append(f'- {count(f["physics"]["spilled"], "part")} spilled over the tray\'s '
+                     f'walls, in {f["runs_spilling"]} of {f["iterations"]} feeder runs; a run '
+                     f'may spill {f["max_spilled"]}.')
     lines += ['', 'No setting of the simulation was tuned to agree with the paper.']
     return lines

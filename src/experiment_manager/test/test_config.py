@@ -7,6 +7,7 @@ import re
 
 from experiment_manager import config
 from pick_common.errors import InvalidArgument
+from pick_common.specs import MOVES
 import pytest
 
 HERE = os.path.dirname(__file__)
@@ -23,8 +24,7 @@ def test_the_default_file_parses_into_si_units():
     assert f.gripper.body_diameter == pytest.approx(0.020)
     assert f.check.tolerance == pytest.approx(math.radians(45))
     assert f.tray.inner_size == pytest.approx((0.195, 0.150, 0.027))
-    assert f.vibration.amplitude == pytest.approx((0.003, 0.0, 0.003))
-    assert f.vibration.direction == 'random'
+    assert f.moves == (MOVES['spread'],) and f.requirements.max_spilled == 0
     assert f.requirements.refill_interval == 4 * 3600 and f.requirements.capacity == 480
     emptying = f.experiment('emptying')
     assert emptying.bin is None and emptying.bin_from == 'bins'
@@ -88,10 +88,10 @@ BAD = [
      + MINIMAL, r'part\.grasps \(grasps\.grasp_0\.closing_axis\): .* is parallel to up_axis'),
     ('part:\n  grasps:\n    - {up_axis: [0, 0, 1], closing_axis: [1, 0, 0]}\n' + MINIMAL,
      r'part\.grasps\[0\]\.jaw_opening_mm: None is required'),
-    ('vibration: {amplitude_mm: [0, 0, 10], frequency_hz: 50}\n' + MINIMAL,
-     r'vibration \(vibration\.amplitude\): .* gives a peak acceleration of .* \(limit 200\)'),
-    ('vibration: {direction: diagonal}\n' + MINIMAL,
-     r"vibration\.direction: 'diagonal' must be one of fixed, random"),
+    ('moves: [{amplitude_mm: [0, 0, 10], frequency_hz: 50}]\n' + MINIMAL,
+     r'moves\[0\] \(vibration\.amplitude\): .* gives a peak acceleration of .* \(limit 200\)'),
+    ('moves: [{direction: diagonal}]\n' + MINIMAL,
+     r"moves\[0\]\.direction: 'diagonal' must be one of fixed, random"),
     ('experiments: [\n', r'line \d+, column \d+: .* is not valid YAML'),
     ('- just\n- a list\n', r'file: .* must be a mapping of keys'),
 ]
@@ -132,3 +132,19 @@ def test_a_reduced_copy_caps_iterations_and_keeps_the_rest(tmp_path):
     assert (small.part, small.gripper, small.grasps) == (f.part, f.gripper, f.grasps)
     with pytest.raises(InvalidArgument, match=r'max_iterations: 0 must be within \[1, '):
         config.reduced(f, 0)
+
+
+def test_feeder_moves_are_named_or_set_field_by_field():
+    text = open(DEFAULT).read()
+    f = config.parse(text.replace('moves: [spread]', 'moves: [flip, {move: backward, '
+                                  'duration_s: 0.2}, {amplitude_mm: [0, 1, 2]}]'))
+    flip, back, own = f.moves
+    assert flip == MOVES['flip'] and back.duration == 0.2
+    assert back.amplitude == MOVES['backward'].amplitude and back.direction == 'fixed'
+    assert own.amplitude == pytest.approx((0.0, 0.001, 0.002)) and own.direction == 'random'
+    for moves, error in (('[shake]', r"moves\[0\].move: 'shake' must be one of spread, flip"),
+                         ('[]', r'moves: \[\] must be a list of 1 to 16 moves'),
+                         ('[{amplitude_mm: [0, 0, -1]}]',
+                          r'moves\[0\] \(vibration.amplitude\[2\]\): -0.001 must be >= 0')):
+        with pytest.raises(InvalidArgument, match=error):
+            config.parse(text.replace('moves: [spread]', f'moves: {moves}'))

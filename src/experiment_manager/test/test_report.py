@@ -32,11 +32,11 @@ def test_a_run_gets_its_report_files(run_dir):
     text = open(os.path.join(run_dir, 'report.md')).read()
     page = open(path).read()
     for heading in ('## Verdict', '## Static bins', '## Bin emptying', '## Vibrating table sweep',
-                    '## Feeder emptying', '## Physics faults'):
+                    '## Feeder emptying', '## Physics health'):
         assert heading in text
         assert f'<h2>{heading[3:]}' in page
     separators = [line for line in text.splitlines() if line.startswith('| --- |')]
-    assert page.count('<table>') == len(separators) == 4 and 'fig15_table.png' in page
+    assert page.count('<table>') == len(separators) == 5 and 'fig15_table.png' in page
     assert 'paper' not in text.split('## Verdict')[1]      # id `small`: no paper numbers
     assert 'No iteration was flagged' in text
 
@@ -45,11 +45,20 @@ def test_verdicts_follow_the_emptied_runs_and_the_capacity(run_dir):
     s = _summary(run_dir)
     s['requirements']['capacity'] = 10
     s['experiments']['emptying'].update(emptied=1, iterations=1)
-    s['experiments']['feeder'].update(emptied=1, iterations=1)
+    s['experiments']['feeder'].update(emptied=1, accepted=1, iterations=1)
     assert [v['verdict'] for v in verdicts.verdicts(s, {})] == [FEASIBLE, FEASIBLE]
-    s['experiments']['feeder'].update(emptied=0, lost=1)
+    # An emptied run that spilled more than the requirement allows is not accepted.
+    s['experiments']['feeder'].update(accepted=0, runs_spilling=1)
+    s['experiments']['feeder']['physics']['spilled'] = 1
     table = verdicts.verdicts(s, {})[1]
-    assert table['verdict'] == NOT_FEASIBLE and '1 part fell off the table' in table['reasons']
+    assert table['verdict'] == NOT_FEASIBLE and (
+        "1 part spilled over the tray's walls, in 1 runs; a run may spill 0 "
+        '(requirements.max_spilled_parts): 0 of the 1 emptied runs met it') in table['reasons']
+    # A tunnelled iteration (left out of the figures) leaves no option feasible.
+    s['experiments']['feeder'].update(accepted=1)
+    s['experiments']['feeder']['faults']['tunnelled'] = 1
+    assert verdicts.verdicts(s, {})[1]['verdict'] == NOT_FEASIBLE
+    s['experiments']['feeder'].update(emptied=0, accepted=0)
     s['experiments']['feeder']['stops'] = {'stop: empty': 1, 'stop: vibration limit': 2}
     assert 'runs ended by: feeder and table empty 1, vibration limit 2)' in \
         verdicts.verdicts(s, {})[1]['reasons'][0]
@@ -74,7 +83,7 @@ def test_the_papers_numbers_stand_beside_ours_for_its_test_case(run_dir, tmp_pat
     assert '| paper | 50 | 480 | 17-27 | 50 | 167 |' in text
     assert 'paper: n* = 22, 17-27' in text
     assert '| `feeder` | 1 | 1 | 0 | 0 |' in text
-    assert '1 iteration flagged: physics_fault 1 (see Physics faults)' in text
+    assert '1 iteration flagged: physics_fault 1 (see Physics health)' in text
 
 
 def _as_paper_says(summary: dict, paper: dict) -> dict:
@@ -108,8 +117,8 @@ def test_against_the_paper_says_which_findings_hold_and_why_figures_differ(run_d
 
     s['experiments']['emptying']['emptied'] = 1
     s['experiments']['sweep']['coefficients'] = [-0.01, 0.98, 2500.0 - 0.01 * 49.0 ** 2]
-    s['experiments']['feeder'].update(emptied=47, lost=4)
-    s['experiments']['feeder']['faults']['escaped'] = 3
+    s['experiments']['feeder'].update(emptied=47, runs_spilling=3)
+    s['experiments']['feeder']['physics']['spilled'] = 4
     s['experiments']['feeder']['vibrations_to_empty']['mean'] = 250.0
     text = '\n'.join(verdicts.against_paper(s, paper))
     assert '| static bins never emptied (0 of 40) | 1 of 40 emptied | differs |' in text
@@ -120,8 +129,8 @@ def test_against_the_paper_says_which_findings_hold_and_why_figures_differ(run_d
     reasons = [line for line in text.splitlines() if line.startswith('- ')]
     assert [r.split(':')[0] for r in reasons[:3]] == ['- Static bins', '- Table optimum',
                                                       '- Feeder']
-    assert reasons[3] == ("- 4 parts fell over the tray's wall, in 3 of 50 feeder runs; a run "
-                          'that loses a part has not emptied the feeder.')
+    assert reasons[3] == ("- 4 parts spilled over the tray's walls, in 3 of 50 feeder runs; a "
+                          'run may spill 0.')
 
     s['experiments']['sweep'].update(n_star=100)
     assert "still rising at the sweep's last count, n = 100" in '\n'.join(

@@ -8,7 +8,7 @@ namespace it commands that worker's world. One goal at a time: another is answer
 import threading
 
 from pick_common.conversions import ERROR_INTERNAL, ERROR_NONE
-from pick_common.errors import CodedError
+from pick_common.errors import CodedError, InvalidArgument
 from pick_common.node_runner import (
     answer_error,
     declare,
@@ -18,8 +18,10 @@ from pick_common.node_runner import (
     ServerWatch,
     serving,
 )
+from pick_common.specs import MAX_MOVES
 from pick_msgs.action import DropParts, FeedCycle, Vibrate
 from pick_msgs.msg import FeederState as FeederStateMsg
+from pick_msgs.msg import Vibration
 from rclpy.action import ActionClient, ActionServer
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import SingleThreadedExecutor
@@ -129,6 +131,9 @@ class FeederControllerNode(Node):
             goal_handle.abort()
             return result
         try:
+            if len(goal.moves) > MAX_MOVES:
+                raise InvalidArgument('moves', len(goal.moves),
+                                      f'moves in one cycle must be at most {MAX_MOVES}')
             if goal.restart:
                 d = self._defaults
                 self._policy = FeederPolicy(FeederConfig(
@@ -141,16 +146,19 @@ class FeederControllerNode(Node):
             if step.feed:
                 goal_handle.publish_feedback(FeedCycle.Feedback(
                     state=self._state_msg(), phase=f'feeding {step.feed} parts'))
-                await self._world(self._drop, DropParts.Goal(
+                dropped = await self._world(self._drop, DropParts.Goal(
                     instances=[goal.instance], count=step.feed,
                     zone=DropParts.Goal.ZONE_FEEDER), 'drop_parts')
+                result.reports.append(dropped.settle)
                 self._policy.fed(step.feed)
                 result.parts_fed = step.feed
             if step.vibrates:
                 goal_handle.publish_feedback(FeedCycle.Feedback(
                     state=self._state_msg(), phase='vibrating'))
-                await self._world(self._vibrate, Vibrate.Goal(
-                    instances=[goal.instance], vibration=goal.vibration), 'vibrate')
+                for move in goal.moves or [Vibration()]:
+                    vibrated = await self._world(self._vibrate, Vibrate.Goal(
+                        instances=[goal.instance], vibration=move), 'vibrate')
+                    result.reports.append(vibrated.settle)
                 self._policy.vibrated()
             goal_handle.succeed()
             self.get_logger().debug(f'feed_cycle: {NAMES[step.decision]}')
