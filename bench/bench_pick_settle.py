@@ -8,7 +8,7 @@ test case's feeder runs (100 parts, the optimal ranges the reduced test case fou
 emptyings (the test case's counts and best bins) on the cores, once as the world does now and
 once with a settle after every removal (the behaviour before 2026-11-23), with the same seeds:
 wall time, steps, removals that skipped the settle, and the outcomes (vibrations, picks, parts
-lost). The runs are spread over a process per CPU.
+spilled). The runs are spread over a process per CPU.
 
     tools/ws python bench/bench_pick_settle.py [--runs 4]
 """
@@ -84,7 +84,7 @@ def main() -> None:
             before, now = by_case[(kind, part, 0)], by_case[(kind, part, 1)]
             for mode, r in zip(MODES, (before, now), strict=True):
                 outcome = '; '.join(
-                    f'{x["vibrations"]} vib, {x["picks"]} picks, {x["lost"]} lost'
+                    f'{x["vibrations"]} vib, {x["picks"]} picks, {x["spilled"]} spilled'
                     for x in r['rows'])
                 print(f'{kind:<8} {part} {mode:<36} wall {r["wall"]:6.1f} s, steps '
                       f'{r["steps"]:6d}, removals {r["removals"]:4d} (settle skipped '

@@ -15,17 +15,18 @@ from experiment_manager.scheduler import Runner
 from mcap.exceptions import McapError
 from mcap.reader import make_reader
 from mcap.records import Message
+from pick_sim_world.config import PhysicsConfig
 import yaml
 
 TEST_CASE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src',
                          'experiment_manager', 'config', 'test_case')
 
 
-def run_on_cores(part_file: str, experiments: list[dict],
+def run_on_cores(part_file: str, experiments: list[dict], physics: PhysicsConfig | None = None,
                  **sections) -> tuple[list[dict], float]:
     """Run TEST_CASE/`part_file` with its experiments replaced by `experiments` and its
-    top-level `sections` (e.g. vibration) by the ones given, on the cores; the rows of
-    iterations.csv and the wall time of the run, s."""
+    top-level `sections` (e.g. vibration) by the ones given, on the cores with `physics` (the
+    world's defaults when None); the rows of iterations.csv and the wall time of the run, s."""
     path = os.path.join(TEST_CASE, part_file)
     with open(path, encoding='utf-8') as f:
         data = yaml.safe_load(f)
@@ -33,7 +34,7 @@ def run_on_cores(part_file: str, experiments: list[dict],
     file = config.parse(yaml.safe_dump(data), path)
     with tempfile.TemporaryDirectory() as out:
         start = time.perf_counter()
-        with LocalBackend() as backend, ResultsWriter(out, file.text) as writer:
+        with LocalBackend(physics) as backend, ResultsWriter(out, file.text) as writer:
             Runner(file, [backend], writer).run()
         wall = time.perf_counter() - start
         return read_csv(os.path.join(out, 'iterations.csv')), wall

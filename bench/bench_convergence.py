@@ -1,0 +1,119 @@
+"""Has the physics converged? The same seeded workloads at the default settings, at half and a
+quarter of the time step, and with more solver iterations, with 95 % confidence intervals.
+
+Workloads (the experiment procedures on the cores, so the figures are the ones a run reports):
+- sweep: PTH0 capacitors dropped onto the tray at three counts, checked with all four stages:
+  valid parts per check;
+- feeder: PTH0 feeder_emptying runs of 240 parts at the optimal range [80, 90] (the reduced
+  test case's sweep): vibrations to empty the feeder, parts spilled;
+- bins: 480 TO-220s (PTH1) into the test case's biggest and tallest bins, 300 x 300 x 26 and
+  200 x 75 x 158 mm: the container-free fraction, parts left moving at the settle's end;
+and for every workload parts tunnelled, the deepest penetration (mm), the worst tray tracking
+error and the wall time per iteration. An interval is mean +- t(0.975, n-1) s / sqrt(n); a
+setting's mean is marked '*' when it lies outside the finest setting's interval.
+
+    tools/ws python bench/bench_convergence.py [--seeds 8] [--workloads sweep,feeder,bins]
+
+Runs are spread over a process per CPU. What it costs: README, "Convergence".
+"""
+
+import argparse
+from dataclasses import replace
+import multiprocessing
+import os
+import statistics
+import time
+
+from paper_case import run_on_cores
+from pick_sim_world.config import PhysicsConfig
+from scipy import stats as scipy_stats
+
+DEFAULT = PhysicsConfig()
+SETTINGS = {
+    'default (1/240 s, 30 it.)': DEFAULT,
+    '1/480 s': replace(DEFAULT, time_step=DEFAULT.time_step / 2),
+    '1/960 s': replace(DEFAULT, time_step=DEFAULT.time_step / 4),
+    '1/240 s, 100 it.': replace(DEFAULT, solver_iterations=100),
+}
+FINEST = '1/960 s'
+WORKLOADS = {
+    'sweep': ('pth0.yaml', lambda n: [{'id': 'sweep', 'type': 'table_sweep', 'iterations': n,
+                                       'counts': {'first': 30, 'last': 90, 'step': 30}}],
+              ('valid', 'tunnelled', 'max_penetration', 'wall_time')),
+    'feeder': ('pth0.yaml', lambda n: [{'id': 'feeder', 'type': 'feeder_emptying',
+                                        'iterations': n, 'parts': 240,
+                                        'optimal_range': [80, 90], 'max_vibrations': 500}],
+               ('vibrations', 'emptied', 'spilled', 'tunnelled', 'max_penetration',
+                'tray_error', 'wall_time')),
+    'bins': ('pth1.yaml', lambda n: [{'id': 'bins', 'type': 'bin_static', 'iterations': n,
+                                      'parts': 480, 'bins_mm': [[300, 300, 26],
+                                                                [200, 75, 158]]}],
+             ('container_free', 'unsettled', 'tunnelled', 'max_penetration', 'wall_time')),
+}
+
+
+def job(args: tuple[str, str, int]) -> tuple[str, str, list[dict]]:
+    setting, workload, seeds = args
+    part_file, experiments, _ = WORKLOADS[workload]
+    rows, _ = run_on_cores(part_file, experiments(seeds), SETTINGS[setting])
+    return setting, workload, rows
+
+
+def value(row: dict, column: str) -> float:
+    if column == 'container_free':
+        return int(row['container_free']) / max(1, int(row['checked']))
+    if column == 'max_penetration':
+        return 1000.0 * float(row[column])
+    if column == 'emptied':
+        return float(row[column] == 'True')
+    return float(row[column])
+
+
+def interval(values: list[float]) -> tuple[float, float]:
+    """Mean and the half width of its 95 % confidence interval (0 for one value)."""
+    mean = statistics.fmean(values)
+    if len(values) < 2:
+        return mean, 0.0
+    t = scipy_stats.t.ppf(0.975, len(values) - 1)
+    return mean, t * statistics.stdev(values) / len(values) ** 0.5
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--seeds', type=int, default=8, help='iterations per group')
+    parser.add_argument('--workloads', default=','.join(WORKLOADS))
+    parser.add_argument('--settings', default=','.join(SETTINGS),
+                        help='comma-separated names of SETTINGS')
+    args = parser.parse_args()
+    workloads = args.workloads.split(',')
+    settings = [s for s in SETTINGS if s in args.settings.split(',')] or list(SETTINGS)
+    jobs = [(s, w, args.seeds) for w in workloads for s in settings]
+    start = time.perf_counter()
+    with multiprocessing.Pool(min(len(jobs), os.cpu_count() or 1)) as pool:
+        results = pool.map(job, jobs, chunksize=1)
+    print(f'{len(jobs)} jobs, {args.seeds} seeds per group, '
+          f'{(time.perf_counter() - start) / 60:.1f} min wall on {os.cpu_count()} CPUs')
+    by = {(s, w): rows for s, w, rows in results}
+    for w in workloads:
+        columns = WORKLOADS[w][2]
+        groups = sorted({int(r['group']) for s in settings for r in by[(s, w)]})
+        for g in groups:
+            print(f'\n{w}' + (f', group {g}' if len(groups) > 1 else ''))
+            print('| setting | ' + ' | '.join(columns) + ' |')
+            print('| --- |' + ' --- |' * len(columns))
+            finest = {c: interval([value(r, c) for r in by[(FINEST, w)]
+                                   if int(r['group']) == g]) for c in columns} \
+                if FINEST in settings else {}
+            for s in settings:
+                cells = []
+                for c in columns:
+                    mean, half = interval([value(r, c) for r in by[(s, w)]
+                                           if int(r['group']) == g])
+                    far = c in finest and c != 'wall_time' and \
+                        abs(mean - finest[c][0]) > finest[c][1] + 1e-12
+                    cells.append(f'{mean:.3g} +- {half:.2g}' + (' *' if far else ''))
+                print(f'| {s} | ' + ' | '.join(cells) + ' |')
+
+
+if __name__ == '__main__':
+    main()
