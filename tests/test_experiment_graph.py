@@ -90,7 +90,7 @@ def test_every_recorded_message_decodes_and_matches_the_results(graph_run):
         by_topic.setdefault(topic[len(NS):], []).append(msg)
     workers = [f'/worker_{k}' for k in range(WORKERS)]
     assert set(by_topic) <= {'/progress'} | {f'{w}/{t}' for w in workers for t in (
-        'parts', 'scene', 'markers', 'results', 'feeder/state')}
+        'parts', 'scene', 'markers', 'settle_reports', 'results', 'feeder/state')}
     assert all(f'{w}/results' in by_topic for w in workers), 'a worker ran no iteration'
     iterations = rows(run_dir, 'iterations')
     assert sum(len(by_topic[f'{w}/scene']) for w in workers) == len(iterations)  # a reset each
@@ -104,6 +104,7 @@ def test_every_recorded_message_decodes_and_matches_the_results(graph_run):
     key_of_seed = {instance_seed(int(i['seed']), 0): (i['experiment'], i['group'],
                                                       i['iteration']) for i in iterations}
     reports: dict[tuple, list] = {}
+    settles: dict[tuple, list] = {}
     for w in workers:
         key = None
         for topic, _, msg in messages:
@@ -111,6 +112,14 @@ def test_every_recorded_message_decodes_and_matches_the_results(graph_run):
                 key = key_of_seed[msg.instances[0].seed]
             elif topic == f'{NS}{w}/results':
                 reports.setdefault(key, []).append(msg)
+            elif topic == f'{NS}{w}/settle_reports':
+                settles.setdefault(key, []).append(msg)
+    # The physics health of each iteration is in the recording: its world reports give the
+    # iteration's deepest penetration and its parts spilled and tunnelled.
+    for i in iterations:
+        got = settles[(i['experiment'], i['group'], i['iteration'])]
+        assert max(r.max_penetration for r in got) == float(i['max_penetration'])
+        assert len({t for r in got for t in r.tunnelled_ids}) == int(i['tunnelled'])
     checks: dict[tuple, list] = {}
     for c in rows(run_dir, 'checks'):
         if int(c['parts_on_table']):

@@ -187,6 +187,7 @@ class Iteration:
             outside = states.ids[~states.inside].tolist()
             if outside:     # spilled or tunnelled (the reports tell which): off the table
                 states, settle = backend.remove(outside, settle=False)
+                self.reports.append(settle)
             report, order = self.check(states, neighbours=True, vibrations=step.vibrations)
             valid = report.counts['valid'] if report else 0
             step = backend.feed(valid, int(states.inside.sum()), None)

@@ -8,7 +8,7 @@ thread: on the manager's multi-threaded executor they slowed the calls it waits 
 import threading
 import time
 
-from pick_msgs.msg import FeederState, PartArray, Scene, ValidityReport
+from pick_msgs.msg import FeederState, PartArray, Scene, SettleReport, ValidityReport
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -17,7 +17,8 @@ from visualization_msgs.msg import MarkerArray
 from .recording import Recorder, type_name
 
 RECORDED = (('parts', PartArray), ('scene', Scene), ('markers', MarkerArray),
-            ('results', ValidityReport), ('feeder/state', FeederState))
+            ('settle_reports', SettleReport), ('results', ValidityReport),
+            ('feeder/state', FeederState))
 QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 DRAIN_QUIET = 0.3       # s without a message before a recording is handed back
 DRAIN_LIMIT = 3.0       # s at most spent waiting for the last messages

@@ -29,6 +29,7 @@ from pick_common.specs import check_vibration, FIXED, RANDOM, SceneSpec, Vibrati
 from pick_common.states import Progress, SettleReport
 from pick_msgs.action import DropParts, RemoveParts, Vibrate
 from pick_msgs.msg import PartArray, Scene
+from pick_msgs.msg import SettleReport as SettleReportMsg
 from pick_msgs.srv import GetParts, ResetScene
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
@@ -61,6 +62,8 @@ class WorldNode(Node):
         self._scene_pub = self.create_publisher(Scene, 'scene', LATCHED,
                                                 qos_overriding_options=qos_options)
         self._markers_pub = self.create_publisher(MarkerArray, 'markers', LATCHED,
+                                                  qos_overriding_options=qos_options)
+        self._reports_pub = self.create_publisher(SettleReportMsg, 'settle_reports', 10,
                                                   qos_overriding_options=qos_options)
         self.create_service(ResetScene, 'reset_scene', self._reset_scene, callback_group=group)
         self.create_service(GetParts, 'get_parts', self._get_parts, callback_group=group)
@@ -270,6 +273,7 @@ class WorldNode(Node):
         if ok:
             report = settle[0]
             result.settle = common.settle_to_msg(report)
+            self._reports_pub.publish(result.settle)
             self._states = self._world.snapshot()
             published = self._publish()
             result.parts = published if instances is None else self._parts_msg(instances)
