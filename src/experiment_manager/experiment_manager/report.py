@@ -82,7 +82,7 @@ def plot_sweep(summary: dict, path: str) -> bool:
     return True
 
 
-def _faults(summary: dict) -> list[str]:
+def _physics_health(summary: dict) -> list[str]:
     """Per experiment: iterations flagged (a NaN state and a tunnelled part leave an iteration
     out of the figures; a settle that hit its cap is counted) and the physics of all of them:
     parts spilled over a wall and tunnelled, the deepest penetration, the worst tray tracking."""
@@ -186,7 +186,7 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
                   f'spill {s["max_spilled"]}); runs emptied within that: {s["accepted"]}.']
     if paper:
         lines += against_paper(summary, paper)
-    lines += ['', '## Physics health', ''] + _faults(summary)
+    lines += ['', '## Physics health', ''] + _physics_health(summary)
     if pictures:
         lines += ['', '## Pictures']
         for name, caption in pictures.items():

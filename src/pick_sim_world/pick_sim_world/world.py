@@ -197,7 +197,7 @@ class World:
         if len(state.ids):
             cx, cy, hx, hy = region
             reach = 2.0 * self._part.radius
-            centres = state.poses[:, :3] + rotate(state.poses[:, 3:], self._part.center)
+            centres = self._centres(state)
             over = ((np.abs(centres[:, 0] - cx) <= hx + reach)
                     & (np.abs(centres[:, 1] - cy) <= hy + reach))
             if over.any():
@@ -244,8 +244,9 @@ class World:
             stream.append(self._run('dropping', spawning.layer_interval(self._part), progress,
                                     stop_when_settled=False))
             if stream[-1].canceled:
-                return new_ids, _joined(stream[-1], stream[:-1])
-        return new_ids, _joined(self._settle('dropping', max_settle_time, progress), stream)
+                return new_ids, self._finished(stream[-1], stream[:-1])
+        return new_ids, self._finished(self._settle('dropping', max_settle_time, progress),
+                                       stream)
 
     def _add_parts(self, inst: Instance, poses: np.ndarray) -> list[int]:
         ids = []
@@ -297,8 +298,8 @@ class World:
             delivered = self._drive.stop()
         report.tray = delivered
         if report.canceled:
-            return report
-        settle = _joined(self._settle('settling', max_settle_time, progress), [report])
+            return self._finished(report)
+        settle = self._finished(self._settle('settling', max_settle_time, progress), [report])
         settle.tray = delivered
         return settle
 
@@ -326,9 +327,9 @@ class World:
             pb.removeBody(self._bodies.pop(pid), physicsClientId=self._client)
             self._instances[self._owner.pop(pid)].part_ids.remove(pid)
         if settle and (touched or not self._at_rest):
-            return ids, self._settle('settling', max_settle_time, progress)
+            return ids, self._finished(self._settle('settling', max_settle_time, progress))
         self._at_rest = self._at_rest and not touched
-        return ids, self._health(SettleReport(True, 0.0, 0.0, 0))
+        return ids, self._finished(SettleReport(True, 0.0, 0.0, 0))
 
     def _touch_other_parts(self, ids: list[int]) -> bool:
         """Whether a part of `ids` touches (is within the contact-breaking threshold of) a part
@@ -346,7 +347,7 @@ class World:
     def settle(self, max_settle_time: float | None = None,
                progress: ProgressCallback | None = None) -> SettleReport:
         """Step until every part rests or the time cap is hit."""
-        return self._settle('settling', max_settle_time, progress)
+        return self._finished(self._settle('settling', max_settle_time, progress))
 
     def _settle(self, phase: str, max_settle_time: float | None,
                 progress: ProgressCallback | None) -> SettleReport:
@@ -354,22 +355,32 @@ class World:
             'max_settle_time', max_settle_time, low=self._physics.settle_window, high=600.0)
         return self._run(phase, cap, progress)
 
-    def _health(self, report: SettleReport) -> SettleReport:
-        """Fill in where the parts ended: outside their containers, tunnelled (centre in or
-        under the floor or in a wall), and the deepest penetration."""
+    def _centres(self, state: PartStates) -> np.ndarray:
+        """Centres (N, 3) of the parts' bounding boxes in their instance frames, m."""
+        return state.poses[:, :3] + rotate(state.poses[:, 3:], self._part.center)
+
+    def _finished(self, last: SettleReport, before: Sequence[SettleReport] = ()) -> SettleReport:
+        """The report of a whole operation, once, at its end: `last` (how it ended) with the
+        times and steps of its earlier runs `before` added in, and where the parts ended:
+        outside their containers, tunnelled (centre in or under the floor or in a wall), and
+        the deepest penetration."""
+        for r in before:
+            last.sim_time += r.sim_time
+            last.wall_time += r.wall_time
+            last.steps += r.steps
         state = self.snapshot()
-        report.escaped_ids = [int(i) for i in state.ids[~state.inside]]
+        last.escaped_ids = [int(i) for i in state.ids[~state.inside]]
         if len(state.ids):
-            centres = state.poses[:, :3] + rotate(state.poses[:, 3:], self._part.center)
-            gone = containers.tunnelled(self._scene.container, centres)
-            report.tunnelled_ids = [int(i) for i in state.ids[gone]]
-        report.max_penetration = bodies.max_penetration(self._client)
-        return report
+            gone = containers.tunnelled(self._scene.container, self._centres(state))
+            last.tunnelled_ids = [int(i) for i in state.ids[gone]]
+        last.max_penetration = bodies.max_penetration(self._client)
+        return last
 
     def _run(self, phase: str, duration: float, progress: ProgressCallback | None,
              stop_when_settled: bool = True, time_step: float | None = None) -> SettleReport:
         """Step every part of the scene for up to `duration` s (stepping.step) at `time_step`
-        (the physics step when None); a fault resets the scene before it is raised."""
+        (the physics step when None); a fault resets the scene before it is raised. The report
+        has no health yet: an operation made of several runs gets it once (`_finished`)."""
         ids = [pid for inst in self._instances for pid in inst.part_ids]
         physics = self._physics
         if time_step is not None and time_step != physics.time_step:
@@ -388,15 +399,6 @@ class World:
         self._sim_time += out.steps * physics.time_step
         self._at_rest = out.settled
         settled = out.settled if stop_when_settled else not out.canceled
-        return self._health(SettleReport(settled, out.steps * physics.time_step, out.wall_time,
-                                         out.steps, out.moving_ids, canceled=out.canceled))
+        return SettleReport(settled, out.steps * physics.time_step, out.wall_time, out.steps,
+                            out.moving_ids, canceled=out.canceled)
 
-
-def _joined(last: SettleReport, before: list[SettleReport]) -> SettleReport:
-    """The report of an operation run in parts: `last` (how it ended) with the times and steps
-    of the parts `before` it added in."""
-    for r in before:
-        last.sim_time += r.sim_time
-        last.wall_time += r.wall_time
-        last.steps += r.steps
-    return last
