@@ -148,13 +148,15 @@ def test_every_recorded_message_decodes_and_matches_the_results(graph_run):
 
 def start_replay(client, recording: str, name: str, rate: str) -> tuple[subprocess.Popen, list]:
     """`replay` of worker_0's results at `rate` under the prefix `name` (one per test: no test
-    hears another's replay), and the list that receives what it publishes."""
+    hears another's replay), and the list that receives what it publishes. The replay waits
+    for this subscription to match (up to 60 s: discovery is slow on a loaded machine; with
+    the 2 s default every message was lost there)."""
     prefix = unique_namespace(name)
     received: list = []
     client.node.create_subscription(ValidityReport, f'{prefix}{NS}/worker_0/results',
                                     received.append, 100)
     replay = subprocess.Popen([executable('experiment_manager', 'replay'), recording,
-                               '--rate', rate, '--prefix', prefix,
+                               '--rate', rate, '--prefix', prefix, '--match-wait', '60',
                                '--topics', f'{NS}/worker_0/results'],
                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     return replay, received
@@ -184,6 +186,17 @@ def test_replay_stopped_with_sigint_says_how_far_it_got(graph_run, client):
         replay.kill()
     assert replay.returncode == 130, output
     assert 1 <= int(re.search(r'stopped after (\d+) messages', output).group(1)) < 10, output
+
+
+def test_replay_says_when_no_subscriber_matched(graph_run):
+    _, recording, _ = graph_run
+    prefix = unique_namespace('replay_alone')      # nobody subscribes under this prefix
+    done = subprocess.run([executable('experiment_manager', 'replay'), recording, '--rate',
+                           '1000', '--prefix', prefix, '--match-wait', '0.2', '--topics',
+                           f'{NS}/worker_0/results'], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert (f'replay: {prefix}{NS}/worker_0/results: no subscriber matched within 0.2 s '
+            '(--match-wait); publishing anyway') in done.stderr
 
 
 def test_a_bad_file_fails_before_any_node_starts(tmp_path):

@@ -33,7 +33,7 @@ from .recording import recover
 
 LATCHED_TOPICS = ('scene', 'markers')
 STREAM = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
-MATCH_WAIT = 2.0     # s a new topic waits for a subscriber to match before its first message
+MATCH_WAIT = 2.0     # s a new topic waits by default for a subscriber to match (--match-wait)
 ACK_WAIT = 5.0       # s at the end for subscribers to acknowledge the last messages
 
 
@@ -53,6 +53,10 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     parser.add_argument('--topics', nargs='*', default=None, help='only these topics')
     parser.add_argument('--prefix', default='',
                         help='namespace put in front of every topic (default: none)')
+    parser.add_argument('--match-wait', type=float, default=MATCH_WAIT, metavar='S',
+                        help='seconds each topic waits for a subscriber to match before its '
+                        f'first message (default {MATCH_WAIT:g}; 0..600); then it publishes '
+                        'anyway and says so')
     parser.add_argument('--info', action='store_true', help='list the content and exit')
     parser.add_argument('--recover', metavar='OUT',
                         help='copy the complete records of a cut-off recording into OUT (a '
@@ -62,6 +66,8 @@ def _parse(argv: list[str]) -> argparse.Namespace:
         parser.error('--recover writes a new file: OUT must differ from RECORDING')
     if not 0.001 <= args.rate <= 1000.0:
         parser.error(f'--rate: {args.rate:g} must be within [0.001, 1000]')
+    if not 0.0 <= args.match_wait <= 600.0:
+        parser.error(f'--match-wait: {args.match_wait:g} must be within [0, 600]')
     return args
 
 
@@ -124,9 +130,13 @@ def main(argv: list[str] | None = None) -> int:
                 latched = channel.topic.rsplit('/', 1)[-1] in LATCHED_TOPICS
                 pub = publishers[channel.id] = node.create_publisher(
                     msg_type, topic, LATCHED if latched else STREAM)
-                deadline = time.monotonic() + MATCH_WAIT
+                deadline = time.monotonic() + args.match_wait
                 while pub.get_subscription_count() == 0 and time.monotonic() < deadline:
                     interrupt.sleep(0.02)
+                if pub.get_subscription_count() == 0:
+                    print(f'replay: {topic}: no subscriber matched within '
+                          f'{args.match_wait:g} s (--match-wait); publishing anyway',
+                          file=sys.stderr)
                 if start_log is not None:   # keep the recorded spacing after the wait
                     start_wall = time.monotonic() - (
                         message.log_time - start_log) / 1e9 / args.rate
