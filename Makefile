@@ -16,11 +16,12 @@ PYTEST_ARGS ?=
 TEST_CASE := $(addprefix src/experiment_manager/config/test_case/,pth0.yaml pth1.yaml pth2.yaml)
 RUN_ARGS ?= --iterations 1 $(TEST_CASE)
 
-.PHONY: help run test lint bench deps build lock clean
+.PHONY: help run test test-loaded lint bench deps build lock clean
 
 help:
 	@echo "make run    - the paper's test case, reduced, through the graph (RUN_ARGS=\"file.yaml\")"
 	@echo 'make test   - lint and run every test (installs and builds on first use)'
+	@echo 'make test-loaded - make test three times with every CPU kept busy by other loops'
 	@echo 'make bench  - world, validity and vibration benchmarks (figures in the READMEs)'
 	@echo 'make clean  - remove build/, install/, log/ (keeps the venv)'
 
@@ -48,6 +49,9 @@ lint: $(DEPS_STAMP)
 
 test: $(BUILD_STAMP) lint
 	$(WS) python -m pytest $(PYTEST_ARGS)
+
+test-loaded: $(BUILD_STAMP)
+	$(PYTHON) tools/loaded.py --rounds 3 -- $(MAKE) test
 
 bench: $(BUILD_STAMP)
 	$(WS) python bench/bench_world.py

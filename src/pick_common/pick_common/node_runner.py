@@ -213,6 +213,12 @@ def run(name: str, make_node: Callable[[], Node],
         rclpy.spin(node, executor=make_executor() if make_executor else None)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except (_rclpy.RCLError, _rclpy.InvalidHandle):
+        # A signal shut the context down while the executor was taking or finishing work:
+        # the handles it used are gone ('feedback publisher is invalid'). That is the
+        # shutdown itself; with the context still up it is a failure.
+        if node.context.ok():
+            raise
     finally:
         node.destroy_node()
         rclpy.try_shutdown()

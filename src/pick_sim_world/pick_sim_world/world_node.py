@@ -270,6 +270,10 @@ class WorldNode(Node):
             return not goal_handle.is_cancel_requested
 
         ok = self._guarded(lambda: settle.append(operation(progress)), result)
+        if self._stopping:
+            # Shutting down: the context may be gone, and with it every publisher; rclpy
+            # reports the goal aborted if it still can.
+            return result
         if ok:
             report = settle[0]
             result.settle = common.settle_to_msg(report)
@@ -329,11 +333,13 @@ class WorldNode(Node):
         return self._execute(RemoveParts, goal_handle, result, remove, None)
 
     def destroy_node(self) -> None:
-        """Stop serving first, then close PyBullet once no operation holds it: a disconnect
-        under a running step is a native crash."""
+        """End a running operation at its next settle check and wait for it, then destroy
+        the node's endpoints, then close PyBullet: endpoints destroyed under a callback that
+        still publishes, or a disconnect under a running step, fail or crash."""
         self._stopping = True
+        idle = self._lock.acquire(timeout=SHUTDOWN_WAIT)
         super().destroy_node()
-        if not self._lock.acquire(timeout=SHUTDOWN_WAIT):
+        if not idle:
             # PyBullet is still stepping (an operation with no settle check yet, such as
             # adding thousands of parts): closing it now would crash; the process exit does.
             self.get_logger().error(f'a physics operation still ran after {SHUTDOWN_WAIT:g} s; '
