@@ -36,6 +36,7 @@ def configure(client: int, physics: PhysicsConfig) -> None:
     pb.setGravity(0.0, 0.0, -GRAVITY, physicsClientId=client)
     pb.setPhysicsEngineParameter(
         fixedTimeStep=physics.time_step, numSolverIterations=physics.solver_iterations,
+        warmStartingFactor=physics.warm_starting_factor,
         contactBreakingThreshold=physics.contact_breaking_threshold,
         deterministicOverlappingPairs=1, physicsClientId=client)
 

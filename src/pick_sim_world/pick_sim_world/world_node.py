@@ -148,6 +148,10 @@ class WorldNode(Node):
             time_step=setting('physics.time_step', cfg.time_step, 's'),
             solver_iterations=setting('physics.solver_iterations', cfg.solver_iterations,
                                       'solver iterations per step'),
+            warm_starting_factor=setting('physics.warm_starting_factor',
+                                         cfg.warm_starting_factor,
+                                         "share of the last step's contact impulses the "
+                                         'solver starts from'),
             contact_breaking_threshold=setting('physics.contact_breaking_threshold',
                                                cfg.contact_breaking_threshold, 'm'),
             settle_check_period=setting('settle.check_period', cfg.settle_check_period,
