@@ -194,11 +194,14 @@ def _tipped(vibration: Vibration, seed: int, shakes: int = 10) -> bool:
     return abs(up) < 0.5
 
 
-def test_a_random_horizontal_shake_tips_a_standing_part_that_a_vertical_one_does_not():
-    # The feeder's last parts stood like this for hundreds of vertical shakes (README).
-    vertical = Vibration((0.0, 0.0, 0.003), direction=FIXED)
-    assert [_tipped(vertical, seed) for seed in range(4)] == [False] * 4
-    assert [_tipped(Vibration(), seed) for seed in range(4)] == [True] * 4
+def test_a_standing_part_stays_up_below_1_g_and_tips_under_the_default_move():
+    # 0.3 mm at 26 Hz peaks at 0.82 g: the tray never throws the part, so nothing can tip it.
+    # The default move (1.4 mm, 3.8 g, random horizontal) tosses it. (At pybullet's warm start
+    # of 0.1 and 30 iterations, a 3 mm vertical shake left it standing for hundreds of
+    # shakes; every finer setting tips it at the first: README, "Piles that rest".)
+    gentle = Vibration((0.0, 0.0, 0.0003), direction=FIXED)
+    assert [_tipped(gentle, seed) for seed in range(3)] == [False] * 3
+    assert [_tipped(Vibration(), seed, shakes=2) for seed in range(3)] == [True] * 3
 
 
 def test_vibrating_a_bin_is_refused():
