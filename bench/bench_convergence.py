@@ -1,5 +1,6 @@
 """Has the physics converged? The same seeded workloads at the default settings, at half and a
-quarter of the time step, and with more solver iterations, with 95 % confidence intervals.
+quarter of the time step, with more solver iterations, and at the former defaults (30
+iterations, pybullet's warm start of 0.1), with 95 % confidence intervals.
 
 Workloads (the experiment procedures on the cores, so the figures are the ones a run reports):
 - sweep: PTH0 capacitors dropped onto the tray at three counts, checked with all four stages:
@@ -7,12 +8,15 @@ Workloads (the experiment procedures on the cores, so the figures are the ones a
 - feeder: PTH0 feeder_emptying runs of 100 parts at the optimal range [80, 90] (the reduced
   test case's sweep): vibrations to empty the feeder, parts spilled;
 - bins: 480 TO-220s (PTH1) into the test case's biggest and tallest bins, 300 x 300 x 26 and
-  200 x 75 x 158 mm: the container-free fraction, parts left moving at the settle's end;
+  200 x 75 x 158 mm: the container-free fraction, parts left moving at the settle's end
+  (flat-bin: the first alone, for more seeds where the intervals are close);
 and for every workload parts tunnelled, the deepest penetration (mm), the worst tray tracking
 error and the wall time per iteration. An interval is mean +- t(0.975, n-1) s / sqrt(n); a
-setting's mean is marked '*' when it lies outside the finest setting's interval.
+setting's mean is marked '*' when it lies outside the finest setting's interval (--finest,
+default a quarter of the step).
 
-    tools/ws python bench/bench_convergence.py [--seeds 8] [--workloads sweep,feeder,bins]
+    tools/ws python bench/bench_convergence.py [--seeds 8] [--workloads sweep,feeder,bins,flat-bin]
+        [--settings default,100-it,...] [--finest dt/4]
 
 Runs are spread over a process per CPU. What it costs: README, "Convergence".
 """
@@ -30,12 +34,15 @@ from scipy import stats as scipy_stats
 
 DEFAULT = PhysicsConfig()
 SETTINGS = {
-    'default': DEFAULT,                                                 # 1/240 s, 30 iterations
+    'default': DEFAULT,                         # 1/240 s, 100 iterations, full warm start
     'dt/2': replace(DEFAULT, time_step=DEFAULT.time_step / 2),
     'dt/4': replace(DEFAULT, time_step=DEFAULT.time_step / 4),
-    '100-it': replace(DEFAULT, solver_iterations=100),
+    'dt/8': replace(DEFAULT, time_step=DEFAULT.time_step / 8),
+    '200-it': replace(DEFAULT, solver_iterations=200),
+    # the defaults before issue 20's convergence study: 30 iterations, pybullet's warm start
+    '30-it': replace(DEFAULT, solver_iterations=30, warm_starting_factor=0.1),
 }
-FINEST = 'dt/4'
+FINEST = 'dt/4'         # the reference the others are marked against
 WORKLOADS = {
     'sweep': ('pth0.yaml', lambda n: [{'id': 'sweep', 'type': 'table_sweep', 'iterations': n,
                                        'counts': {'first': 30, 'last': 90, 'step': 30}}],
@@ -49,6 +56,9 @@ WORKLOADS = {
                                       'parts': 480, 'bins_mm': [[300, 300, 26],
                                                                 [200, 75, 158]]}],
              ('container_free', 'unsettled', 'tunnelled', 'max_penetration', 'wall_time')),
+    'flat-bin': ('pth1.yaml', lambda n: [{'id': 'bins', 'type': 'bin_static', 'iterations': n,
+                                          'parts': 480, 'bins_mm': [[300, 300, 26]]}],
+                 ('container_free', 'unsettled', 'tunnelled', 'max_penetration', 'wall_time')),
 }
 
 
@@ -81,15 +91,16 @@ def interval(values: list[float]) -> tuple[float, float]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--seeds', type=int, default=8, help='iterations per group')
-    parser.add_argument('--workloads', default=','.join(WORKLOADS))
+    parser.add_argument('--workloads', default='sweep,feeder,bins')
     parser.add_argument('--settings', default=','.join(SETTINGS),
                         help='comma-separated names of SETTINGS')
+    parser.add_argument('--finest', default=FINEST, help='the reference setting')
     args = parser.parse_args()
     workloads = args.workloads.split(',')
-    unknown = set(args.settings.split(',')) - set(SETTINGS)
+    unknown = set(args.settings.split(',') + [args.finest]) - set(SETTINGS)
     if unknown:
         parser.error(f'--settings: unknown {sorted(unknown)}; known: {", ".join(SETTINGS)}')
-    settings = [s for s in SETTINGS if s in args.settings.split(',')]
+    settings = [s for s in SETTINGS if s in args.settings.split(',') or s == args.finest]
     jobs = [(s, w, args.seeds) for w in workloads for s in settings]
     start = time.perf_counter()
     with multiprocessing.Pool(min(len(jobs), os.cpu_count() or 1)) as pool:
@@ -104,9 +115,8 @@ def main() -> None:
             print(f'\n{w}' + (f', group {g}' if len(groups) > 1 else ''))
             print('| setting | ' + ' | '.join(columns) + ' |')
             print('| --- |' + ' --- |' * len(columns))
-            finest = {c: interval([value(r, c) for r in by[(FINEST, w)]
-                                   if int(r['group']) == g]) for c in columns} \
-                if FINEST in settings else {}
+            finest = {c: interval([value(r, c) for r in by[(args.finest, w)]
+                                   if int(r['group']) == g]) for c in columns}
             for s in settings:
                 cells = []
                 for c in columns:
