@@ -39,7 +39,7 @@ def main() -> None:
         validator = Validator(part, Gripper(), CAPACITOR_GRASPS, PlaceSpec(), CheckConfig())
         build = time.perf_counter() - start
         print(f'\n== seed {seed}: 480 settled capacitors; validator built in {build * 1e3:.1f} ms '
-              '(part and gripper geometry, placeability of every grasp and tilt)')
+              "(part and gripper geometry, each grasp's finger depth)")
         for neighbours in (True, False):
             label = 'four stages' if neighbours else 'stages 1-3 (static bin analysis)'
             walls = []

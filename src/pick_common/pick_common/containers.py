@@ -103,16 +103,19 @@ def outer_size(spec: ContainerSpec) -> tuple[float, float, float]:
     return (x + 2 * t, y + 2 * t, z + spec.floor_thickness)
 
 
-def inside(spec: ContainerSpec, points: np.ndarray, tolerance: float = 0.001) -> np.ndarray:
+def inside(spec: ContainerSpec, points: np.ndarray, tolerance: float = 0.001,
+           above_rim: float | None = None) -> np.ndarray:
     """Which points (N, 3) in the instance frame lie within the inner box, (N,) bool.
 
-    The box is open upwards up to twice the wall height: a part resting on a pile that rises
-    above the walls is still in the container; tolerance (m) absorbs contact penetration.
+    The box is open upwards to `above_rim` m above the walls' top (None: the wall height
+    again, the world's rule): a part resting on a pile that rises above the walls is still in
+    the container; tolerance (m) absorbs contact penetration.
     """
     x, y, z = spec.inner_size
+    top = z + (z if above_rim is None else above_rim)
     p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     return ((np.abs(p[:, 0]) <= x / 2 + tolerance) & (np.abs(p[:, 1]) <= y / 2 + tolerance)
-            & (p[:, 2] >= -tolerance) & (p[:, 2] <= 2 * z + tolerance))
+            & (p[:, 2] >= -tolerance) & (p[:, 2] <= top + tolerance))
 
 
 def tunnelled(spec: ContainerSpec, points: np.ndarray) -> np.ndarray:

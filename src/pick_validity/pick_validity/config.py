@@ -20,12 +20,15 @@ LIMITS = {
     'gripper.body_length': Limit(0.0, 2.0, low_open=True),
     'gripper.jaw_height': Limit(0.0, 1.0, low_open=True),
     'gripper.jaw_depth': Limit(0.0, 1.0, low_open=True),
+    'gripper.finger_clearance': Limit(0.0, 1.0),
     'jaw_opening': Limit(0.0, 1.0, low_open=True),
     'place.seat_offset': Limit(-1.0, 1.0),
     'check.tolerance': Limit(0.0, math.pi / 2, low_open=True),
     'check.tilt_min': Limit(-math.pi / 2, math.pi / 2),
     'check.tilt_max': Limit(-math.pi / 2, math.pi / 2),    # and at least tilt_min
     'check.tilt_step': Limit(math.radians(0.1), math.pi),
+    'check.approach_cone': Limit(0.0, math.pi / 2, low_open=True),
+    'check.rim_tolerance': Limit(0.0, 1.0),
 }
 
 
@@ -35,12 +38,22 @@ class Gripper:
 
     body_diameter D and body_length of the body cylinder; jaw_height V and jaw_depth W of the
     jaws' workspace cuboid (its width U is the grasp's jaw opening). m.
+
+    finger_clearance: how far above the bottom of the grasped part the fingertips stop, m. The
+    fingers close around the part as a parallel gripper's do: the jaws' cuboid reaches from the
+    fingertips up, and the body sits on top of it. The grasped part's bottom is the lowest
+    point, along the grasp's up axis, of the collision primitive that holds the grasp point
+    (the body of a built-in part). At 0 the fingertips would be level with the floor under
+    every resting part (and below it by the physics' overlap, up to 1 mm); pick programs stop
+    them short of the surface. The fingertips never go above the grasp point nor deeper
+    than V below it.
     """
 
     body_diameter: float = 0.020
     body_length: float = 0.060
     jaw_height: float = 0.015
     jaw_depth: float = 0.006
+    finger_clearance: float = 0.001
 
 
 @dataclass(frozen=True)
@@ -48,7 +61,8 @@ class GraspPose:
     """A user-defined grasp pose (paper figure 4), in the part frame.
 
     up_axis must point along world +Z; closing_axis lies along the jaws' closing direction;
-    jaw_opening is U, m; grasp_point is where the jaw tips' centre goes, m.
+    jaw_opening is U, m; grasp_point is the point the jaws close on (the gripper frame's
+    origin), m.
     """
 
     name: str
@@ -70,13 +84,22 @@ class PlaceSpec:
 
 @dataclass(frozen=True)
 class CheckConfig:
-    """tolerance: largest angle between a grasp's up axis and world +Z, rad. The wrist tilts
-    about the closing axis from tilt_min to tilt_max in steps of tilt_step, rad."""
+    """tolerance: largest angle between a grasp's up axis and world +Z, rad.
+
+    The gripper closes along the part's closing axis as the part lies; the wrist turns about
+    that axis from tilt_min to tilt_max in steps of tilt_step, rad, where tilt 0 is the most
+    vertical approach (the gripper's axis in the vertical plane through the closing axis).
+    A tilt whose gripper axis is more than approach_cone from world +Z is not tried.
+    rim_tolerance: a part whose centre lies more than this above the container's rim is not
+    in the container (nor is one beside its walls or below its floor), m.
+    """
 
     tolerance: float = math.radians(45.0)
     tilt_min: float = math.radians(-45.0)
     tilt_max: float = math.radians(45.0)
     tilt_step: float = math.radians(5.0)
+    approach_cone: float = math.radians(45.0)
+    rim_tolerance: float = 0.02
 
 
 # The default grasp poses, for a radial capacitor (body along part +Z, leads along -Z) lying on
@@ -111,7 +134,7 @@ def _unit(field_name: str, values) -> np.ndarray:
 
 
 def check_gripper(gripper: Gripper) -> Gripper:
-    for name in ('body_diameter', 'body_length', 'jaw_height', 'jaw_depth'):
+    for name in ('body_diameter', 'body_length', 'jaw_height', 'jaw_depth', 'finger_clearance'):
         LIMITS[f'gripper.{name}'].check(f'gripper.{name}', getattr(gripper, name))
     return gripper
 
@@ -146,8 +169,10 @@ def check_place(place: PlaceSpec) -> tuple[np.ndarray, float]:
 
 
 def tilts(cfg: CheckConfig) -> np.ndarray:
-    """The tilt angles to try, rad, from tilt_min to tilt_max inclusive."""
+    """Check the settings; the tilt angles to try, rad, from tilt_min to tilt_max inclusive."""
     LIMITS['check.tolerance'].check('check.tolerance', cfg.tolerance)
+    LIMITS['check.approach_cone'].check('check.approach_cone', cfg.approach_cone)
+    LIMITS['check.rim_tolerance'].check('check.rim_tolerance', cfg.rim_tolerance)
     low = LIMITS['check.tilt_min'].check('check.tilt_min', cfg.tilt_min)
     high = LIMITS['check.tilt_max'].check('check.tilt_max', cfg.tilt_max, low=low)
     step = LIMITS['check.tilt_step'].check('check.tilt_step', cfg.tilt_step)

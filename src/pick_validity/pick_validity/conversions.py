@@ -53,7 +53,8 @@ def setup_from_request(request: CheckParts.Request, defaults: Setup) -> Setup:
     g = request.gripper
     gripper = defaults.gripper
     if any((g.body_diameter, g.body_length, g.jaw_height, g.jaw_depth)):
-        gripper = Gripper(g.body_diameter, g.body_length, g.jaw_height, g.jaw_depth)
+        gripper = Gripper(g.body_diameter, g.body_length, g.jaw_height, g.jaw_depth,
+                          g.finger_clearance)
     grasps = tuple(GraspPose(m.name, _xyz(m.up_axis), _xyz(m.closing_axis), m.jaw_opening,
                              _xyz(m.grasp_point)) for m in request.grasps) or defaults.grasps
     place = defaults.place
@@ -62,7 +63,8 @@ def setup_from_request(request: CheckParts.Request, defaults: Setup) -> Setup:
     s = request.settings
     config = defaults.config
     if s.tilt_step != 0.0:
-        config = CheckConfig(s.tolerance, s.tilt_min, s.tilt_max, s.tilt_step)
+        config = CheckConfig(s.tolerance, s.tilt_min, s.tilt_max, s.tilt_step,
+                             s.approach_cone, s.rim_tolerance)
     return Setup(gripper, grasps, place, config)
 
 
@@ -70,14 +72,17 @@ def setup_to_request(setup: Setup, request: CheckParts.Request) -> CheckParts.Re
     """Fill a request's gripper, grasps, placement and settings from a Setup."""
     g, p, c = setup.gripper, setup.place, setup.config
     request.gripper = GripperMsg(body_diameter=g.body_diameter, body_length=g.body_length,
-                                 jaw_height=g.jaw_height, jaw_depth=g.jaw_depth)
+                                 jaw_height=g.jaw_height, jaw_depth=g.jaw_depth,
+                                 finger_clearance=g.finger_clearance)
     request.grasps = [_grasp_msg(x.name, x.up_axis, x.closing_axis, x.jaw_opening,
                                  x.grasp_point) for x in setup.grasps]
     request.place = PlaceSpecMsg(place_axis=Vector3(x=p.place_axis[0], y=p.place_axis[1],
                                                     z=p.place_axis[2]),
                                  seat_offset=p.seat_offset)
     request.settings = CheckSettings(tolerance=c.tolerance, tilt_min=c.tilt_min,
-                                     tilt_max=c.tilt_max, tilt_step=c.tilt_step)
+                                     tilt_max=c.tilt_max, tilt_step=c.tilt_step,
+                                     approach_cone=c.approach_cone,
+                                     rim_tolerance=c.rim_tolerance)
     return request
 
 
@@ -100,7 +105,7 @@ def report_to_msg(report: Report, validator: Validator, stamp: Time, frame_id: s
                   instance: int) -> ValidityReport:
     msg = ValidityReport(header=Header(stamp=stamp, frame_id=frame_id), instance=instance,
                          neighbour_check=report.neighbour_check, wall_time=report.wall_time,
-                         checked=report.counts['checked'],
+                         checked=report.counts['checked'], outside=report.counts['outside'],
                          candidates=report.counts['candidates'],
                          placeable=report.counts['placeable'],
                          container_free=report.counts['container_free'],

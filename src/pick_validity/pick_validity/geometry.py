@@ -6,11 +6,14 @@ frame. Its FCL geometry is built once and shared; a query sets the object's tran
 Rotations are (..., 3, 3) float64 arrays whose columns are the child axes; quaternions xyzw.
 """
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+import math
 
 import fcl
 import numpy as np
 from pick_common.parts import PartGeometry
+from scipy.spatial import Delaunay
 import trimesh
 
 from .config import Gripper
@@ -92,17 +95,39 @@ def part_shapes(part: PartGeometry) -> tuple[Shape, ...]:
     return tuple(shapes)
 
 
-def gripper_shapes(gripper: Gripper, opening: float) -> tuple[Shape, Shape]:
-    """The jaws' workspace cuboid (U x W x V, z from 0 to V) and the body cylinder (diameter D,
-    z from V to V + body_length), in the gripper frame: origin at the jaw tips' centre, x along
-    the closing direction, z up the gripper."""
+def gripper_shapes(gripper: Gripper, opening: float, depth: float) -> tuple[Shape, Shape]:
+    """The jaws' workspace cuboid (U x W x V, z from -depth to V - depth: the fingertips
+    `depth` below the grasp point) and the body cylinder (diameter D, from V - depth up
+    body_length), in the gripper frame: origin at the grasp point (the point the jaws close
+    on), x along the closing direction, z up the gripper."""
     v, length = gripper.jaw_height, gripper.body_length
     jaws = Shape(BOX, np.array([opening / 2, gripper.jaw_depth / 2, v / 2]), None, np.eye(3),
-                 np.array([0.0, 0.0, v / 2]), fcl.Box(opening, gripper.jaw_depth, v))
+                 np.array([0.0, 0.0, v / 2 - depth]), fcl.Box(opening, gripper.jaw_depth, v))
     body = Shape(CYLINDER, np.array([gripper.body_diameter / 2, length / 2]), None, np.eye(3),
-                 np.array([0.0, 0.0, v + length / 2]),
+                 np.array([0.0, 0.0, v - depth + length / 2]),
                  fcl.Cylinder(gripper.body_diameter / 2, length))
     return jaws, body
+
+
+def contains(shape: Shape, point: np.ndarray) -> bool:
+    """Is the point (3,), in the parent frame, inside or on the shape?"""
+    local = shape.rotation.T @ (np.asarray(point, dtype=np.float64) - shape.center)
+    if shape.kind == BOX:
+        return bool((np.abs(local) <= shape.half + 1e-12).all())
+    if shape.kind == CYLINDER:
+        return bool(math.hypot(local[0], local[1]) <= shape.half[0] + 1e-12
+                    and abs(local[2]) <= shape.half[1] + 1e-12)
+    return bool(Delaunay(shape.vertices).find_simplex(local) >= 0)
+
+
+def grasped_extent(shapes: Sequence[Shape], point: np.ndarray, up: np.ndarray) -> float:
+    """How far the grasped part reaches below the grasp point along -up, m: over the shape
+    that holds the point, or over every shape when none does (a grasp point in a gap)."""
+    point = np.asarray(point, dtype=np.float64)
+    holding = [s for s in shapes if contains(s, point)] or list(shapes)
+    down = -np.asarray(up, dtype=np.float64)
+    reach = max(float(support(s, s.rotation[None], s.center[None], down)[0]) for s in holding)
+    return reach - float(point @ down)
 
 
 def place(shape: Shape, rotation: np.ndarray, translation: np.ndarray) -> tuple[np.ndarray,

@@ -1,18 +1,23 @@
 """The staged validity check (paper section 4.1, figure 3), with python-fcl.
 
 Per part, in order, stopping at the first stage that fails:
-1. candidacy: a grasp pose's up axis within `tolerance` of world +Z (the nearest is chosen);
-2. placeability: tilts of the wrist about the closing axis at which the gripper, rigidly holding
-   the part in its place orientation, stays clear of the placing surface;
+0. location: a part whose centre is not in the container (beside it, under its floor, or
+   more than `rim_tolerance` above its rim) is answered OUTSIDE and not checked;
+1. candidacy: a grasp pose's up axis within `tolerance` of world +Z (the nearest is chosen),
+   with at least one wrist tilt whose approach lies within `approach_cone` of world +Z;
+2. placeability (figure 6): tilts at which the gripper, holding the part as it picked it,
+   stays clear of the placing surface once the pair is turned to the part's place orientation;
 3. container: of those, tilts at which the gripper clears the container's walls and floor;
 4. neighbours: of those, tilts at which the gripper clears every other part (skipped for the
    static bin analysis). A part with a tilt left is valid.
 
-The gripper frame is fixed relative to the part for a grasp and tilt (origin at the grasp point,
-z along the up axis, x along the closing axis, then rotated by the tilt about x), so placeability
-depends on the grasp and tilt only: `Validator` computes it once. Container and neighbour stages
-decide what exact bounds can decide and ask FCL the rest; `naive_check` asks FCL everything, with
-no broadphase and no caching, and must give identical results.
+The gripper closes along the grasp's closing axis as the part lies (x), and its axis (z) is
+the most vertical one perpendicular to it, turned by the wrist tilt about x; its origin is at
+the grasp point. So the part-in-gripper pose, and with it placeability, depends on how the part
+lies: the same grasp of a part tilted one way can be placed and tilted the other way not.
+Container and neighbour stages decide what exact bounds can decide and ask FCL the rest;
+`naive_check` asks FCL everything, with no broadphase and no caching, and must give identical
+results.
 
 Poses are (N, 7) float64, xyz m + xyzw unit quaternion, in the container frame (origin at the
 centre of the inner floor, +Z up).
@@ -46,6 +51,7 @@ from .config import (
 from .geometry import (
     bounds,
     collide,
+    grasped_extent,
     gripper_shapes,
     matrix_to_quaternion,
     part_shapes,
@@ -58,7 +64,11 @@ from .geometry import (
 
 # The stage a check stopped at (the one that failed), or VALID; values as in PartValidity.msg.
 STAGE_NONE, STAGE_CANDIDACY, STAGE_PLACEABILITY, STAGE_CONTAINER, STAGE_NEIGHBOUR, \
-    STAGE_VALID = range(6)
+    STAGE_VALID, STAGE_OUTSIDE = range(7)
+# The stages a part in the container passed, in order (OUTSIDE is not among them: its part
+# was not checked).
+ORDER = (STAGE_CANDIDACY, STAGE_PLACEABILITY, STAGE_CONTAINER, STAGE_NEIGHBOUR, STAGE_VALID)
+CENTRE_TOLERANCE = 0.001      # m beyond the inner walls and floor a part's centre may lie
 QUATERNION_TOLERANCE = 1e-3   # |norm - 1| accepted (and normalised); larger is refused
 MAX_PARTS = 20000
 MAX_POSITION = 10.0           # m from the instance frame; a container is at most 2 m wide
@@ -89,7 +99,8 @@ class PartResult:
 
 @dataclass
 class Report:
-    """The results of one check, in the order of the targets, with counts per stage."""
+    """The results of one check, in the order of the targets, with counts per stage (a part
+    outside the container counts as checked and in none of the stages)."""
 
     results: list[PartResult]
     neighbour_check: bool
@@ -98,13 +109,14 @@ class Report:
     counts: dict[str, int] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        stages = [r.stage for r in self.results]
+        passed = [ORDER.index(r.stage) if r.stage in ORDER else -1 for r in self.results]
         self.counts = {
-            'checked': len(stages),
-            'candidates': sum(s > STAGE_CANDIDACY for s in stages),
-            'placeable': sum(s > STAGE_PLACEABILITY for s in stages),
-            'container_free': sum(s > STAGE_CONTAINER for s in stages),
-            'valid': sum(s == STAGE_VALID for s in stages)}
+            'checked': len(passed),
+            'outside': sum(r.stage == STAGE_OUTSIDE for r in self.results),
+            'candidates': sum(p > 0 for p in passed),
+            'placeable': sum(p > 1 for p in passed),
+            'container_free': sum(p > 2 for p in passed),
+            'valid': sum(p == 4 for p in passed)}
 
 
 def check_poses(ids: Sequence[int], poses: np.ndarray) -> np.ndarray:
@@ -163,8 +175,8 @@ def _deg(rad: float) -> str:
 class Validator:
     """The checks for one part model, gripper, set of grasps, placement and settings.
 
-    Build once and reuse: part and gripper geometry and the placeability of every grasp and
-    tilt are computed here, never per part.
+    Build once and reuse: part and gripper geometry, and how deep each grasp's fingers reach,
+    are computed here, never per part.
     """
 
     def __init__(self, part: PartGeometry, gripper: Gripper, grasps: Sequence[GraspPose],
@@ -175,26 +187,57 @@ class Validator:
         self.grasps = check_grasps(list(grasps))
         self.place_axis, self.seat_offset = check_place(place_spec)
         self.tilts = tilts(self.config)
+        self._rotations = rotations_about_x(self.tilts)
         self.part_shapes = part_shapes(part)
-        self.gripper_shapes = [gripper_shapes(self.gripper, g.jaw_opening) for g in self.grasps]
-        self.frames = [self._frames(g) for g in self.grasps]
-        self.placeable = [self._placeable(k) for k in range(len(self.grasps))]
+        self.finger_depths = tuple(self._finger_depth(g) for g in self.grasps)
+        self.gripper_shapes = [gripper_shapes(self.gripper, g.jaw_opening, depth)
+                               for g, depth in zip(self.grasps, self.finger_depths, strict=True)]
         self._gripper_objects = [[s.fcl_object() for s in shapes]
                                  for shapes in self.gripper_shapes]
 
-    def _frames(self, grasp: Grasp) -> np.ndarray:
-        """Gripper rotations in the part frame, (T, 3, 3), one per tilt."""
-        return grasp_basis(grasp) @ rotations_about_x(self.tilts)
+    def _finger_depth(self, grasp: Grasp) -> float:
+        """How far below the grasp point the fingertips go, m: to `finger_clearance` above
+        the grasped part's bottom, between the grasp point and V below it."""
+        extent = grasped_extent(self.part_shapes, grasp.point, grasp.up)
+        return min(self.gripper.jaw_height,
+                   max(0.0, extent - self.gripper.finger_clearance))
 
-    def _placeable(self, k: int) -> np.ndarray:
-        """(T,) bool: the gripper stays on its side of the seating plane at each tilt."""
-        rotations = self.frames[k]
-        origin = np.broadcast_to(self.grasps[k].point, (len(self.tilts), 3))
-        clear = np.ones(len(self.tilts), dtype=bool)
-        for shape in self.gripper_shapes[k]:
-            r, c = place(shape, rotations, origin)
-            clear &= support(shape, r, c, self.place_axis) < self.seat_offset
-        return clear
+    def gripper_frames(self, rotations: np.ndarray, grasp_index: np.ndarray) -> np.ndarray:
+        """The gripper's rotations in the container frame, (n, T, 3, 3), for parts at
+        rotations (n, 3, 3) held with the grasps `grasp_index` (n,), at every tilt: x along the
+        part's closing axis, z the most vertical axis perpendicular to it, turned by the tilt
+        about x."""
+        closing = np.stack([g.closing for g in self.grasps])[grasp_index]
+        up = np.stack([g.up for g in self.grasps])[grasp_index]
+        x = np.einsum('nij,nj->ni', rotations, closing)
+        z = np.array([0.0, 0.0, 1.0]) - x[:, 2:3] * x
+        norm = np.linalg.norm(z, axis=1)
+        flat = norm < 1e-9         # a vertical closing axis: no approach within any cone
+        z[flat] = np.einsum('nij,nj->ni', rotations[flat], up[flat])
+        z /= np.linalg.norm(z, axis=1, keepdims=True)
+        base = np.stack([x, np.cross(z, x), z], axis=-1)
+        return base[:, None] @ self._rotations[None]
+
+    def _approachable(self, frames: np.ndarray) -> np.ndarray:
+        """(n, T) bool: the gripper's axis lies within the approach cone of world +Z."""
+        return frames[..., 2, 2] >= math.cos(self.config.approach_cone) - 1e-12
+
+    def _placeable(self, rotations: np.ndarray, frames: np.ndarray,
+                   grasp_index: np.ndarray) -> np.ndarray:
+        """(n, T) bool: with the part turned to its place orientation, the gripper holding it
+        as it picked it stays on the gripper's side of the seating plane. Decided in the part
+        frame, where the place orientation only fixes the seating plane."""
+        n, count = frames.shape[:2]
+        relative = (np.swapaxes(rotations, 1, 2)[:, None] @ frames).reshape(-1, 3, 3)
+        points = np.stack([g.point for g in self.grasps])[grasp_index]
+        origin = np.repeat(points, count, axis=0)
+        clear = np.ones(n * count, dtype=bool)
+        for g in np.unique(grasp_index):
+            sel = np.repeat(grasp_index == g, count)
+            for shape in self.gripper_shapes[g]:
+                r, c = place(shape, relative[sel], origin[sel])
+                clear[sel] &= support(shape, r, c, self.place_axis) < self.seat_offset
+        return clear.reshape(n, count)
 
     # ----------------------------------------------------------------------------- check
     def check(self, container: ContainerSpec, ids: Sequence[int], poses: np.ndarray,
@@ -211,13 +254,27 @@ class Validator:
         results: dict[int, PartResult] = {}
         queries = 0
 
+        # 0. location.
+        centres = positions[rows] + rotations[rows] @ self.part.center
+        located = containers.inside(container, centres, CENTRE_TOLERANCE,
+                                    self.config.rim_tolerance)
+        for n in np.flatnonzero(~located):
+            row = rows[n]
+            results[row] = PartResult(ids[row], STAGE_OUTSIDE, _outside_reason(
+                container, centres[n], self.config.rim_tolerance))
+        inner = [row for row, ok in zip(rows, located, strict=True) if ok]
+
         # 1. candidacy, vectorised over targets and grasps.
         ups = np.stack([g.up for g in self.grasps])                     # (G, 3)
-        z = np.einsum('njk,gk->ngj', rotations[rows], ups)[:, :, 2]     # (n, G)
+        z = np.einsum('njk,gk->ngj', rotations[inner], ups)[:, :, 2]    # (n, G)
         angles = np.arccos(np.clip(z, -1.0, 1.0))
-        best = angles.argmin(axis=1)
+        best = angles.argmin(axis=1) if len(inner) else np.zeros(0, dtype=int)
+        frames = self.gripper_frames(rotations[inner], best)            # (n, T, 3, 3)
+        approach = self._approachable(frames)
+        placeable = self._placeable(rotations[inner], frames, best) & approach
         kept: dict[int, np.ndarray] = {}
-        for n, row in enumerate(rows):
+        world_frames: dict[int, np.ndarray] = {}
+        for n, row in enumerate(inner):
             g, angle = int(best[n]), float(angles[n, best[n]])
             result = PartResult(ids[row], STAGE_CANDIDACY, '', g, angle,
                                 jaw_opening=self.grasps[g].jaw_opening)
@@ -227,41 +284,58 @@ class Validator:
                 result.reason = (f'no grasp pose within {_deg(self.config.tolerance)} of +Z: '
                                  f'the nearest, {self.grasps[g].name!r}, is at {_deg(angle)}')
                 continue
-            # 2. placeability: precomputed per grasp and tilt.
-            if not self.placeable[g].any():
-                result.stage = STAGE_PLACEABILITY
-                result.reason = (f'grasp {self.grasps[g].name!r}: the gripper hits the placing '
-                                 f'surface at every tilt')
+            if not approach[n].any():
+                rise = math.asin(min(1.0, abs(float(frames[n, 0, 2, 0]))))
+                result.reason = (f'grasp {self.grasps[g].name!r}: no wrist tilt approaches '
+                                 f'within {_deg(self.config.approach_cone)} of +Z (the '
+                                 f'closing axis rises {_deg(rise)})')
                 continue
-            kept[row] = self.placeable[g].copy()
+            # 2. placeability of the tilts within the approach cone.
+            if not placeable[n].any():
+                result.stage = STAGE_PLACEABILITY
+                result.reason = (f'grasp {self.grasps[g].name!r}: held as it lies, the part '
+                                 f'cannot be placed: the gripper hits the placing surface at '
+                                 f'each of the {int(approach[n].sum())} tilts within the '
+                                 f'approach cone')
+                continue
+            kept[row] = placeable[n].copy()
+            world_frames[row] = frames[n]
 
         # 3. container, 4. neighbours: vectorised over every (part, tilt) pair left.
-        pairs = _Pairs(self, kept, results, rotations, positions)
+        pairs = _Pairs(self, kept, results, world_frames, rotations, positions)
         queries += pairs.container(container)
         if neighbour_check:
             queries += pairs.neighbours(ids, rotations, positions)
         for row, mask in kept.items():
             if mask.any():
-                self._finish_valid(results[row], mask, rotations[row], positions[row])
+                self._finish_valid(results[row], mask, world_frames[row], rotations[row],
+                                   positions[row])
         return Report([results[row] for row in rows], neighbour_check, queries,
                       time.perf_counter() - start)
 
-    def _gripper_in_world(self, rotation, position, g, k_idx):
-        """Gripper rotations (K, 3, 3) and origins (K, 3) in the container frame."""
-        rot = rotation @ self.frames[g][k_idx]
-        origin = np.broadcast_to(position + rotation @ self.grasps[g].point, (len(k_idx), 3))
-        return rot, origin
-
-    def _finish_valid(self, result: PartResult, mask: np.ndarray, rotation, position) -> None:
+    def _finish_valid(self, result: PartResult, mask: np.ndarray, frames: np.ndarray,
+                      rotation: np.ndarray, position: np.ndarray) -> None:
         g = result.grasp_index
         valid = np.flatnonzero(mask)
         result.stage = STAGE_VALID
         result.valid_tilts = tuple(float(self.tilts[k]) for k in valid)
         k = valid[np.abs(self.tilts[valid]).argmin()]
-        rot, origin = self._gripper_in_world(rotation, position, g, np.array([k]))
-        result.gripper_pose = np.concatenate([origin[0], matrix_to_quaternion(rot[0])])
+        origin = position + rotation @ self.grasps[g].point
+        result.gripper_pose = np.concatenate([origin, matrix_to_quaternion(frames[k])])
         result.reason = (f'valid with grasp {self.grasps[g].name!r} at {len(valid)} of '
                          f'{len(self.tilts)} tilts')
+
+
+def _outside_reason(container: ContainerSpec, centre: np.ndarray, rim: float) -> str:
+    x, y, z = container.inner_size
+    mm = ', '.join(f'{1000 * c:.1f}' for c in centre)
+    if centre[2] < -CENTRE_TOLERANCE:
+        where = 'below the floor'
+    elif abs(centre[0]) > x / 2 + CENTRE_TOLERANCE or abs(centre[1]) > y / 2 + CENTRE_TOLERANCE:
+        where = f'beside the container (inner {1000 * x:g} x {1000 * y:g} mm)'
+    else:
+        where = f'more than {1000 * rim:g} mm (check.rim_tolerance) above its {1000 * z:g} mm rim'
+    return f'not in the container: its centre ({mm}) mm lies {where}; not checked'
 
 
 class _Pairs:
@@ -269,8 +343,8 @@ class _Pairs:
     in the container frame, their exact bounds, and the masks of `kept` to update."""
 
     def __init__(self, v: Validator, kept: dict[int, np.ndarray],
-                 results: dict[int, PartResult], rotations: np.ndarray,
-                 positions: np.ndarray) -> None:
+                 results: dict[int, PartResult], frames: dict[int, np.ndarray],
+                 rotations: np.ndarray, positions: np.ndarray) -> None:
         self.v, self.kept, self.results = v, kept, results
         rows, ks = [], []
         for row, mask in kept.items():
@@ -289,7 +363,8 @@ class _Pairs:
         for g in np.unique(self.g):
             sel = np.flatnonzero(self.g == g)
             r = rotations[self.row[sel]]
-            frame = r @ v.frames[g][self.k[sel]]
+            frame = np.stack([frames[row][k] for row, k in zip(self.row[sel], self.k[sel],
+                                                                strict=True)])
             origin = positions[self.row[sel]] + r @ v.grasps[g].point
             self.grasp_point[sel] = origin
             for s, shape in enumerate(v.gripper_shapes[g]):
@@ -395,12 +470,6 @@ class _Pairs:
         return queries
 
 
-def grasp_basis(grasp: Grasp) -> np.ndarray:
-    """The gripper's rotation in the part frame at tilt 0: x along the closing axis, z along
-    the up axis, (3, 3)."""
-    return np.column_stack([grasp.closing, np.cross(grasp.up, grasp.closing), grasp.up])
-
-
 def _radius(shape: Shape) -> float:
     """Radius of a sphere about the shape's center that encloses it, m."""
     if shape.kind == 'hull':
@@ -413,8 +482,10 @@ def _radius(shape: Shape) -> float:
 def naive_check(validator: Validator, container: ContainerSpec, ids: Sequence[int],
                 poses: np.ndarray, targets: Iterable[int] | None = None,
                 neighbour_check: bool = True) -> Report:
-    """The reference: every part, every tilt, every other part, FCL for every decision, no
-    broadphase, no bounds, no caching. Same results as `Validator.check`, far slower."""
+    """The reference: every part, every tilt, every other part, FCL for every decision (the
+    placing surface a half-space in the part frame), no broadphase, no bounds, no caching;
+    the gripper's frame built per tilt from its definition. Same results as
+    `Validator.check`, far slower."""
     start = time.perf_counter()
     v = validator
     ids = [int(i) for i in ids]
@@ -427,28 +498,52 @@ def naive_check(validator: Validator, container: ContainerSpec, ids: Sequence[in
              for h, c in containers.wall_boxes(container)]
     surface = fcl.CollisionObject(fcl.Halfspace(-v.place_axis, -v.seat_offset),
                                   fcl.Transform())
+    x, y, z = container.inner_size
     queries = 0
     results = []
     for row in rows:
-        angles = [math.acos(max(-1.0, min(1.0, float((rotations[row] @ g.up)[2]))))
+        rotation, position = rotations[row], positions[row]
+        centre = position + rotation @ v.part.center
+        if not (abs(centre[0]) <= x / 2 + CENTRE_TOLERANCE
+                and abs(centre[1]) <= y / 2 + CENTRE_TOLERANCE
+                and -CENTRE_TOLERANCE <= centre[2] <= z + v.config.rim_tolerance
+                + CENTRE_TOLERANCE):
+            results.append(PartResult(ids[row], STAGE_OUTSIDE, 'outside'))
+            continue
+        angles = [math.acos(max(-1.0, min(1.0, float((rotation @ g.up)[2]))))
                   for g in v.grasps]
         g = int(np.argmin(angles))
+        grasp = v.grasps[g]
         result = PartResult(ids[row], STAGE_CANDIDACY, '', g, angles[g],
-                            jaw_opening=v.grasps[g].jaw_opening)
+                            jaw_opening=grasp.jaw_opening)
         results.append(result)
         if angles[g] > v.config.tolerance:
             result.grasp_index = -1
             continue
-        shapes = gripper_shapes(v.gripper, v.grasps[g].jaw_opening)
+        shapes = gripper_shapes(v.gripper, grasp.jaw_opening, v.finger_depths[g])
         objects = [s.fcl_object() for s in shapes]
-        base = grasp_basis(v.grasps[g])
+        closing = rotation @ grasp.closing
+        frames = []
+        for tilt in v.tilts:
+            # the vertical made perpendicular to the closing axis, turned by the tilt about it
+            axis = np.array([0.0, 0.0, 1.0]) - closing[2] * closing
+            if np.linalg.norm(axis) < 1e-9:
+                axis = rotation @ grasp.up
+            axis /= np.linalg.norm(axis)
+            side = np.cross(axis, closing)
+            up = math.cos(tilt) * axis - math.sin(tilt) * side
+            frames.append(np.column_stack([closing, np.cross(up, closing), up]))
+        approach = [k for k, f in enumerate(frames)
+                    if f[2, 2] >= math.cos(v.config.approach_cone) - 1e-12]
+        if not approach:
+            continue
         kept = []
-        for k, tilt in enumerate(v.tilts):
-            frame = base @ rotations_about_x(np.array([tilt]))[0]
+        for k in approach:
+            relative = rotation.T @ frames[k]
             clear = True
             for s, obj in zip(shapes, objects, strict=True):
-                obj.setTransform(fcl.Transform(frame @ s.rotation,
-                                               v.grasps[g].point + frame @ s.center))
+                obj.setTransform(fcl.Transform(relative @ s.rotation,
+                                               grasp.point + relative @ s.center))
                 queries += 1
                 clear &= not collide(obj, surface)
             if clear:
@@ -457,10 +552,9 @@ def naive_check(validator: Validator, container: ContainerSpec, ids: Sequence[in
             result.stage = STAGE_PLACEABILITY
             continue
 
-        def placed(k, s, row=row, base=base, g=g):
-            frame = rotations[row] @ base @ rotations_about_x(np.array([v.tilts[k]]))[0]
-            origin = positions[row] + rotations[row] @ v.grasps[g].point
-            return fcl.Transform(frame @ s.rotation, origin + frame @ s.center)
+        def placed(k, s, frames=frames, position=position, rotation=rotation, grasp=grasp):
+            origin = position + rotation @ grasp.point
+            return fcl.Transform(frames[k] @ s.rotation, origin + frames[k] @ s.center)
 
         free = []
         for k in kept:

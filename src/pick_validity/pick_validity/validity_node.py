@@ -47,7 +47,10 @@ class ValidityNode(Node):
                             LIMITS['gripper.body_length']),
             jaw_height=get('gripper.jaw_height', d.jaw_height, 'V, m',
                            LIMITS['gripper.jaw_height']),
-            jaw_depth=get('gripper.jaw_depth', d.jaw_depth, 'W, m', LIMITS['gripper.jaw_depth']))
+            jaw_depth=get('gripper.jaw_depth', d.jaw_depth, 'W, m', LIMITS['gripper.jaw_depth']),
+            finger_clearance=get('gripper.finger_clearance', d.finger_clearance,
+                                 "height of the fingertips above the grasped part's bottom, m",
+                                 LIMITS['gripper.finger_clearance']))
         defaults = {g.name: g for g in CAPACITOR_GRASPS}
         names = get('grasp_names', list(defaults),
                     'names of the grasp poses; each has grasps.<name>.* parameters')
@@ -62,7 +65,7 @@ class ValidityNode(Node):
                           "part axis along the jaws' closing direction")),
                 get(prefix + 'jaw_opening', d.jaw_opening, 'U, m', LIMITS['jaw_opening']),
                 tuple(get(prefix + 'grasp_point', list(d.grasp_point),
-                          "jaw tips' centre in the part frame, m"))))
+                          'point the jaws close on, in the part frame, m'))))
         p = PlaceSpec()
         place = PlaceSpec(
             place_axis=tuple(get('place.axis', list(p.place_axis),
@@ -76,7 +79,13 @@ class ValidityNode(Node):
                           'from +Z, rad', LIMITS['check.tolerance']),
             tilt_min=get('check.tilt_min', c.tilt_min, 'rad', LIMITS['check.tilt_min']),
             tilt_max=get('check.tilt_max', c.tilt_max, 'rad', LIMITS['check.tilt_max']),
-            tilt_step=get('check.tilt_step', c.tilt_step, 'rad', LIMITS['check.tilt_step']))
+            tilt_step=get('check.tilt_step', c.tilt_step, 'rad', LIMITS['check.tilt_step']),
+            approach_cone=get('check.approach_cone', c.approach_cone,
+                              "largest angle of the gripper's axis from +Z, rad",
+                              LIMITS['check.approach_cone']),
+            rim_tolerance=get('check.rim_tolerance', c.rim_tolerance,
+                              "how far above the container's rim a part's centre may lie, m",
+                              LIMITS['check.rim_tolerance']))
         self._mesh_dirs = declare_mesh_dirs(self)
         return gripper, tuple(grasps), place, config
 

@@ -15,6 +15,7 @@ from pick_validity.validity import (
     STAGE_CANDIDACY,
     STAGE_CONTAINER,
     STAGE_NEIGHBOUR,
+    STAGE_OUTSIDE,
     STAGE_PLACEABILITY,
     STAGE_VALID,
     Validator,
@@ -67,25 +68,110 @@ def test_the_nearest_grasp_pose_is_chosen():
     assert math.isclose(report.results[0].candidacy_angle, math.radians(30))
 
 
-def test_placement_hits_the_surface_at_some_tilts_and_not_others():
+DEEP = ContainerSpec(inner_size=(0.2, 0.2, 0.1))
+THIN = Gripper(body_diameter=0.004, jaw_depth=0.004)
+FAR = PlaceSpec(seat_offset=0.5)      # a seat no gripper reaches: placeability never decides
+
+
+def _tilted(pitch_deg: float, roll_deg: float = 0.0, z: float = 0.03) -> np.ndarray:
+    """A lying capacitor held in the air (nothing near it), pitched by pitch_deg about its
+    closing axis (world Y) after a roll of roll_deg about its body axis: pose (7,)."""
+    pose = _lying(0, 0, roll_deg)
+    rotation = Rotation.from_euler('y', pitch_deg, degrees=True) * Rotation.from_quat(pose[3:])
+    return np.concatenate([[0, 0, z], rotation.as_quat()])
+
+
+def _tilts(validator: Validator, pose: np.ndarray) -> tuple[int, tuple[int, ...]]:
+    result = validator.check(DEEP, [1], [pose], neighbour_check=False).results[0]
+    return result.stage, tuple(round(math.degrees(t)) for t in result.valid_tilts)
+
+
+def test_placeability_depends_on_how_the_part_lies():
+    # The gripper comes from above and holds the part as it lies; placing turns the pair so
+    # that the part's -Z (the seat at 5.5 mm) points down. Lying flat, a tilt a leans the
+    # gripper's axis by a from the part's +X towards -Z or +Z: the 20 mm body clears the seat
+    # only leaning away from it (a <= -20 deg).
     v = _validator()
-    placeable = v.placeable[0]
-    # Tilt 0: the 20 mm body reaches 10 mm along the part's -Z, past the seat at 5.5 mm.
-    assert not placeable[np.argmin(np.abs(v.tilts))]
-    # A tilt a about the closing axis (part Y) turns the gripper axis to cos(a) X - sin(a) Z:
-    # negative tilts lean the body away from the seat (part -Z), positive ones into it.
-    assert placeable[0] and not placeable[-1]
-    assert math.isclose(v.tilts[0], -math.pi / 4) and math.isclose(v.tilts[-1], math.pi / 4)
-    # A gripper as thin as the part clears it upright and at more tilts (its 75 mm reach still
-    # crosses the seat once tilted 5 deg into it); a huge jaw never clears it.
-    thin = Validator(CAPACITOR, Gripper(body_diameter=0.004, jaw_depth=0.004), [SIDE],
-                     PlaceSpec())
-    assert thin.placeable[0][np.argmin(np.abs(v.tilts))]
-    assert thin.placeable[0].sum() > placeable.sum()
+    stage, flat = _tilts(v, _tilted(0))
+    assert stage == STAGE_VALID and flat == tuple(range(-45, -15, 5)), flat
+    # Pitch the part 20 deg about the closing axis: wrist tilt a is now a - 20 or a + 20
+    # relative to the part, so the placeable wrist tilts are those with a -+ 20 <= -20.
+    assert _tilts(v, _tilted(20)) == (STAGE_VALID, tuple(range(-45, 5, 5)))
+    assert _tilts(v, _tilted(-20)) == (STAGE_VALID, (-45, -40))
+    # Pitched 30 deg the wrong way, no wrist tilt can place it: the same grasp, another answer.
+    result = v.check(DEEP, [1], [_tilted(-30)], neighbour_check=False).results[0]
+    assert result.stage == STAGE_PLACEABILITY and result.grasp_index == 0
+    assert 'cannot be placed' in result.reason
+    assert _tilts(v, _tilted(30)) == (STAGE_VALID, tuple(range(-45, 15, 5)))
+    # A huge jaw never clears the seat, however the part lies.
     wide = Validator(CAPACITOR, Gripper(jaw_depth=0.05), [SIDE], PlaceSpec())
-    assert not wide.placeable[0].any()
-    report = wide.check(BIN, [1], [_lying(0, 0)], neighbour_check=False)
-    assert report.results[0].stage == STAGE_PLACEABILITY
+    assert _tilts(wide, _tilted(20))[0] == STAGE_PLACEABILITY
+
+
+def test_the_gripper_stays_within_the_approach_cone():
+    # Rolled 40 deg about its body axis, the lying part's closing axis rises 40 deg: the
+    # gripper's axis leans at least 40 deg from the vertical, and tilt a makes it
+    # acos(cos 40 cos a): within the 45 deg cone for |a| <= 22.6 deg.
+    v = Validator(CAPACITOR, THIN, [SIDE], FAR)
+    assert _tilts(v, _tilted(0))[1] == tuple(range(-45, 50, 5))
+    assert _tilts(v, _tilted(0, roll_deg=40))[1] == tuple(range(-20, 25, 5))
+    narrow = Validator(CAPACITOR, THIN, [SIDE], FAR,
+                       CheckConfig(approach_cone=math.radians(30)))
+    result = narrow.check(DEEP, [1], [_tilted(0, roll_deg=40)], neighbour_check=False)
+    assert result.results[0].stage == STAGE_CANDIDACY
+    assert 'no wrist tilt approaches within 30.0 deg' in result.results[0].reason
+    # The reported gripper pose is the most vertical valid one: its axis straight up.
+    pose = v.check(DEEP, [1], [_tilted(30)], neighbour_check=False).results[0].gripper_pose
+    assert np.allclose(Rotation.from_quat(pose[3:]).apply([0, 0, 1.0]), [0, 0, 1])
+
+
+def test_the_fingertips_reach_down_the_grasped_part():
+    # Side grasp of a lying capacitor: the body (radius 2.5 mm) is the primitive holding the
+    # grasp point, so the fingertips go 2.5 mm - clearance below the body's axis.
+    v = _validator()
+    assert math.isclose(v.finger_depths[0], RADIUS - 0.001)
+    assert math.isclose(_validator(grasps=(TOP,)).finger_depths[0], 0.0055 + 0.002 - 0.001)
+    # Lying 0.5 mm into the floor (as resting parts do in the physics): with no clearance the
+    # fingertips, and nothing else, go through the floor at every tilt.
+    sunk = _lying(0, 0)
+    sunk[2] -= 0.0005
+    touching = Validator(CAPACITOR, Gripper(finger_clearance=0.0), [SIDE], PlaceSpec())
+    result = touching.check(BIN, [1], [sunk], neighbour_check=False).results[0]
+    assert result.stage == STAGE_CONTAINER, result.reason
+    # With the default 1 mm they stop 1.5 mm below the axis, which lies 2.0 mm above the
+    # floor: they clear it straight down. Tilted by a, the 4 mm deep jaws' lower edge swings
+    # to 1.5 cos a + 2 sin |a| mm below the axis: above the floor up to 10 deg, into it from
+    # 15 deg. (The default 20 mm body hits the seat below 20 deg: a far seat keeps
+    # placeability out of this.)
+    sunk[2] -= 0.0001
+    clear = Validator(CAPACITOR, THIN, [SIDE], FAR)
+    assert _tilts(clear, sunk) == (STAGE_VALID, (-10, -5, 0, 5, 10))
+
+
+@pytest.mark.parametrize(('where', 'position', 'words'), [
+    ('beside', (0.13, 0.0, RADIUS), 'beside the container'),
+    ('below', (0.0, 0.0, -0.006), 'below the floor'),
+    ('above', (0.0, 0.0, 0.03 + 0.025), 'more than 20 mm (check.rim_tolerance) above'),
+])
+def test_a_part_not_in_the_container_is_answered_outside(where, position, words):
+    pose = _lying(0, 0)
+    pose[:3] = position
+    # The other part lies off to the side: the part outside is still an obstacle.
+    report = _validator().check(BIN, [1, 2], [pose, _lying(0, 0.06)])
+    outside, inside = report.results
+    assert outside.stage == STAGE_OUTSIDE and not outside.valid, outside.reason
+    assert words in outside.reason and 'not checked' in outside.reason
+    assert inside.valid
+    assert report.counts['outside'] == 1 and report.counts['checked'] == 2
+    assert report.counts['candidates'] == 1
+    naive = naive_check(_validator(), BIN, [1, 2], [pose, _lying(0, 0.06)])
+    assert [r.stage for r in naive.results] == [STAGE_OUTSIDE, STAGE_VALID]
+
+
+def test_a_part_just_above_the_rim_is_still_in_the_container():
+    pose = _lying(0, 0)
+    pose[2] = 0.03 + 0.015        # on a heap 15 mm above the 30 mm rim
+    assert _validator().check(BIN, [1], [pose], neighbour_check=False).results[0].valid
 
 
 def test_a_part_in_the_middle_is_valid_and_against_a_wall_is_not():
@@ -116,7 +202,7 @@ def test_counts_per_stage():
     v = _validator()
     poses = [_lying(0, 0), _lying(0, 0.06, 60.0), _lying(0, BIN.inner_size[1] / 2 - RADIUS)]
     report = v.check(BIN, [1, 2, 3], poses)
-    assert report.counts == {'checked': 3, 'candidates': 2, 'placeable': 2,
+    assert report.counts == {'checked': 3, 'outside': 0, 'candidates': 2, 'placeable': 2,
                              'container_free': 1, 'valid': 1}
 
 
@@ -135,12 +221,16 @@ def test_fast_check_equals_the_naive_loop_on_settled_scenes(container, model, co
         ('+', 'x', (1, 0, 0), (0, 1, 0)), ('-', 'x', (-1, 0, 0), (0, 1, 0)),
         ('+', 'y', (0, 1, 0), (1, 0, 0)), ('-', 'y', (0, -1, 0), (1, 0, 0)),
         ('+', 'z', (0, 0, 1), (1, 0, 0)), ('-', 'z', (0, 0, -1), (1, 0, 0)))]
-    v = Validator(part, Gripper(), grasps, PlaceSpec(seat_offset=0.003))
-    for neighbours in (False, True):
-        fast = v.check(container, state.ids, state.poses, neighbour_check=neighbours)
-        naive = naive_check(v, container, state.ids, state.poses, neighbour_check=neighbours)
-        assert [r.key() for r in fast.results] == [r.key() for r in naive.results]
-        assert fast.queries < naive.queries
+    # The default gripper stops most parts at placeability or the container; a thin one
+    # lets more through to the later stages.
+    for gripper in (Gripper(), THIN):
+        v = Validator(part, gripper, grasps, PlaceSpec(seat_offset=0.003))
+        for neighbours in (False, True):
+            fast = v.check(container, state.ids, state.poses, neighbour_check=neighbours)
+            naive = naive_check(v, container, state.ids, state.poses,
+                                neighbour_check=neighbours)
+            assert [r.key() for r in fast.results] == [r.key() for r in naive.results]
+            assert fast.queries < naive.queries
     stages = {r.stage for r in fast.results}
     assert len(stages) >= 3, f'a scene that exercises several stages, got {stages}'
 
@@ -219,6 +309,8 @@ def test_an_unnamed_bad_grasp_is_named_by_its_index():
     (dict(tolerance=math.nan), 'check.tolerance: nan must be finite'),
     (dict(tilt_min=0.5, tilt_max=0.1), 'check.tilt_max: 0.1 must be >= 0.5'),
     (dict(tilt_step=1e-4), 'check.tilt_step'),
+    (dict(approach_cone=0.0), 'check.approach_cone: 0.0 must be > 0'),
+    (dict(rim_tolerance=-0.01), 'check.rim_tolerance: -0.01 must be >= 0'),
 ])
 def test_bad_check_settings_are_refused(config, rule):
     with pytest.raises(InvalidArgument, match=rule):
@@ -228,5 +320,7 @@ def test_bad_check_settings_are_refused(config, rule):
 def test_bad_gripper_and_placement_are_refused():
     with pytest.raises(InvalidArgument, match='gripper.body_diameter: -0.02 must be > 0'):
         Validator(CAPACITOR, Gripper(body_diameter=-0.02), [SIDE], PlaceSpec())
+    with pytest.raises(InvalidArgument, match='gripper.finger_clearance: nan must be finite'):
+        Validator(CAPACITOR, Gripper(finger_clearance=math.nan), [SIDE], PlaceSpec())
     with pytest.raises(InvalidArgument, match='place.place_axis: .* is a zero vector'):
         Validator(CAPACITOR, Gripper(), [SIDE], PlaceSpec(place_axis=(0, 0, 0)))
