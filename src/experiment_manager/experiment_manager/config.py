@@ -410,13 +410,19 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         body_diameter=g.number('body_diameter_mm', d.body_diameter / MM, scale=MM),
         body_length=g.number('body_length_mm', d.body_length / MM, scale=MM),
         jaw_height=g.number('jaw_height_mm', d.jaw_height / MM, scale=MM),
-        jaw_depth=g.number('jaw_depth_mm', d.jaw_depth / MM, scale=MM))
+        jaw_depth=g.number('jaw_depth_mm', d.jaw_depth / MM, scale=MM),
+        finger_clearance=g.number('finger_clearance_mm', d.finger_clearance / MM, scale=MM))
     g.done()
     c = m.sub('check')
-    check = CheckConfig(tolerance=c.number('tolerance_deg', 45.0, scale=DEG),
-                        tilt_min=c.number('tilt_min_deg', -45.0, scale=DEG),
-                        tilt_max=c.number('tilt_max_deg', 45.0, scale=DEG),
-                        tilt_step=c.number('tilt_step_deg', 5.0, scale=DEG))
+    dc = CheckConfig()
+    check = CheckConfig(tolerance=c.number('tolerance_deg', dc.tolerance / DEG, scale=DEG),
+                        tilt_min=c.number('tilt_min_deg', dc.tilt_min / DEG, scale=DEG),
+                        tilt_max=c.number('tilt_max_deg', dc.tilt_max / DEG, scale=DEG),
+                        tilt_step=c.number('tilt_step_deg', dc.tilt_step / DEG, scale=DEG),
+                        approach_cone=c.number('approach_cone_deg', dc.approach_cone / DEG,
+                                               scale=DEG),
+                        rim_tolerance=c.number('rim_tolerance_mm', dc.rim_tolerance / MM,
+                                               scale=MM))
     search_order = c.text('search_order', 'top_first', SEARCH_ORDERS)
     c.done()
     r = m.sub('requirements')

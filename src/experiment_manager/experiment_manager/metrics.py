@@ -80,7 +80,9 @@ def fit_optimum(counts, valid, first: int, last: int, margin: int) -> dict:
     best = int(grid[int(np.argmax(np.polyval(coefficients, grid)))])
     return {'order': order, 'coefficients': coefficients.tolist(), 'n_star': best,
             'fit_max': float(np.polyval(coefficients, best)),
-            'optimal_range': [max(1, best - margin), best + margin]}
+            'optimal_range': [max(1, best - margin), best + margin],
+            # No valid part at any count: the fit is flat and n* says nothing.
+            'no_valid': not np.any(np.asarray(valid) > 0)}
 
 
 def table_sweep(exp: Experiment, rows: list[dict]) -> dict:

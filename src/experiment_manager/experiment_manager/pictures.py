@@ -3,8 +3,8 @@
 An iteration is re-simulated from its seed on the cores (the same physics as the nodes: the
 settled poses are identical to the recorded ones, which is checked and said in the caption):
 - `bin.png`: the first bin_emptying iteration's settled bin, with the gripper of its first pick
-  (green, a valid grasp) and the gripper of a rejected part at tilt 0 (red: it hits the bin or
-  a neighbour);
+  (green, a valid grasp) and the gripper of a rejected part at the tilt nearest 0, the most
+  vertical approach (red: it hits the bin or a neighbour);
 - `tray.png`: the first table_sweep iteration at the count nearest the optimum n*.
 """
 
@@ -16,8 +16,8 @@ import matplotlib.image
 import numpy as np
 from pick_common.specs import SceneSpec
 from pick_sim_world.world import Overlay, World
-from pick_validity.config import check_grasps, Gripper
-from pick_validity.validity import grasp_basis, STAGE_CONTAINER, STAGE_NEIGHBOUR
+from pick_validity.geometry import BOX, Shape
+from pick_validity.validity import STAGE_CONTAINER, STAGE_NEIGHBOUR, Validator
 from scipy.spatial.transform import Rotation
 
 from .config import BIN_EMPTYING, ExperimentFile, TABLE_SWEEP
@@ -27,19 +27,20 @@ SIZE = (800, 600)
 GREEN, RED = (0.1, 0.8, 0.1, 0.55), (0.9, 0.1, 0.1, 0.55)
 
 
-def gripper_overlays(gripper: Gripper, opening: float, pose, rgba) -> list[Overlay]:
-    """The simplified gripper at a pose (7,) of its frame: the jaws' cuboid (U x W x V above
-    the grasp point) and the body cylinder above it."""
+def gripper_overlays(shapes: tuple[Shape, ...], pose, rgba) -> list[Overlay]:
+    """The validity check's simplified gripper (its shapes, in the gripper frame: the jaws'
+    cuboid around the grasp point and the body cylinder above it) at a pose (7,) of its
+    frame."""
     pose = np.asarray(pose, dtype=float)
     rotation = Rotation.from_quat(pose[3:])
-    v, length = gripper.jaw_height, gripper.body_length
-
-    def at(offset) -> tuple[float, ...]:
-        return (*(pose[:3] + rotation.apply(offset)), *pose[3:])
-
-    return [Overlay('box', (opening / 2, gripper.jaw_depth / 2, v / 2), at((0, 0, v / 2)), rgba),
-            Overlay('cylinder', (gripper.body_diameter / 2, length),
-                    at((0, 0, v + length / 2)), rgba)]
+    overlays = []
+    for shape in shapes:
+        at = (*(pose[:3] + rotation.apply(shape.center)),
+              *(rotation * Rotation.from_matrix(shape.rotation)).as_quat())
+        size = (tuple(shape.half) if shape.kind == BOX
+                else (shape.half[0], 2 * shape.half[1]))
+        overlays.append(Overlay(shape.kind, size, at, rgba))
+    return overlays
 
 
 def _rows(run_dir: str, name: str, experiment: str, iteration: int = 0) -> list[dict]:
@@ -81,33 +82,38 @@ def bin_picture(file: ExperimentFile, summary: dict, run_dir: str) -> str | None
     parts, picks = _rows(run_dir, 'parts', exp.id), _rows(run_dir, 'picks', exp.id)
     if not parts:
         return None
-    grasps = check_grasps(list(file.grasps))
     with _settle(file, unit) as world:
+        validator = Validator(world.part, file.gripper, file.grasps, file.place, file.check)
+        grasps = validator.grasps
         same = _same_as_recorded(world, parts, 0)
         overlays, notes = [], []
         if picks:
             p = picks[0]
             pose = [float(p[k]) for k in ('gripper_x', 'gripper_y', 'gripper_z', 'gripper_qx',
                                           'gripper_qy', 'gripper_qz', 'gripper_qw')]
-            overlays += gripper_overlays(file.gripper, grasps[int(p['grasp'])].jaw_opening,
-                                         pose, GREEN)
+            overlays += gripper_overlays(validator.gripper_shapes[int(p['grasp'])], pose,
+                                         GREEN)
             notes.append(f'green: the first pick, part {p["part_id"]} (grasp '
                          f'{grasps[int(p["grasp"])].name}), found after {p["searches"]} '
                          'parts in search order')
         rejected = next((r for r in parts if r['check'] == '0' and int(r['grasp']) >= 0
                          and int(r['stage']) in (STAGE_CONTAINER, STAGE_NEIGHBOUR)), None)
         if rejected is not None:
-            g = grasps[int(rejected['grasp'])]
+            index = int(rejected['grasp'])
+            g = grasps[index]
             position = np.array([float(rejected[k]) for k in ('x', 'y', 'z')])
             part_rotation = Rotation.from_quat([float(rejected[k])
                                                 for k in ('qx', 'qy', 'qz', 'qw')])
-            rotation = part_rotation * Rotation.from_matrix(grasp_basis(g))
+            frames = validator.gripper_frames(part_rotation.as_matrix()[None],
+                                              np.array([index]))
+            tilt = int(np.abs(validator.tilts).argmin())
+            rotation = Rotation.from_matrix(frames[0, tilt])
             origin = position + part_rotation.apply(g.point)
-            overlays += gripper_overlays(file.gripper, g.jaw_opening,
+            overlays += gripper_overlays(validator.gripper_shapes[index],
                                          (*origin, *rotation.as_quat()), RED)
             why = 'the bin' if int(rejected['stage']) == STAGE_CONTAINER else 'a neighbour'
-            notes.append(f'red: part {rejected["part_id"]} (grasp {g.name}) at tilt 0, '
-                         f'rejected: it hits {why}')
+            notes.append(f'red: part {rejected["part_id"]} (grasp {g.name}) at the most '
+                         f'vertical approach, rejected: it hits {why}')
         image = world.render(*SIZE, overlays=overlays, **_camera(unit))
     _save(os.path.join(run_dir, 'bin.png'), image)
     size = ' x '.join(f'{s * 1000:g}' for s in unit.container.inner_size)

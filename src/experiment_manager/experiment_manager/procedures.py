@@ -73,7 +73,7 @@ def run_unit(file: ExperimentFile, u: Unit, backend: Backend) -> Record:
         'experiment': u.experiment.id, 'type': u.experiment.type, 'group': u.group,
         'iteration': u.iteration, 'seed': u.seed, 'container_x': x, 'container_y': y,
         'container_z': z, 'parts': u.parts,
-        **{k: first.get(k, 0) for k in ('checked', 'candidates', 'placeable',
+        **{k: first.get(k, 0) for k in ('checked', 'outside', 'candidates', 'placeable',
                                          'container_free', 'valid')},
         'checks': len(record.checks), 'picks': len(record.picks),
         **row, 'fault': faults(row), 'wall_time': time.monotonic() - start}
@@ -110,7 +110,8 @@ class Iteration:
         targets = states.ids[states.inside]
         index = len(record.checks)
         row = {**self.key, 'check': index, 'parts_on_table': int(len(targets)),
-               'checked': 0, 'candidates': 0, 'placeable': 0, 'container_free': 0, 'valid': 0,
+               'checked': 0, 'outside': 0, 'candidates': 0, 'placeable': 0,
+               'container_free': 0, 'valid': 0,
                'picked_id': -1, 'searches': 0, 'vibrations': vibrations, 'wall_time': 0.0}
         report = None
         stages: dict[int, tuple[int, int, int]] = {}

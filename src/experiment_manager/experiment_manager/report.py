@@ -160,6 +160,11 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
         lines += ['', f'## Vibrating table sweep (`{exp_id}`, figure 15)', '']
         if figures.get('fig15'):
             lines += ['![figure 15](fig15_table.png)', '']
+        if s.get('no_valid'):
+            lines += ['**No valid part at any count**: with this gripper and these grasps no '
+                      'part on the table can be picked and placed, so n* and its range say '
+                      'nothing (the feeder runs use them all the same, and cannot empty the '
+                      'table).', '']
         if 'n_star' in s:
             lines += [f'Fit of order {s["order"]}: the most valid parts at n* = {s["n_star"]} '
                       f'parts on the table; optimal range {s["optimal_range"][0]}-'

@@ -13,11 +13,12 @@ GRIPPER_POSE = ('gripper_x', 'gripper_y', 'gripper_z', 'gripper_qx', 'gripper_qy
 KEY = ('experiment', 'group', 'iteration')
 ITERATION_COLUMNS = (
     'experiment', 'type', 'group', 'iteration', 'seed', 'container_x', 'container_y',
-    'container_z', 'parts', 'checked', 'candidates', 'placeable', 'container_free', 'valid',
-    'checks', 'picks', 'settled', 'unsettled', 'spilled', 'tunnelled', 'max_penetration',
+    'container_z', 'parts', 'checked', 'outside', 'candidates', 'placeable', 'container_free',
+    'valid', 'checks', 'picks', 'settled', 'unsettled', 'spilled', 'tunnelled', 'max_penetration',
     'tray_error', 'emptied', 'vibrations', 'feeds', 'stop', 'fault', 'wall_time')
-CHECK_COLUMNS = (*KEY, 'check', 'parts_on_table', 'checked', 'candidates', 'placeable',
-                 'container_free', 'valid', 'picked_id', 'searches', 'vibrations', 'wall_time')
+CHECK_COLUMNS = (*KEY, 'check', 'parts_on_table', 'checked', 'outside', 'candidates',
+                 'placeable', 'container_free', 'valid', 'picked_id', 'searches', 'vibrations',
+                 'wall_time')
 PART_COLUMNS = (*KEY, 'check', 'part_id', *POSE, 'inside', 'stage', 'grasp', 'tilts')
 PICK_COLUMNS = (*KEY, 'pick', 'check', 'part_id', 'searches', 'vibrations', 'grasp',
                 *GRIPPER_POSE)

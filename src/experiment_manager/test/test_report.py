@@ -99,7 +99,8 @@ def _as_paper_says(summary: dict, paper: dict) -> dict:
     b['bins'][b['best_bin']]['fractions']['container_free']['mean'] = 0.25
     # 2500 - 0.25 (n - 49)^2 over n = 1..100: a peak at 49, 26 % lower at n = 100
     w.update(per_n=[{'n': n, 'valid': {'mean': 0.0}} for n in range(1, 101)],
-             coefficients=[-0.25, 24.5, 2500.0 - 0.25 * 49.0 ** 2], n_star=49, fit_max=2500.0)
+             coefficients=[-0.25, 24.5, 2500.0 - 0.25 * 49.0 ** 2], n_star=49, fit_max=2500.0,
+             no_valid=False)
     f.update(emptied=50, iterations=50, lost=0)
     f['vibrations_to_empty']['mean'] = 130.0
     return s
@@ -135,6 +136,11 @@ def test_against_the_paper_says_which_findings_hold_and_why_figures_differ(run_d
     s['experiments']['sweep'].update(n_star=100)
     assert "still rising at the sweep's last count, n = 100" in '\n'.join(
         verdicts.against_paper(s, paper))
+    s['experiments']['sweep'].update(no_valid=True, fit_max=0.0)
+    assert 'no valid part at any count: the gripper cannot pick this part' in '\n'.join(
+        verdicts.against_paper(s, paper))
+    assert '**No valid part at any count**' in report.markdown(s, {}, {})
+    s['experiments']['sweep'].update(no_valid=False, fit_max=2500.0)
     page = report.to_html(report.markdown(s, {}, {}), 'pth0')
     assert '<h2>Against the paper</h2>' in page and page.count('<li>') == 4
 
