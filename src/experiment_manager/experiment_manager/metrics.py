@@ -71,18 +71,18 @@ def fit_optimum(counts, valid, first: int, last: int, margin: int) -> dict:
     [max(1, n* - margin), n* + margin]. Coefficients highest power first."""
     n = np.asarray(counts, dtype=float)
     order = min(FIT_ORDER, len(np.unique(n)) - 1)
+    # No valid part at any count: the fit is flat and n* says nothing.
+    no_valid = not np.any(np.asarray(valid) > 0)
     if order < 1:
         best = int(n[0])
         return {'order': 0, 'coefficients': [float(np.mean(valid))], 'n_star': best,
-                'optimal_range': [max(1, best - margin), best + margin]}
+                'optimal_range': [max(1, best - margin), best + margin], 'no_valid': no_valid}
     coefficients = np.polyfit(n, np.asarray(valid, dtype=float), order)
     grid = np.arange(first, last + 1)
     best = int(grid[int(np.argmax(np.polyval(coefficients, grid)))])
     return {'order': order, 'coefficients': coefficients.tolist(), 'n_star': best,
             'fit_max': float(np.polyval(coefficients, best)),
-            'optimal_range': [max(1, best - margin), best + margin],
-            # No valid part at any count: the fit is flat and n* says nothing.
-            'no_valid': not np.any(np.asarray(valid) > 0)}
+            'optimal_range': [max(1, best - margin), best + margin], 'no_valid': no_valid}
 
 
 def table_sweep(exp: Experiment, rows: list[dict]) -> dict:

@@ -129,7 +129,7 @@ def _sweep_shape(s: dict) -> tuple[str, bool]:
     """How valid parts go with the parts on the tray (the fit), and whether that is the
     paper's shape: up to a peak inside the sweep, then down by at least FALLS."""
     last = s['per_n'][-1]['n']
-    if s.get('no_valid') or s.get('fit_max', 0.0) <= 0.0:
+    if s.get('no_valid'):
         return 'no valid part at any count: the gripper cannot pick this part off the table', False
     if s['n_star'] >= last:
         return f"still rising at the sweep's last count, n = {last}", False

@@ -498,16 +498,13 @@ def naive_check(validator: Validator, container: ContainerSpec, ids: Sequence[in
              for h, c in containers.wall_boxes(container)]
     surface = fcl.CollisionObject(fcl.Halfspace(-v.place_axis, -v.seat_offset),
                                   fcl.Transform())
-    x, y, z = container.inner_size
     queries = 0
     results = []
     for row in rows:
         rotation, position = rotations[row], positions[row]
         centre = position + rotation @ v.part.center
-        if not (abs(centre[0]) <= x / 2 + CENTRE_TOLERANCE
-                and abs(centre[1]) <= y / 2 + CENTRE_TOLERANCE
-                and -CENTRE_TOLERANCE <= centre[2] <= z + v.config.rim_tolerance
-                + CENTRE_TOLERANCE):
+        if not containers.inside(container, centre, CENTRE_TOLERANCE,
+                                 v.config.rim_tolerance)[0]:
             results.append(PartResult(ids[row], STAGE_OUTSIDE, 'outside'))
             continue
         angles = [math.acos(max(-1.0, min(1.0, float((rotation @ g.up)[2]))))
@@ -523,14 +520,14 @@ def naive_check(validator: Validator, container: ContainerSpec, ids: Sequence[in
         shapes = gripper_shapes(v.gripper, grasp.jaw_opening, v.finger_depths[g])
         objects = [s.fcl_object() for s in shapes]
         closing = rotation @ grasp.closing
+        # the vertical made perpendicular to the closing axis, turned by each tilt about it
+        axis = np.array([0.0, 0.0, 1.0]) - closing[2] * closing
+        if np.linalg.norm(axis) < 1e-9:
+            axis = rotation @ grasp.up
+        axis /= np.linalg.norm(axis)
+        side = np.cross(axis, closing)
         frames = []
         for tilt in v.tilts:
-            # the vertical made perpendicular to the closing axis, turned by the tilt about it
-            axis = np.array([0.0, 0.0, 1.0]) - closing[2] * closing
-            if np.linalg.norm(axis) < 1e-9:
-                axis = rotation @ grasp.up
-            axis /= np.linalg.norm(axis)
-            side = np.cross(axis, closing)
             up = math.cos(tilt) * axis - math.sin(tilt) * side
             frames.append(np.column_stack([closing, np.cross(up, closing), up]))
         approach = [k for k, f in enumerate(frames)
