@@ -28,9 +28,9 @@ import os
 import statistics
 import time
 
+from experiment_manager import metrics
 from paper_case import run_on_cores
 from pick_sim_world.config import PhysicsConfig
-from scipy import stats as scipy_stats
 
 DEFAULT = PhysicsConfig()
 SETTINGS = {
@@ -80,12 +80,10 @@ def value(row: dict, column: str) -> float:
 
 
 def interval(values: list[float]) -> tuple[float, float]:
-    """Mean and the half width of its 95 % confidence interval (0 for one value)."""
-    mean = statistics.fmean(values)
-    if len(values) < 2:
-        return mean, 0.0
-    t = scipy_stats.t.ppf(0.975, len(values) - 1)
-    return mean, t * statistics.stdev(values) / len(values) ** 0.5
+    """Mean and the half width of its 95 % confidence interval (metrics.interval; 0 for one
+    value)."""
+    low, high = metrics.interval(values)
+    return statistics.fmean(values), 0.0 if low is None else (high - low) / 2
 
 
 def main() -> None:

@@ -15,7 +15,7 @@ from pick_common.containers import ContainerSpec
 from pick_common.states import PartStates, SettleReport
 from pick_validity.validity import Report
 
-from .config import ExperimentFile
+from .config import ExperimentFile, GripperVariant
 
 
 @dataclass(frozen=True)
@@ -56,8 +56,9 @@ class Backend(Protocol):
         """The parts now."""
 
     def check(self, container: ContainerSpec, states: PartStates, targets: list[int],
-              neighbours: bool) -> Report:
-        """The staged checks of `targets` among every part of `states`."""
+              neighbours: bool, variant: GripperVariant | None = None) -> Report:
+        """The staged checks of `targets` among every part of `states`, with the file's
+        gripper and grasps or, given a variant (gripper_sweep), its own."""
 
     def feed(self, valid: int, on_table: int, restart: FeederConfig | None) -> FeedStep:
         """One feeder policy step (restart: load the feeder first)."""

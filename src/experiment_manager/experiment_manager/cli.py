@@ -40,6 +40,7 @@ from rclpy.validate_namespace import validate_namespace
 from . import config, interrupt
 from .claim import claim, NamespaceInUse
 from .supervisor import Graph, report_dead, spin_until, start_graph
+from .wording import gripper_label
 
 MAX_WORKERS = 64
 START_TIMEOUT = 60.0    # s for the manager's action server to appear
@@ -145,6 +146,12 @@ def _summary_lines(summary: dict) -> list[str]:
         elif kind == 'table_sweep':
             lines.append(f'  {exp_id} (table_sweep): optimum {s.get("n_star")} parts, range '
                          f'{s.get("optimal_range")}')
+        elif kind == 'gripper_sweep':
+            found = s['smallest']
+            lines.append(f'  {exp_id} (gripper_sweep): ' + (
+                f'smallest meeting {s["min_valid"]:g} valid per check: '
+                f'{gripper_label(s["variants"][found])}' if found is not None else
+                f'no gripper of {len(s["variants"])} meets {s["min_valid"]:g} valid per check'))
         else:
             v = s['vibrations_to_empty']['mean']
             lines.append(f'  {exp_id} (feeder_emptying): {s["emptied"]}/{s["iterations"]} '

@@ -9,6 +9,7 @@ value and the rule. The annotated example is `config/default_experiment.yaml`.
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+import itertools
 import math
 import os
 from typing import Any
@@ -39,13 +40,14 @@ from pick_validity.config import (
 )
 import yaml
 
-BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING = (
-    'bin_static', 'bin_emptying', 'table_sweep', 'feeder_emptying')
-TYPES = (BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING)
+BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING, GRIPPER_SWEEP = (
+    'bin_static', 'bin_emptying', 'table_sweep', 'feeder_emptying', 'gripper_sweep')
+TYPES = (BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING, GRIPPER_SWEEP)
 SEARCH_ORDERS = ('top_first', 'random', 'id')
 MAX_ITERATIONS = 10_000
 MAX_BINS = 100
 MAX_EXPERIMENTS = 50
+MAX_VARIANTS = 64         # grippers x grasp sets of one gripper_sweep
 MAX_FILE_BYTES = 1_000_000
 ID_CHARS = set('abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-')
 
@@ -68,13 +70,33 @@ class Requirements:
 
 
 @dataclass(frozen=True)
+class GripperVariant:
+    """One gripper and grasp set of a gripper_sweep: the gripper, the name of the grasp set
+    (a key of the experiment's `grasp_sets`) and its grasps, in part.grasps order."""
+
+    gripper: Gripper
+    grasp_set: str
+    grasps: tuple[GraspPose, ...]
+
+    @property
+    def size(self) -> tuple[float, float, float, float]:
+        """What "smaller" means when grippers are compared: the body's diameter first (what
+        must fit between neighbours), then the jaws' depth and height, then the body's length."""
+        g = self.gripper
+        return g.body_diameter, g.jaw_depth, g.jaw_height, g.body_length
+
+
+@dataclass(frozen=True)
 class Experiment:
     """One experiment of the file.
 
     bins: bin_static's candidate bins. bin: bin_emptying's bin, or None when `bin_from` names
-    the bin_static experiment whose best bin is used. counts: table_sweep's parts on the tray.
-    optimal_range: feeder_emptying's [min*, max*], or None when `range_from` names the
-    table_sweep whose optimum is used.
+    the bin_static experiment whose best bin is used (gripper_sweep: the same, and neither
+    means the tray). counts: table_sweep's parts on the tray. optimal_range:
+    feeder_emptying's [min*, max*], or None when `range_from` names the table_sweep whose
+    optimum is used. variants: gripper_sweep's grippers and grasp sets, checked on the same
+    scenes; min_valid: the valid parts per check a gripper must give (its 95 % interval's low
+    end at least this).
     """
 
     id: str
@@ -89,6 +111,8 @@ class Experiment:
     optimal_range: tuple[int, int] | None = None
     range_from: str = ''
     max_vibrations: int = 500
+    variants: tuple[GripperVariant, ...] = ()
+    min_valid: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -310,23 +334,14 @@ def _experiment(m: _Map, f: dict, earlier: dict[str, Experiment]) -> Experiment:
     iterations = m.integer('iterations', None, 1, MAX_ITERATIONS)
     part, tray, wall, limit = f['part_geometry'], f['tray'], f['bin_wall'], f['max_dimension']
     out: dict[str, Any] = {'id': exp_id, 'type': kind, 'iterations': iterations}
-    if kind in (BIN_STATIC, BIN_EMPTYING, FEEDER_EMPTYING):
+    if kind in (BIN_STATIC, BIN_EMPTYING, FEEDER_EMPTYING, GRIPPER_SWEEP):
         out['parts'] = m.integer('parts', None, 1, MAX_PARTS_PER_INSTANCE)
     if kind == BIN_STATIC:
         out['bins'] = _bins(m, 'bins_mm', wall, limit)
         for i, b in enumerate(out['bins']):
             check_fits(m.where('parts') + f' (bins_mm[{i}])', out['parts'], part.volume, b)
     elif kind == BIN_EMPTYING:
-        raw = m.get('bin', None, required=True)
-        if isinstance(raw, str):
-            source = _earlier(m, 'bin', raw, earlier, BIN_STATIC, 'a bin [x, y, z] in mm')
-            out['bin_from'] = raw
-            for i, b in enumerate(source.bins):
-                check_fits(m.where('parts') + f' ({raw}.bins_mm[{i}])', out['parts'],
-                           part.volume, b)
-        else:
-            out['bin'] = _bin(raw, m.where('bin'), wall, limit)
-            check_fits(m.where('parts'), out['parts'], part.volume, out['bin'])
+        out.update(_bin_or_source(m, out['parts'], f, earlier, required=True))
     elif kind == TABLE_SWEEP:
         counts = m.sub('counts')
         first = counts.integer('first', 1, 1, MAX_PARTS_PER_INSTANCE)
@@ -336,6 +351,13 @@ def _experiment(m: _Map, f: dict, earlier: dict[str, Experiment]) -> Experiment:
         out['counts'] = tuple(range(first, last + 1, step))
         check_fits(m.where('counts.last'), out['counts'][-1], part.volume, tray)
         out['margin'] = m.integer('margin', 5, 0, 1000)
+    elif kind == GRIPPER_SWEEP:
+        scene = _bin_or_source(m, out['parts'], f, earlier, required=False)
+        if not scene:       # no bin: the parts lie on the tray, as in a table_sweep
+            check_fits(m.where('parts') + ' (tray_mm)', out['parts'], part.volume, tray)
+        out.update(scene)
+        out['variants'] = _variants(m, f['gripper'], f['grasps'])
+        out['min_valid'] = m.number('min_valid', 1.0, low=0.0, high=MAX_PARTS_PER_INSTANCE)
     if kind == FEEDER_EMPTYING:
         raw = m.get('optimal_range', None, required=True)
         if isinstance(raw, str):
@@ -361,6 +383,88 @@ def _experiment(m: _Map, f: dict, earlier: dict[str, Experiment]) -> Experiment:
         check_fits(m.where('optimal_range') + ' (max)', high, part.volume, tray)
     m.done()
     return Experiment(**out)
+
+
+def _bin_or_source(m: _Map, parts: int, f: dict, earlier: dict[str, Experiment],
+                   required: bool) -> dict:
+    """The experiment's `bin`: a bin [x, y, z] in mm ({'bin': spec}) or the id of an earlier
+    bin_static experiment whose best bin is used ({'bin_from': id}); {} when it is absent and
+    not required. `parts` must fit in it (in every bin of the source)."""
+    raw = m.get('bin', None, required=required)
+    if raw is None:
+        return {}
+    volume = f['part_geometry'].volume
+    if isinstance(raw, str):
+        source = _earlier(m, 'bin', raw, earlier, BIN_STATIC, 'a bin [x, y, z] in mm')
+        for i, b in enumerate(source.bins):
+            check_fits(m.where('parts') + f' ({raw}.bins_mm[{i}])', parts, volume, b)
+        return {'bin_from': raw}
+    spec = _bin(raw, m.where('bin'), f['bin_wall'], f['max_dimension'])
+    check_fits(m.where('parts'), parts, volume, spec)
+    return {'bin': spec}
+
+
+GRIPPER_KEYS = (('body_diameter_mm', 'body_diameter'), ('body_length_mm', 'body_length'),
+                ('jaw_height_mm', 'jaw_height'), ('jaw_depth_mm', 'jaw_depth'),
+                ('finger_clearance_mm', 'finger_clearance'))
+
+
+def _gripper(m: _Map, base: Gripper) -> Gripper:
+    """The `gripper` section: each of GRIPPER_KEYS, in mm, defaulting to `base`'s."""
+    return Gripper(**{attr: m.number(key, getattr(base, attr) / MM, scale=MM)
+                      for key, attr in GRIPPER_KEYS})
+
+
+def _variants(m: _Map, gripper: Gripper, grasps: tuple[GraspPose, ...]
+              ) -> tuple[GripperVariant, ...]:
+    """gripper_sweep's grid: `grippers` maps gripper keys (as in the gripper section) to a
+    number or a list of numbers, the file's gripper standing in for keys not given;
+    `grasp_sets` maps a name to a list of grasp names of part.grasps (default: all of them,
+    named 'all'). Every combination, in the order given, body diameter varying slowest."""
+    grid = m.sub('grippers')
+    axes = []
+    for key, attr in GRIPPER_KEYS:
+        where = grid.where(key)
+        raw = grid.get(key, getattr(gripper, attr) / MM)
+        values = raw if isinstance(raw, list) else [raw]
+        if not values or len(values) > MAX_VARIANTS:
+            raise InvalidArgument(where, _short(raw), f'must be a number or a list of 1 to '
+                                  f'{MAX_VARIANTS} numbers (mm)')
+        for i, v in enumerate(values):
+            if isinstance(v, bool) or not isinstance(v, int | float):
+                raise InvalidArgument(f'{where}[{i}]' if isinstance(raw, list) else where,
+                                      _short(v), 'is not a number')
+        axes.append([(attr, check_number(where, v, low=0.0) * MM) for v in values])
+    grid.done()
+    names = [g.name for g in grasps]
+    raw_sets = m.get('grasp_sets', {'all': names})
+    if not isinstance(raw_sets, Mapping) or not raw_sets:
+        raise InvalidArgument(m.where('grasp_sets'), _short(raw_sets),
+                              'must map a name to a list of grasp names of part.grasps')
+    sets = []
+    for name, members in raw_sets.items():
+        where = f'{m.where("grasp_sets")}.{name}'
+        if not isinstance(members, list) or not members:
+            raise InvalidArgument(where, _short(members), 'must be a non-empty list of grasp '
+                                  f'names (part.grasps: {", ".join(names)})')
+        for i, member in enumerate(members):
+            if member not in names:
+                raise InvalidArgument(f'{where}[{i}]', _short(member), 'is not the name of a '
+                                      f'grasp of part.grasps ({", ".join(names)})')
+        if len(set(members)) != len(members):
+            raise InvalidArgument(where, members, 'names a grasp twice')
+        sets.append((str(name), tuple(g for g in grasps if g.name in members)))
+    total = math.prod(len(a) for a in axes) * len(sets)
+    if total > MAX_VARIANTS:
+        raise InvalidArgument(m.where('grippers'), total, f'grippers x grasp sets is over the '
+                              f'limit of {MAX_VARIANTS} combinations per experiment')
+    out = []
+    for combination in itertools.product(*axes):
+        g = Gripper(**dict(combination))
+        _checked(check_gripper, g, m.where('grippers') + ' (' + ', '.join(
+            f'{key} {getattr(g, attr) / MM:g}' for key, attr in GRIPPER_KEYS) + ')')
+        out += [GripperVariant(g, name, members) for name, members in sets]
+    return tuple(out)
 
 
 def _moves(m: _Map) -> tuple[Vibration, ...]:
@@ -405,13 +509,7 @@ def parse(text: str, path: str = '') -> ExperimentFile:
     output_dir = m.text('output_dir', 'results')
     part, grasps, place = _part(m.sub('part'), base_dir)
     g = m.sub('gripper')
-    d = Gripper()
-    gripper = Gripper(
-        body_diameter=g.number('body_diameter_mm', d.body_diameter / MM, scale=MM),
-        body_length=g.number('body_length_mm', d.body_length / MM, scale=MM),
-        jaw_height=g.number('jaw_height_mm', d.jaw_height / MM, scale=MM),
-        jaw_depth=g.number('jaw_depth_mm', d.jaw_depth / MM, scale=MM),
-        finger_clearance=g.number('finger_clearance_mm', d.finger_clearance / MM, scale=MM))
+    gripper = _gripper(g, Gripper())
     g.done()
     c = m.sub('check')
     dc = CheckConfig()
@@ -453,7 +551,8 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         raise InvalidArgument('experiments', _short(raw),
                               f'must be a list of 1..{MAX_EXPERIMENTS} experiments')
     context = {'part_geometry': geometry, 'tray': tray, 'bin_wall': bin_wall,
-               'max_dimension': requirements.max_dimension}
+               'max_dimension': requirements.max_dimension, 'gripper': gripper,
+               'grasps': grasps}
     experiments: dict[str, Experiment] = {}
     for i, item in enumerate(raw):
         e = _experiment(_Map(item, f'experiments[{i}]'), context, experiments)

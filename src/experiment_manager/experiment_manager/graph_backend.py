@@ -8,6 +8,7 @@ died) or gives no answer within `call_timeout` (the runner then runs the iterati
 """
 
 from collections.abc import Callable
+from dataclasses import replace
 import threading
 import time
 
@@ -26,7 +27,7 @@ from rclpy.action import ActionClient
 from rclpy.node import Node
 
 from .backend import FeedStep, WorkerLost
-from .config import ExperimentFile
+from .config import ExperimentFile, GripperVariant
 
 POLL = 0.1              # s between checks of a pending call
 
@@ -280,7 +281,7 @@ class GraphBackend:
         return self._states(self._service(self._get, GetParts.Request(), 'get_parts').parts)
 
     def check(self, container: ContainerSpec, states: PartStates, targets: list[int],
-              neighbours: bool) -> Report:
+              neighbours: bool, variant: GripperVariant | None = None) -> Report:
         # The messages as received (no encoding again), of the parts in `states`: all, or
         # those the runner kept (it leaves out parts fallen far from the container).
         wanted = set(states.ids.tolist())
@@ -292,7 +293,9 @@ class GraphBackend:
                                      part_model=self._part_msg, parts=parts,
                                      target_ids=[int(t) for t in targets],
                                      check_neighbours=neighbours)
-        validity_conv.setup_to_request(self._setup, request)
+        setup = self._setup if variant is None else replace(
+            self._setup, gripper=variant.gripper, grasps=variant.grasps)
+        validity_conv.setup_to_request(setup, request)
         response = self._service(self._check_client, request, 'check_parts')
         return validity_conv.report_from_msg(response.report)
 

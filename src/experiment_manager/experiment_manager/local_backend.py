@@ -13,7 +13,7 @@ from pick_sim_world.world import World
 from pick_validity.validity import Report, Validator
 
 from .backend import FeedStep
-from .config import ExperimentFile
+from .config import ExperimentFile, GripperVariant
 
 
 class LocalBackend:
@@ -23,6 +23,7 @@ class LocalBackend:
         self._physics = physics
         self._world: World | None = None
         self._validator: Validator | None = None
+        self._variants: dict[GripperVariant, Validator] = {}
         self._policy: FeederPolicy | None = None
         self._file: ExperimentFile | None = None
 
@@ -31,6 +32,7 @@ class LocalBackend:
         self._world = self._world or World(SceneSpec(file.tray, file.part), self._physics)
         self._validator = Validator(self._world.part, file.gripper, file.grasps, file.place,
                                     file.check)
+        self._variants = {}
 
     def reset(self, container: ContainerSpec, seed: int) -> None:
         self._world.reset(SceneSpec(container, self._file.part, 1, seed))
@@ -47,9 +49,16 @@ class LocalBackend:
         return self._world.snapshot()
 
     def check(self, container: ContainerSpec, states: PartStates, targets: list[int],
-              neighbours: bool) -> Report:
-        return self._validator.check(container, states.ids.tolist(), states.poses, targets,
-                                     neighbours)
+              neighbours: bool, variant: GripperVariant | None = None) -> Report:
+        validator = self._validator
+        if variant is not None:
+            validator = self._variants.get(variant)
+            if validator is None:
+                validator = self._variants[variant] = Validator(
+                    self._world.part, variant.gripper, variant.grasps, self._file.place,
+                    self._file.check)
+        return validator.check(container, states.ids.tolist(), states.poses, targets,
+                               neighbours)
 
     def feed(self, valid: int, on_table: int, restart: FeederConfig | None) -> FeedStep:
         if restart is not None:

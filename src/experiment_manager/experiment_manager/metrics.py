@@ -5,12 +5,25 @@ per bin) and the best bin. bin_emptying: Table 2 (emptied bins, parts removed: m
 standard deviation; searches before each pick). table_sweep: figure 15 (mean valid parts per n),
 the 4th-order polynomial fit, its maximum n* and the optimal range n* +- margin. feeder_emptying:
 Table 3 (emptied runs, vibrations to empty the feeder, and the time per vibration the refill
-interval allows). Standard deviations are sample ones (n - 1), 0 for a single value.
+interval allows). gripper_sweep (ours, not the paper's): per gripper and grasp set, the stage
+fractions and the valid parts per check with their 95 % interval, and the smallest gripper whose
+interval's low end reaches the experiment's min_valid. Standard deviations are sample ones
+(n - 1), 0 for a single value.
 """
 
 import numpy as np
+from scipy import stats as scipy_stats
 
-from .config import BIN_EMPTYING, BIN_STATIC, Experiment, ExperimentFile, TABLE_SWEEP
+from .config import (
+    BIN_EMPTYING,
+    BIN_STATIC,
+    Experiment,
+    ExperimentFile,
+    GRIPPER_KEYS,
+    GRIPPER_SWEEP,
+    MM,
+    TABLE_SWEEP,
+)
 
 # The physics faults an iteration is flagged with (procedures.faults); the first two leave it
 # out of the figures.
@@ -29,6 +42,22 @@ def stats(values) -> dict:
         return {'n': 0, 'mean': None, 'min': None, 'max': None, 'std': None}
     return {'n': int(a.size), 'mean': float(a.mean()), 'min': float(a.min()),
             'max': float(a.max()), 'std': float(a.std(ddof=1)) if a.size > 1 else 0.0}
+
+
+def interval(values, confidence: float = 0.95, counts: bool = False
+             ) -> tuple[float | None, float | None]:
+    """The two-sided Student-t confidence interval of the mean of `values`; (None, None) for
+    fewer than two values (one value says nothing of its spread). counts: the values are counts
+    of parts, whose spread is taken as at least a Poisson count's (variance >= mean): a few
+    scenes that happen to agree (two scenes of 4 valid parts each) do not make a mean certain."""
+    a = np.asarray(values, dtype=float)
+    if a.size < 2:
+        return None, None
+    variance = a.var(ddof=1)
+    if counts:
+        variance = max(variance, a.mean())
+    half = scipy_stats.t.ppf(0.5 + confidence / 2, a.size - 1) * np.sqrt(variance / a.size)
+    return float(a.mean() - half), float(a.mean() + half)
 
 
 def _fractions(rows: list[dict]) -> dict:
@@ -118,6 +147,35 @@ def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
             'minutes_per_vibration_allowed': per_vibration}
 
 
+def gripper_sweep(exp: Experiment, rows: list[dict], checks: list[dict]) -> dict:
+    """Per variant (gripper and grasp set, in the experiment's order; check k of each scene is
+    variant k): the stage fractions, the valid parts per check with their 95 % interval (of
+    counts: interval(counts=True)) and
+    the scenes with at least one valid part; `meets`: the interval's low end is at least
+    min_valid. `smallest`: the index of the smallest variant that meets (GripperVariant.size;
+    the first in the file's order among equals), None when none does."""
+    kept = {(r['group'], r['iteration']) for r in rows}
+    variants = []
+    for k, v in enumerate(exp.variants):
+        mine = [c for c in checks if c['check'] == k and (c['group'], c['iteration']) in kept]
+        valid = [c['valid'] for c in mine]
+        low, high = interval(valid, counts=True)
+        variants.append({
+            'index': k, 'grasp_set': v.grasp_set, 'grasps': [g.name for g in v.grasps],
+            'gripper_mm': {key: round(getattr(v.gripper, attr) / MM, 6)
+                           for key, attr in GRIPPER_KEYS},
+            'scenes': len(mine), 'fractions': _fractions(mine), 'valid': stats(valid),
+            'valid_ci95': [low, high], 'scenes_with_valid': sum(x > 0 for x in valid),
+            'meets': low is not None and low >= exp.min_valid})
+    by_size = sorted(range(len(variants)), key=lambda k: (exp.variants[k].size, k))
+    smallest = next((k for k in by_size if variants[k]['meets']), None)
+    first = rows[0] if rows else None
+    return {'iterations': len(rows), 'parts': exp.parts,
+            'scene_mm': [round(first[k] * 1000, 6) for k in ('container_x', 'container_y',
+                                                               'container_z')] if first else None,
+            'min_valid': exp.min_valid, 'variants': variants, 'smallest': smallest}
+
+
 def physics(rows: list[dict]) -> dict:
     """The physics health of every iteration (left-out ones too): parts spilled and tunnelled
     (totals), the most parts left moving at a settle's end, the deepest penetration (m) and
@@ -138,9 +196,10 @@ def fault_counts(rows: list[dict]) -> dict:
 
 
 def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: list[dict],
-              earlier: dict | None = None) -> dict:
-    """The metrics of one experiment. `earlier`: the summaries of the experiments before it
-    (for feeder_emptying's range taken from a table_sweep). Iterations that ended in a physics
+              earlier: dict | None = None, checks: list[dict] = ()) -> dict:
+    """The metrics of one experiment from its rows of iterations.csv, picks.csv and checks.csv.
+    `earlier`: the summaries of the experiments before it (for feeder_emptying's range taken
+    from a table_sweep). Iterations that ended in a physics
     fault or with a tunnelled part have no figures and are left out; every flagged iteration is
     listed in `faults`, and `physics` tells the health of all."""
     faults = fault_counts(rows)
@@ -155,6 +214,8 @@ def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: li
         out = bin_emptying(exp, rows, picks)
     elif exp.type == TABLE_SWEEP:
         out = table_sweep(exp, rows)
+    elif exp.type == GRIPPER_SWEEP:
+        out = gripper_sweep(exp, rows, checks)
     else:
         low_high = exp.optimal_range or (earlier or {})[exp.range_from]['optimal_range']
         out = feeder_emptying(file, exp, rows, low_high)

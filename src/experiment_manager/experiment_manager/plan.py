@@ -18,6 +18,7 @@ from .config import (
     BIN_STATIC,
     Experiment,
     ExperimentFile,
+    GRIPPER_SWEEP,
     TABLE_SWEEP,
 )
 
@@ -79,11 +80,13 @@ def plan(file: ExperimentFile, exp: Experiment, summary: dict) -> list[Unit]:
     if exp.type == BIN_STATIC:
         for b, container in enumerate(exp.bins):
             units += [unit(b, i, container, exp.parts) for i in range(exp.iterations)]
-    elif exp.type == BIN_EMPTYING:
+    elif exp.type in (BIN_EMPTYING, GRIPPER_SWEEP):
         container = exp.bin
-        if container is None:
+        if exp.bin_from:
             best = summary[exp.bin_from]['best_bin']
             container = file.experiment(exp.bin_from).bins[best]
+        elif container is None:     # a gripper_sweep without a bin: the tray
+            container = file.tray
         units = [unit(0, i, container, exp.parts) for i in range(exp.iterations)]
     elif exp.type == TABLE_SWEEP:
         for n in exp.counts:

@@ -1,5 +1,6 @@
-"""The four experiment types (paper section 4.3) as iteration procedures over a `Backend`:
-what one iteration does and the rows it records (rows.py has the columns).
+"""The four experiment types of the paper (section 4.3) and the gripper sweep as iteration
+procedures over a `Backend`: what one iteration does and the rows it records (rows.py has the
+columns).
 
 The procedures are the same for every backend, so they are tested without a graph
 (LocalBackend), and their rows do not depend on which worker ran them.
@@ -21,6 +22,8 @@ from .config import (
     BIN_STATIC,
     ExperimentFile,
     FEEDER_EMPTYING,
+    GRIPPER_SWEEP,
+    GripperVariant,
     TABLE_SWEEP,
 )
 from .plan import Unit
@@ -60,7 +63,8 @@ def run_unit(file: ExperimentFile, u: Unit, backend: Backend) -> Record:
     backend.reset(u.container, u.seed)
     iteration = Iteration(file, u, backend)
     run = {BIN_STATIC: iteration.static, TABLE_SWEEP: iteration.static,
-           BIN_EMPTYING: iteration.emptying, FEEDER_EMPTYING: iteration.feeder}
+           BIN_EMPTYING: iteration.emptying, FEEDER_EMPTYING: iteration.feeder,
+           GRIPPER_SWEEP: iteration.grippers}
     try:
         row = run[u.experiment.type]()
     except PhysicsFault as exc:    # its seed would fault again: marked, not run again
@@ -81,7 +85,7 @@ def run_unit(file: ExperimentFile, u: Unit, backend: Backend) -> Record:
 
 
 class Iteration:
-    """One iteration in progress: the procedures of the four types and the rows they record."""
+    """One iteration in progress: the procedures of the five types and the rows they record."""
 
     def __init__(self, file: ExperimentFile, u: Unit, backend: Backend) -> None:
         self.file, self.u, self.backend = file, u, backend
@@ -102,10 +106,11 @@ class Iteration:
                 'max_penetration': max((x.max_penetration for x in r), default=0.0),
                 'tray_error': max((x.tray.error for x in r if x.tray), default=0.0)}
 
-    def check(self, states: PartStates, neighbours: bool,
-              vibrations: int = 0) -> tuple[Report | None, np.ndarray]:
-        """Check the parts inside the container; record the check and every part's row.
-        Returns the report (None when no part is inside) and the targets in search order."""
+    def check(self, states: PartStates, neighbours: bool, vibrations: int = 0,
+              variant: GripperVariant | None = None) -> tuple[Report | None, np.ndarray]:
+        """Check the parts inside the container (with the file's gripper and grasps, or
+        `variant`'s); record the check and every part's row. Returns the report (None when no
+        part is inside) and the targets in search order."""
         u, record = self.u, self.record
         targets = states.ids[states.inside]
         index = len(record.checks)
@@ -121,7 +126,7 @@ class Iteration:
             reach = max(u.container.inner_size) + NEIGHBOUR_MARGIN
             near = np.abs(states.poses[:, :3]).max(axis=1) <= reach
             report = self.backend.check(u.container, states.masked(near), targets.tolist(),
-                                        neighbours)
+                                        neighbours, variant)
             row.update(report.counts)
             row['wall_time'] = report.wall_time
             stages = {r.part_id: (r.stage, r.grasp_index, len(r.valid_tilts))
@@ -158,6 +163,15 @@ class Iteration:
         states, settle = self.backend.drop(self.u.parts, 'container')
         self.reports.append(settle)
         self.check(states, neighbours=self.u.experiment.type == TABLE_SWEEP)
+        return {**self.health(), 'emptied': False, 'vibrations': 0, 'feeds': 0, 'stop': ''}
+
+    def grippers(self) -> dict:
+        """gripper_sweep: drop and settle one scene, then check it (all four stages) with each
+        gripper and grasp set of the sweep in turn: the iteration's check k is variant k."""
+        states, settle = self.backend.drop(self.u.parts, 'container')
+        self.reports.append(settle)
+        for variant in self.u.experiment.variants:
+            self.check(states, neighbours=True, variant=variant)
         return {**self.health(), 'emptied': False, 'vibrations': 0, 'feeds': 0, 'stop': ''}
 
     def emptying(self) -> dict:

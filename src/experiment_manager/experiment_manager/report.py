@@ -4,11 +4,12 @@ From a run directory (`summary.json`, `experiment.yaml`, and `pictures.json` wit
 of pictures.py when they were rendered) it writes
 `report.md` and `report.html` (the same content) and the plots `fig14_bins.png` (fractions of
 parts passing each stage per bin, paper figure 14) and `fig15_table.png` (valid parts against
-parts on the tray with the 4th-order fit, paper figure 15). Tables follow the paper's Tables 2
-and 3. For the paper's test-case files (ids pth0, pth1, pth2) the paper's numbers stand beside
-ours, and a section "Against the paper" checks its three findings on this run and says where
-and why ours differ. The decisions themselves (the verdicts and the check against the paper)
-are verdicts.py's; this module renders them.
+parts on the tray with the 4th-order fit, paper figure 15) and, for a gripper_sweep,
+`grippers.png` (valid parts per check per gripper with the yield required). Tables follow the
+paper's Tables 2 and 3. For the paper's test-case files (ids pth0, pth1, pth2) the paper's
+numbers stand beside ours, and a section "Against the paper" checks its three findings on
+this run and says where and why ours differ. The decisions themselves (the verdicts and the
+check against the paper) are verdicts.py's; this module renders them.
 """
 
 import html
@@ -22,8 +23,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 import yaml
 
-from .verdicts import against_paper, PAPER, verdicts
-from .wording import fmt, of_type, pct, table
+from .verdicts import against_paper, interval_text, PAPER, verdicts
+from .wording import dims, fmt, gripper_label, of_type, pct, table, varying
 
 FIGSIZE = (6.4, 4.0)   # inches
 
@@ -82,6 +83,38 @@ def plot_sweep(summary: dict, path: str) -> bool:
     return True
 
 
+def plot_grippers(summary: dict, path: str) -> bool:
+    """The last gripper_sweep: valid parts per check (mean and 95 % interval) per gripper and
+    grasp set, the yield it must reach, and the smallest that does in green."""
+    sweeps = of_type(summary, 'gripper_sweep')
+    if not sweeps:
+        return False
+    _, s = sweeps[-1]
+    variants = s['variants']
+    keys, sets = varying(variants)
+    labels = [gripper_label(v, keys, sets) or f'variant {v["index"]}' for v in variants]
+    mean = np.array([v['valid']['mean'] if v['valid']['mean'] is not None else np.nan
+                     for v in variants])
+    low = np.array([np.nan if v['valid_ci95'][0] is None else v['valid_ci95'][0]
+                    for v in variants])
+    high = np.array([np.nan if v['valid_ci95'][1] is None else v['valid_ci95'][1]
+                     for v in variants])
+    x = np.arange(len(variants))
+    fig, ax = plt.subplots(figsize=(max(FIGSIZE[0], 0.5 * len(variants) + 2), FIGSIZE[1] + 1))
+    colours = ['tab:green' if v['index'] == s['smallest'] else
+               'tab:blue' if v['meets'] else 'tab:gray' for v in variants]
+    ax.bar(x, np.nan_to_num(mean), color=colours,
+           label='mean valid parts per check (green: the smallest that meets)')
+    ax.errorbar(x, mean, yerr=[np.nan_to_num(mean - low), np.nan_to_num(high - mean)],
+                fmt='none', ecolor='black', capsize=3, label='95 % interval')
+    ax.axhline(s['min_valid'], color='tab:red', linestyle='--',
+               label=f'required: {fmt(s["min_valid"])} (min_valid)')
+    ax.set_xticks(x, labels, rotation=60, ha='right', fontsize=8)
+    ax.set_ylim(bottom=0)       # a count: an interval's low end below 0 is cut at 0
+    _finish(fig, ax, path, f'{summary["id"]}: gripper sweep', '', 'valid parts per check')
+    return True
+
+
 def _physics_health(summary: dict) -> list[str]:
     """Per experiment: iterations flagged (a NaN state and a tunnelled part leave an iteration
     out of the figures; a settle that hit its cap is counted) and the physics of all of them:
@@ -128,7 +161,7 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
             lines += ['![figure 14](fig14_bins.png)', '']
         lines += table(['bin (mm)', 'iterations', 'candidacy', 'placeability',
                          'bin collision free'],
-                        [[' x '.join(fmt(x) for x in b['size_mm']), b['iterations'],
+                        [[dims(b['size_mm']), b['iterations'],
                           pct(b['fractions']['candidates']['mean']),
                           pct(b['fractions']['placeable']['mean']),
                           pct(b['fractions']['container_free']['mean'])]
@@ -189,6 +222,29 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
                   f'{fmt(s["minutes_per_vibration_allowed"])} min. Parts spilled over the '
                   f'walls: {s["physics"]["spilled"]} (in {s["runs_spilling"]} runs; a run may '
                   f'spill {s["max_spilled"]}); runs emptied within that: {s["accepted"]}.']
+    for exp_id, s in of_type(summary, 'gripper_sweep'):
+        lines += ['', f'## Gripper sweep (`{exp_id}`)', '']
+        if figures.get('grippers') and exp_id == of_type(summary, 'gripper_sweep')[-1][0]:
+            lines += ['![gripper sweep](grippers.png)', '']
+        lines += [f'Every gripper and grasp set checked (all four stages) on the same '
+                  f'{s["iterations"]} scenes of {s["parts"]} parts in the '
+                  f'{dims(s["scene_mm"])} mm container. A gripper meets the yield when the '
+                  f'95 % interval of its valid parts per check lies at or above '
+                  f'{fmt(s["min_valid"])} (min_valid). D: body diameter, W: jaw depth, V: jaw '
+                  "height, L: body length, clearance: fingertips above the part's bottom.", '']
+        rows = []
+        for v in s['variants']:
+            f = v['fractions']
+            rows.append([gripper_label(v), pct(f['candidates']['mean']),
+                         pct(f['placeable']['mean']), pct(f['container_free']['mean']),
+                         pct(f['valid']['mean']), fmt(v['valid']['mean']),
+                         interval_text(v),
+                         f'{v["scenes_with_valid"]}/{v["scenes"]}',
+                         ('**smallest**' if v['index'] == s['smallest'] else 'yes')
+                         if v['meets'] else 'no'])
+        lines += table(['gripper', 'candidacy', 'placeability', 'container free', 'valid',
+                        'valid per check', '95 % interval', 'scenes with a valid part',
+                        'meets'], rows)
     if paper:
         lines += against_paper(summary, paper)
     lines += ['', '## Physics health', ''] + _physics_health(summary)
@@ -260,7 +316,8 @@ def write(run_dir: str) -> str:
     with open(os.path.join(run_dir, 'experiment.yaml'), encoding='utf-8') as f:
         spec = yaml.safe_load(f) or {}
     figures = {'fig14': plot_bins(summary, os.path.join(run_dir, 'fig14_bins.png')),
-               'fig15': plot_sweep(summary, os.path.join(run_dir, 'fig15_table.png'))}
+               'fig15': plot_sweep(summary, os.path.join(run_dir, 'fig15_table.png')),
+               'grippers': plot_grippers(summary, os.path.join(run_dir, 'grippers.png'))}
     pictures = None
     if os.path.exists(os.path.join(run_dir, 'pictures.json')):
         with open(os.path.join(run_dir, 'pictures.json'), encoding='utf-8') as f:

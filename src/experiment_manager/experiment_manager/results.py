@@ -77,7 +77,8 @@ class ResultsWriter:
 
     def __init__(self, directory: str, experiment_text: str, resume: bool = False) -> None:
         self.directory = directory
-        self._rows: dict[str, list[dict]] = {'iterations': [], 'picks': []}
+        # The rows the metrics read (parts.csv, by far the largest, is never held).
+        self._rows: dict[str, list[dict]] = {'iterations': [], 'checks': [], 'picks': []}
         try:
             os.makedirs(directory, exist_ok=True)
             probe = tempfile.NamedTemporaryFile(dir=directory, prefix='.write-test-')
@@ -153,6 +154,7 @@ class ResultsWriter:
             self._writers[name].writerows(rows)
             self._files[name].flush()
         self._rows['iterations'].append(record.iteration)
+        self._rows['checks'] += record.checks
         self._rows['picks'] += record.picks
         self._done.add(_key(record.iteration))
 
@@ -200,6 +202,9 @@ class ResultsWriter:
 
     def picks(self, experiment_id: str) -> list[dict]:
         return [r for r in self._rows['picks'] if r['experiment'] == experiment_id]
+
+    def checks(self, experiment_id: str) -> list[dict]:
+        return [r for r in self._rows['checks'] if r['experiment'] == experiment_id]
 
     def write_summary(self, summary: dict) -> None:
         self._write_text('summary.json', json.dumps(summary, indent=2, allow_nan=False) + '\n')

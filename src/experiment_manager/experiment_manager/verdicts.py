@@ -7,7 +7,9 @@ Verdicts, per option:
   refill interval's parts (requirements.parts_per_hour x refill_interval_h);
 - vibrating table: feasible when every `feeder_emptying` run emptied the feeder spilling no more
   than requirements.max_spilled_parts over the tray's walls, and the feeder held a refill
-  interval's parts; the report gives the time per vibration this leaves.
+  interval's parts; the report gives the time per vibration this leaves;
+- gripper (one per gripper_sweep): the smallest gripper of the sweep whose valid parts per
+  check reach the experiment's min_valid at 95 % confidence; not feasible when none does.
 Iterations left out of the figures (a NaN state, a tunnelled part) make no option feasible.
 An option whose experiment did not run is "not analysed".
 """
@@ -15,7 +17,7 @@ An option whose experiment did not run is "not analysed".
 import numpy as np
 
 from .metrics import EXCLUDED, FAULTS
-from .wording import count, fmt, of_type, pct, table
+from .wording import count, dims, fmt, gripper_label, of_type, pct, table
 
 # The paper's results (section 5) for its test case, by experiment-file id.
 PAPER = {
@@ -92,7 +94,38 @@ def verdicts(summary: dict, spec: dict) -> list[dict]:
     else:
         out.append({'option': 'vibrating table', 'verdict': NOT_ANALYSED,
                     'reasons': ['no feeder_emptying experiment in the file']})
+    out += [_gripper_verdict(exp_id, s) for exp_id, s in of_type(summary, 'gripper_sweep')]
     return out
+
+
+def _gripper_verdict(exp_id: str, s: dict) -> dict:
+    """A gripper_sweep's answer: the smallest gripper whose valid parts per check reach
+    min_valid at 95 % confidence, or that none of the sweep does."""
+    variants = s['variants']
+    where = (f'{len(variants)} grippers x grasp sets checked on the same {s["iterations"]} '
+             f'scenes of {s["parts"]} parts in the {dims(s["scene_mm"])} mm '
+             'container')
+    if s['smallest'] is None:
+        best = max(variants, key=lambda v: v['valid']['mean'] or 0.0)
+        return {'option': f'gripper (`{exp_id}`)', 'verdict': NOT_FEASIBLE, 'reasons': [
+            f'no gripper of the sweep gives {fmt(s["min_valid"])} valid parts per check at '
+            f'95 % confidence; the most: {gripper_label(best)}, mean '
+            f'{fmt(best["valid"]["mean"])} (95 % interval {interval_text(best)})', where,
+            *_fault_reason(s)]}
+    v = variants[s['smallest']]
+    return {'option': f'gripper {gripper_label(v)} (`{exp_id}`)',
+            'verdict': NOT_FEASIBLE if _left_out(s) else FEASIBLE,
+            'reasons': [f'the smallest of the sweep whose valid parts per check reach '
+                        f'{fmt(s["min_valid"])} at 95 % confidence: mean '
+                        f'{fmt(v["valid"]["mean"])}, 95 % interval {interval_text(v)}; '
+                        f'{v["scenes_with_valid"]} of {v["scenes"]} scenes had a valid part',
+                        where, *_fault_reason(s)]}
+
+
+def interval_text(v: dict) -> str:
+    """A gripper_sweep variant's 95 % interval of valid parts per check, as the report says it."""
+    low, high = v['valid_ci95']
+    return '-' if low is None else f'{fmt(low)} to {fmt(high)}'
 
 
 def _left_out(s: dict) -> int:
@@ -150,8 +183,8 @@ def against_paper(summary: dict, paper: dict) -> list[str]:
         best = b['bins'][b['best_bin']]
         free = best['fractions']['container_free']['mean']
         same = [float(x) for x in paper['best_bin_mm']] == [float(x) for x in b['best_bin_mm']]
-        figures += [['best bin (mm)', ' x '.join(fmt(x) for x in b['best_bin_mm']),
-                     ' x '.join(fmt(x) for x in paper['best_bin_mm']),
+        figures += [['best bin (mm)', dims(b['best_bin_mm']),
+                     dims(paper['best_bin_mm']),
                      'the same' if same else 'another'],
                     ['its parts free of the bin (bin collision free)', pct(free),
                      pct(paper['container_free']), _ratio(free, paper['container_free'])]]

@@ -10,6 +10,11 @@ def fmt(value, digits: int = 3) -> str:
     return str(value)
 
 
+def dims(values) -> str:
+    """Sizes as '195 x 150 x 27' (the caller says the unit)."""
+    return ' x '.join(fmt(x) for x in values)
+
+
 def count(n: int, noun: str) -> str:
     """'1 part', '35 parts': the report's sentences say a count as it is read."""
     return f'{n} {noun}' + ('' if n == 1 else 's')
@@ -27,3 +32,27 @@ def table(header: list[str], rows: list[list]) -> list[str]:
     lines = ['| ' + ' | '.join(header) + ' |', '|' + ' --- |' * len(header)]
     lines += ['| ' + ' | '.join(fmt(c) for c in r) + ' |' for r in rows]
     return lines
+
+
+# How a gripper's dimensions (summary.json's gripper_mm) are said, shortest first.
+GRIPPER_WORDS = {'body_diameter_mm': 'D', 'jaw_depth_mm': 'W', 'jaw_height_mm': 'V',
+                 'body_length_mm': 'L', 'finger_clearance_mm': 'clearance'}
+
+
+def gripper_label(variant: dict, keys=tuple(GRIPPER_WORDS), grasp_set: bool = True) -> str:
+    """A gripper_sweep variant as 'D 8, W 3 mm; grasps all': the dimensions `keys` (mm) and,
+    when asked, the grasp set."""
+    dims = ', '.join(f'{GRIPPER_WORDS[k]} {fmt(float(variant["gripper_mm"][k]))}'
+                     for k in GRIPPER_WORDS if k in keys)
+    out = f'{dims} mm' if dims else ''
+    if grasp_set:
+        out += ('; ' if out else '') + f'grasps {variant["grasp_set"]}'
+    return out
+
+
+def varying(variants: list[dict]) -> tuple[tuple[str, ...], bool]:
+    """The gripper dimensions that differ between the variants, and whether the grasp set
+    does: what a label needs to tell them apart."""
+    keys = tuple(k for k in GRIPPER_WORDS
+                 if len({v['gripper_mm'][k] for v in variants}) > 1)
+    return keys, len({v['grasp_set'] for v in variants}) > 1

@@ -16,6 +16,7 @@ MINIMAL = """id: t
 experiments:
   - {id: b, type: bin_static, iterations: 1, parts: 10, bins_mm: [[100, 100, 20]]}
 """
+SWEEP = MINIMAL + '  - {id: g, type: gripper_sweep, iterations: 1, parts: 10, '
 
 
 def test_the_default_file_parses_into_si_units():
@@ -93,6 +94,25 @@ BAD = [
     ('moves: [{direction: diagonal}]\n' + MINIMAL,
      r"moves\[0\]\.direction: 'diagonal' must be one of fixed, random"),
     ('experiments: [\n', r'line \d+, column \d+: .* is not valid YAML'),
+    (SWEEP + 'grippers: {jaw_depth_mm: []}}\n',
+     r'grippers\.jaw_depth_mm: \[\] must be a number or a list of 1 to 64 numbers'),
+    (SWEEP + 'grippers: {jaw_depth_mm: [3, x]}}\n',
+     r"grippers\.jaw_depth_mm\[1\]: 'x' is not a number"),
+    (SWEEP + 'grippers: {jaw_width_mm: 3}}\n',
+     r'grippers\.jaw_width_mm: 3 is not a known key here \(known: body_diameter_mm'),
+    (SWEEP + 'grippers: {body_diameter_mm: [0, 8]}}\n',
+     r'grippers \(body_diameter_mm 0, body_length_mm 60, .*\) \(gripper\.body_diameter\): 0'),
+    (SWEEP + 'grippers: {body_diameter_mm: [5, 6, 7, 8, 9, 10, 11, 12, 13], '
+     'jaw_depth_mm: [1, 2, 3, 4, 5, 6, 7, 8]}}\n',
+     r'experiments\[1\]\.grippers: 72 grippers x grasp sets is over the limit of 64'),
+    (SWEEP + 'grasp_sets: {top: [upright, flat]}}\n',
+     r"grasp_sets\.top\[1\]: 'flat' is not the name of a grasp of part\.grasps \(side_px, "),
+    (SWEEP + 'grasp_sets: {top: []}}\n',
+     r'grasp_sets\.top: \[\] must be a non-empty list of grasp names'),
+    (SWEEP + 'bin: nope}\n',
+     r'experiments\[1\]\.bin: .nope. names no earlier bin_static experiment'),
+    (SWEEP + 'bins_mm: [[1, 1, 1]]}\n',
+     r'experiments\[1\]\.bins_mm: .* is not a known key here'),
     ('- just\n- a list\n', r'file: .* must be a mapping of keys'),
 ]
 
@@ -102,6 +122,28 @@ def test_a_bad_file_is_refused_with_field_value_and_rule(text, message):
     with pytest.raises(InvalidArgument) as info:
         config.parse(text)
     assert re.search(message, str(info.value)), str(info.value)
+
+
+def test_a_gripper_sweep_is_every_combination_of_its_grid_and_grasp_sets():
+    f = config.parse('gripper: {body_diameter_mm: 10, jaw_height_mm: 12}\n' + MINIMAL + (
+        '  - {id: g, type: gripper_sweep, iterations: 3, parts: 10, min_valid: 2, '
+        'grippers: {body_diameter_mm: [8, 12], jaw_depth_mm: [3, 4, 5]}, '
+        'grasp_sets: {sides: [side_py, side_px], up: [upright]}}\n'
+        '  - {id: h, type: gripper_sweep, iterations: 1, parts: 10, bin: b}\n'))
+    g = f.experiment('g')
+    assert g.bin is None and g.bin_from == '' and g.min_valid == 2
+    assert len(g.variants) == 2 * 3 * 2
+    # body diameter varies slowest, then jaw depth, then the grasp set; grasps keep the
+    # part's order; keys not in the grid are the file's gripper's.
+    assert [(v.gripper.body_diameter, v.gripper.jaw_depth, v.grasp_set)
+            for v in g.variants[:3]] == [(0.008, 0.003, 'sides'), (0.008, 0.003, 'up'),
+                                         (0.008, 0.004, 'sides')]
+    assert [x.name for x in g.variants[0].grasps] == ['side_px', 'side_py']
+    assert {v.gripper.jaw_height for v in g.variants} == {0.012}
+    h = f.experiment('h')       # no grid: the file's gripper, every grasp, the best bin of b
+    assert h.bin_from == 'b' and h.min_valid == 1.0
+    assert [(v.gripper, v.grasp_set, v.grasps) for v in h.variants] == [
+        (f.gripper, 'all', f.grasps)]
 
 
 def test_a_file_that_cannot_be_read_is_named(tmp_path):
@@ -127,7 +169,7 @@ def test_a_mesh_path_is_relative_to_the_file(tmp_path):
 def test_a_reduced_copy_caps_iterations_and_keeps_the_rest(tmp_path):
     f = config.load(DEFAULT)
     small = config.parse(config.reduced(f, 1))
-    assert [e.iterations for e in small.experiments] == [1, 1, 1, 1]
+    assert [e.iterations for e in small.experiments] == [1, 1, 1, 1, 1]
     assert small.experiment('sweep').counts == f.experiment('sweep').counts
     assert (small.part, small.gripper, small.grasps) == (f.part, f.gripper, f.grasps)
     with pytest.raises(InvalidArgument, match=r'max_iterations: 0 must be within \[1, '):

@@ -1,6 +1,7 @@
 """The four experiment types on the real cores (LocalBackend: PyBullet, FCL, the feeder
 policy), the results files they leave, resumption, and the metrics."""
 
+from dataclasses import replace
 import json
 import math
 import os
@@ -14,14 +15,16 @@ from experiment_manager.local_backend import LocalBackend
 from experiment_manager.plan import iteration_seed, plan, Unit
 from experiment_manager.procedures import faults, Iteration, run_unit, search_order
 from experiment_manager.results import read_text_rows, ResultsWriter
-from experiment_manager.rows import FILES
+from experiment_manager.rows import FILES, POSE
 from experiment_manager.scheduler import Runner
 from feeder_controller.policy import NAMES
 import numpy as np
 from pick_common.errors import InvalidArgument
 from pick_common.states import PartStates
+from pick_validity.validity import STAGE_VALID
 import pybullet as pb
 import pytest
+from scipy import stats as scipy_stats
 
 SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
 
@@ -34,7 +37,7 @@ def test_every_type_records_its_rows_and_metrics(small):
     directory, summary = small
     rows = read(directory, 'iterations')
     by_type = {t: [r for r in rows if r['type'] == t] for t in config.TYPES}
-    assert [len(by_type[t]) for t in config.TYPES] == [4, 1, 8, 1]
+    assert [len(by_type[t]) for t in config.TYPES] == [4, 1, 8, 1, 2]
     for r in rows:
         n = [int(r[k]) for k in ('checked', 'candidates', 'placeable', 'container_free')]
         assert n == sorted(n, reverse=True), r      # each stage passes a subset of the last
@@ -72,6 +75,79 @@ def test_every_type_records_its_rows_and_metrics(small):
     assert 0 < float(feeder['tray_error']) < 0.05    # the tray moved as commanded
     with open(os.path.join(directory, 'summary.json')) as f:
         assert json.load(f) == summary
+
+
+def test_a_gripper_sweep_checks_every_gripper_on_the_same_scenes(small):
+    directory, summary = small
+    exp = config.load(SMALL).experiment('grippers')
+    checks = [c for c in read(directory, 'checks') if c['experiment'] == 'grippers']
+    assert [(int(c['iteration']), int(c['check'])) for c in checks] == [
+        (i, k) for i in range(2) for k in range(len(exp.variants))]
+    valid: dict[tuple[int, int], set] = {}
+    poses: dict[tuple[int, int], set] = {}
+    for p in read(directory, 'parts'):
+        if p['experiment'] == 'grippers':
+            key = int(p['iteration']), int(p['check'])
+            valid.setdefault(key, set())
+            if int(p['stage']) == STAGE_VALID:
+                valid[key].add(p['part_id'])
+            poses.setdefault((key[0], p['part_id']), set()).add(tuple(p[k] for k in POSE))
+    assert all(len(seen) == 1 for seen in poses.values())    # one scene for every gripper
+    # Shapes nest: a gripper no wider (D) and no deeper (W) than another, with the same or
+    # more grasps, reaches every part the other reaches.
+    size = ('body_diameter', 'jaw_depth')
+    pairs = 0
+    for a, va in enumerate(exp.variants):
+        for b, vb in enumerate(exp.variants):
+            if a != b and set(va.grasps) >= set(vb.grasps) and all(
+                    getattr(va.gripper, k) <= getattr(vb.gripper, k) for k in size):
+                pairs += 1
+                for i in range(2):
+                    assert valid[i, a] >= valid[i, b], (i, va, vb)
+    assert pairs == 19      # of the 8 x 7 ordered pairs
+    # ... and the sweep tells them apart: the narrow gripper reaches more than the wide one.
+    s = summary['experiments']['grippers']
+    means = [v['valid']['mean'] for v in s['variants']]
+    assert means == [sum(len(valid[i, k]) for i in range(2)) / 2 for k in range(8)]
+    assert means[0] > means[6]      # D 8 W 3 against D 20 W 6, every grasp
+    assert [v['gripper_mm']['body_diameter_mm'] for v in s['variants']] == [8] * 4 + [20] * 4
+    assert [v['grasp_set'] for v in s['variants']] == ['all', 'upright'] * 4
+
+
+def test_the_smallest_gripper_meeting_the_yield_is_chosen_by_size_then_order():
+    file = config.parse(open(SMALL).read())
+    exp = file.experiment('grippers')      # D 8 / 20 x W 3 / 6 x {all, upright}
+    # Per scene (iteration), the valid parts of each variant; 8 scenes.
+    per_variant = {0: [9] * 8, 1: [0, 1] * 4, 2: [4] * 8, 3: [16] * 8, 4: [25] * 8,
+                   5: [0] * 8, 6: [1, 1, 1, 2] * 2, 7: [0] * 8}
+
+    def summary(min_valid):
+        e = replace(exp, min_valid=min_valid)
+        iterations = [{'group': 0, 'iteration': i, 'container_x': 0.195, 'container_y': 0.15,
+                       'container_z': 0.027, 'fault': ''} for i in range(8)]
+        checks = [{'group': 0, 'iteration': i, 'check': k, 'checked': 30, 'candidates': 30,
+                   'placeable': 30, 'container_free': 30, 'valid': v[i]}
+                  for k, v in per_variant.items() for i in range(8)]
+        return metrics.gripper_sweep(e, iterations, checks)
+
+    s = summary(2.0)
+    # Counts spread at least as a Poisson count's: 8 scenes of 4 valid parts give 4 +- t *
+    # sqrt(4 / 8), not 4 +- 0.
+    t = scipy_stats.t.ppf(0.975, 7)
+    assert s['variants'][2]['valid_ci95'] == pytest.approx([4 - t * 0.5 ** 0.5,
+                                                            4 + t * 0.5 ** 0.5])
+    assert [v['meets'] for v in s['variants']] == [True, False, True, True, True, False,
+                                                   False, False]
+    # D 8 W 3 'all' (0) and D 8 W 6 'all' (2) both meet; W 3 is smaller.
+    assert s['smallest'] == 0 and s['scene_mm'] == [195, 150, 27]
+    low, high = s['variants'][6]['valid_ci95']
+    assert low < 1.25 < high and s['variants'][1]['scenes_with_valid'] == 4
+    assert summary(10.0)['smallest'] == 3       # D 8 W 6 upright (16) before D 20 W 3 (25)
+    assert summary(30.0)['smallest'] is None
+    # An interval reaching below 0 does not meet even min_valid 0.
+    assert not summary(0.0)['variants'][1]['meets']
+    assert metrics.interval([4.0]) == (None, None)
+    assert metrics.interval([4.0, 4.0]) == (4.0, 4.0)
 
 
 def test_runs_are_deterministic_and_independent_of_order(small, tmp_path):
@@ -259,7 +335,7 @@ def test_a_physics_fault_is_marked_left_out_of_the_figures_and_the_run_goes_on(s
     _, got, _ = run_on([Worker(nan_at=2)], str(tmp_path / 'nan'))
     rows = read(str(tmp_path / 'nan'), 'iterations')
     expected = read(directory, 'iterations')
-    assert len(rows) == len(expected) == 14
+    assert len(rows) == len(expected) == 16
     faulted = rows.pop(1)
     assert faulted['fault'] == 'physics_fault' and faulted['checks'] == '0'
     assert re.match(r'physics_fault: parts \[0\b.*\] got non-finite poses', faulted['stop'])

@@ -26,17 +26,18 @@ def _summary(run_dir):
 def test_a_run_gets_its_report_files(run_dir):
     path = report.write(run_dir)
     assert path == os.path.join(run_dir, 'report.html')
-    for name in ('fig14_bins.png', 'fig15_table.png'):
+    for name in ('fig14_bins.png', 'fig15_table.png', 'grippers.png'):
         with open(os.path.join(run_dir, name), 'rb') as f:
             assert f.read(8) == b'\x89PNG\r\n\x1a\n', name
     text = open(os.path.join(run_dir, 'report.md')).read()
     page = open(path).read()
     for heading in ('## Verdict', '## Static bins', '## Bin emptying', '## Vibrating table sweep',
-                    '## Feeder emptying', '## Physics health'):
+                    '## Feeder emptying', '## Gripper sweep', '## Physics health'):
         assert heading in text
         assert f'<h2>{heading[3:]}' in page
     separators = [line for line in text.splitlines() if line.startswith('| --- |')]
-    assert page.count('<table>') == len(separators) == 5 and 'fig15_table.png' in page
+    assert page.count('<table>') == len(separators) == 6 and 'fig15_table.png' in page
+    assert 'grippers.png' in page
     assert 'paper' not in text.split('## Verdict')[1]      # id `small`: no paper numbers
     assert 'No iteration was flagged' in text
 
@@ -46,7 +47,7 @@ def test_verdicts_follow_the_emptied_runs_and_the_capacity(run_dir):
     s['requirements']['capacity'] = 10
     s['experiments']['emptying'].update(emptied=1, iterations=1)
     s['experiments']['feeder'].update(emptied=1, accepted=1, iterations=1)
-    assert [v['verdict'] for v in verdicts.verdicts(s, {})] == [FEASIBLE, FEASIBLE]
+    assert [v['verdict'] for v in verdicts.verdicts(s, {})][:2] == [FEASIBLE, FEASIBLE]
     # An emptied run that spilled more than the requirement allows is not accepted.
     s['experiments']['feeder'].update(accepted=0, runs_spilling=1)
     s['experiments']['feeder']['physics']['spilled'] = 1
@@ -66,8 +67,34 @@ def test_verdicts_follow_the_emptied_runs_and_the_capacity(run_dir):
     bin_verdict = verdicts.verdicts(s, {})[0]
     assert bin_verdict['verdict'] == NOT_FEASIBLE
     assert 'fewer than the 480 a refill interval needs' in bin_verdict['reasons'][-1]
-    del s['experiments']['emptying'], s['experiments']['feeder']
+    del s['experiments']['emptying'], s['experiments']['feeder'], s['experiments']['grippers']
     assert [v['verdict'] for v in verdicts.verdicts(s, {})] == [NOT_ANALYSED, NOT_ANALYSED]
+
+
+def test_the_gripper_verdict_names_the_smallest_gripper_that_meets_the_yield(run_dir):
+    s = _summary(run_dir)
+    g = s['experiments']['grippers']
+    for v in g['variants']:
+        v['meets'] = False
+    g['smallest'] = None
+    verdict = verdicts.verdicts(s, {})[2]
+    assert verdict['verdict'] == NOT_FEASIBLE and verdict['option'] == 'gripper (`grippers`)'
+    assert verdict['reasons'][0].startswith('no gripper of the sweep gives 1 valid parts per '
+                                            'check at 95 % confidence; the most: D ')
+    g['variants'][1].update(meets=True, valid_ci95=[1.5, 2.5])
+    g['smallest'] = 1
+    verdict = verdicts.verdicts(s, {})[2]
+    assert verdict['verdict'] == FEASIBLE
+    assert verdict['option'] == ('gripper D 8, W 3, V 15, L 60, clearance 1 mm; grasps upright '
+                                 '(`grippers`)')
+    assert '95 % interval 1.5 to 2.5' in verdict['reasons'][0]
+    assert '8 grippers x grasp sets checked on the same 2 scenes of 14 parts' in \
+        verdict['reasons'][1]
+    text = report.markdown(s, {}, {})
+    assert '| D 8, W 3, V 15, L 60, clearance 1 mm; grasps upright |' in text
+    assert '| 1.5 to 2.5 |' in text and '| **smallest** |' in text
+    g['faults']['tunnelled'] = 1        # a scene left out: no answer to rely on
+    assert verdicts.verdicts(s, {})[2]['verdict'] == NOT_FEASIBLE
 
 
 def test_the_papers_numbers_stand_beside_ours_for_its_test_case(run_dir, tmp_path):
