@@ -21,7 +21,7 @@ from rcl_interfaces.msg import (
 import rclpy
 from rclpy.action import ActionClient
 from rclpy.exceptions import ParameterException
-from rclpy.executors import Executor, ExternalShutdownException
+from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -36,6 +36,7 @@ from .errors import CodedError, Limit, PickError
 # a feeder run of a thousand goals made the manager spend half its time decoding goal statuses
 # (py-spy). Clients here ask for the result as soon as the goal is accepted.
 RESULT_KEEP = 10.0
+SPIN_WAKE = 0.5     # s: the longest a node's executor waits before it looks at its context
 
 # Latched: a late subscriber gets the last message (scene, markers, last report).
 LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL,
@@ -209,8 +210,15 @@ def run(name: str, make_node: Callable[[], Node],
         print(f'{name}: could not start: {exc}', file=sys.stderr)
         rclpy.try_shutdown()
         sys.exit(2)
+    executor = make_executor() if make_executor else SingleThreadedExecutor()
+    executor.add_node(node)
     try:
-        rclpy.spin(node, executor=make_executor() if make_executor else None)
+        # Not rclpy.spin: on SIGTERM, rclpy's signal thread wakes the executor and only then
+        # shuts the context down, so an executor that wakes in between sees the context still
+        # up and waits again, for ever in a node that nothing else wakes (a validity node
+        # stopped 1 time in 48 under load, issue 24). A bounded wait sees the shutdown.
+        while node.context.ok():
+            executor.spin_once(timeout_sec=SPIN_WAKE)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except (_rclpy.RCLError, _rclpy.InvalidHandle):
@@ -220,5 +228,6 @@ def run(name: str, make_node: Callable[[], Node],
         if node.context.ok():
             raise
     finally:
+        executor.remove_node(node)     # as rclpy.spin does
         node.destroy_node()
         rclpy.try_shutdown()
