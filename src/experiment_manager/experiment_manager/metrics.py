@@ -149,11 +149,11 @@ def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
 
 def gripper_sweep(exp: Experiment, rows: list[dict], checks: list[dict]) -> dict:
     """Per variant (gripper and grasp set, in the experiment's order; check k of each scene is
-    variant k): the stage fractions, the valid parts per check with their 95 % interval (of
-    counts: interval(counts=True)) and
-    the scenes with at least one valid part; `meets`: the interval's low end is at least
-    min_valid. `smallest`: the index of the smallest variant that meets (GripperVariant.size;
-    the first in the file's order among equals), None when none does."""
+    variant k): the stage fractions, the valid parts per check with their 95 % interval
+    (interval(counts=True)) and the scenes with at least one valid part; `meets`: the
+    interval's low end is at least min_valid. `smallest`: the index of the smallest variant
+    that meets (GripperVariant.size; the first in the file's order among equals), None when
+    none does."""
     kept = {(r['group'], r['iteration']) for r in rows}
     variants = []
     for k, v in enumerate(exp.variants):

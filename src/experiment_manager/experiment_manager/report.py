@@ -222,9 +222,10 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
                   f'{fmt(s["minutes_per_vibration_allowed"])} min. Parts spilled over the '
                   f'walls: {s["physics"]["spilled"]} (in {s["runs_spilling"]} runs; a run may '
                   f'spill {s["max_spilled"]}); runs emptied within that: {s["accepted"]}.']
-    for exp_id, s in of_type(summary, 'gripper_sweep'):
+    gripper_sweeps = of_type(summary, 'gripper_sweep')
+    for exp_id, s in gripper_sweeps:
         lines += ['', f'## Gripper sweep (`{exp_id}`)', '']
-        if figures.get('grippers') and exp_id == of_type(summary, 'gripper_sweep')[-1][0]:
+        if figures.get('grippers') and exp_id == gripper_sweeps[-1][0]:   # the one plotted
             lines += ['![gripper sweep](grippers.png)', '']
         lines += [f'Every gripper and grasp set checked (all four stages) on the same '
                   f'{s["iterations"]} scenes of {s["parts"]} parts in the '

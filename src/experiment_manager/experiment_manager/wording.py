@@ -42,9 +42,9 @@ GRIPPER_WORDS = {'body_diameter_mm': 'D', 'jaw_depth_mm': 'W', 'jaw_height_mm': 
 def gripper_label(variant: dict, keys=tuple(GRIPPER_WORDS), grasp_set: bool = True) -> str:
     """A gripper_sweep variant as 'D 8, W 3 mm; grasps all': the dimensions `keys` (mm) and,
     when asked, the grasp set."""
-    dims = ', '.join(f'{GRIPPER_WORDS[k]} {fmt(float(variant["gripper_mm"][k]))}'
-                     for k in GRIPPER_WORDS if k in keys)
-    out = f'{dims} mm' if dims else ''
+    sizes = ', '.join(f'{GRIPPER_WORDS[k]} {fmt(float(variant["gripper_mm"][k]))}'
+                      for k in GRIPPER_WORDS if k in keys)
+    out = f'{sizes} mm' if sizes else ''
     if grasp_set:
         out += ('; ' if out else '') + f'grasps {variant["grasp_set"]}'
     return out
