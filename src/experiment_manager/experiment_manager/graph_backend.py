@@ -16,7 +16,14 @@ from feeder_controller.policy import FeederConfig
 from pick_common import conversions as common
 from pick_common.containers import ContainerSpec
 from pick_common.errors import CodedError, PhysicsFault
-from pick_common.node_runner import GONE_AFTER, handshake, server_ready, ServerWatch, serving
+from pick_common.node_runner import (
+    endpoint_name,
+    GONE_AFTER,
+    handshake,
+    server_ready,
+    ServerWatch,
+    serving,
+)
 from pick_common.states import PartStates, SettleReport
 from pick_msgs.action import DropParts, FeedCycle, RemoveParts
 from pick_msgs.msg import PartArray
@@ -127,8 +134,7 @@ class GraphBackend:
 
     # ------------------------------------------------------------------------- waiting
     def _endpoint(self, client) -> str:
-        name = client._action_name if isinstance(client, ActionClient) else client.srv_name
-        return self._node.resolve_service_name(name)
+        return self._node.resolve_service_name(endpoint_name(client))
 
     def _missing(self) -> list:
         """The worker's clients whose server is not in the graph now."""

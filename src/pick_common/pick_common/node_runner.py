@@ -6,6 +6,7 @@ exit code 2 (never a traceback), spins, and shuts down cleanly on Ctrl-C or SIGI
 way: ros2/demos `qos_overrides_talker.py`)."""
 
 from collections.abc import Callable, Iterable, Mapping
+import signal
 import sys
 import time
 import traceback
@@ -20,7 +21,7 @@ from rcl_interfaces.msg import (
 )
 import rclpy
 from rclpy.action import ActionClient
-from rclpy.exceptions import ParameterException
+from rclpy.exceptions import InvalidHandle, ParameterException
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
@@ -30,6 +31,10 @@ from rclpy.task import Future
 
 from .conversions import error_code, ERROR_INTERNAL
 from .errors import CodedError, Limit, PickError
+
+# `_rclpy` (rclpy's binding) is not public API: rcl's failures (a context shut down under a
+# call, a node rcl refuses) raise its RCLError, which rclpy Jazzy exports nowhere else, and the
+# runner must tell them from other errors.
 
 # s an action server keeps a finished goal's result (rclpy's default: 900). Every status
 # message lists each goal kept, and every client decodes every status message: with the default,
@@ -43,16 +48,22 @@ LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL,
                      reliability=ReliabilityPolicy.RELIABLE)
 
 
+def endpoint_name(client) -> str:
+    """The name a service or action client was made with, as given (unresolved). Not public
+    API for an action: rclpy Jazzy's ActionClient keeps it only as `_action_name`."""
+    return client._action_name if isinstance(client, ActionClient) else client.srv_name
+
+
 def server_ids(node: Node, client) -> frozenset[bytes]:
     """The DDS ids of the endpoints that serve a client: an action's status publisher, a
     service's reply writer (ROS 2's rr/<name>Reply topic). A node started again serves under
     new ids, so a call to the one that died is seen lost although the name is served again."""
     if isinstance(client, ActionClient):
         infos = node.get_publishers_info_by_topic(
-            node.resolve_service_name(client._action_name) + '/_action/status')
+            node.resolve_service_name(endpoint_name(client)) + '/_action/status')
     else:
         infos = node.get_publishers_info_by_topic(
-            f'rr{node.resolve_service_name(client.srv_name)}Reply', no_mangle=True)
+            f'rr{node.resolve_service_name(endpoint_name(client))}Reply', no_mangle=True)
     return frozenset(bytes(i.endpoint_gid) for i in infos)
 
 
@@ -133,7 +144,7 @@ def probe(node: Node, client) -> tuple[object, object]:
     response (timeout)", seen here under load for a first goal). Destroy the service client
     when it is not `client`."""
     if isinstance(client, ActionClient):
-        cancel = node.create_client(CancelGoal, client._action_name + '/_action/cancel_goal')
+        cancel = node.create_client(CancelGoal, endpoint_name(client) + '/_action/cancel_goal')
         request = CancelGoal.Request()
         request.goal_info.goal_id.uuid = list(uuid.uuid4().bytes)
         return cancel, request
@@ -190,28 +201,73 @@ def declare_mesh_dirs(node: Node) -> list[str]:
         type=ParameterType.PARAMETER_STRING_ARRAY)).value or []
 
 
+_interrupts = []    # every SIGINT's Python handler call; run() reads it once, after rclpy.init
+
+
+def _leave_shutdown_to_rclpy(signum: int, frame) -> None:
+    """SIGINT's Python handler under rclpy's: nothing to do (the comment in run says why),
+    except to note the signal, so that one that came before rclpy's handler was there to shut
+    down is not lost. It calls nothing of rclpy: Python runs it between two bytecodes of the
+    main thread, once inside Context.ok() with the context's lock held, and a handler that
+    asked rclpy.ok() waited for that lock for ever (a world still up 30 s after SIGINT, its
+    stack in Context.ok twice; CI, 2026-11-25)."""
+    _interrupts.append(signum)
+
+
+def _destroy_quietly(node: Node | None) -> None:
+    """Destroy a node whose start failed; its handles may already be gone with the context."""
+    if node is None:
+        return
+    try:
+        node.destroy_node()
+    except (_rclpy.RCLError, InvalidHandle):
+        pass
+
+
 def run(name: str, make_node: Callable[[], Node],
         make_executor: Callable[[], Executor] | None = None,
         args: list[str] | None = None) -> None:
-    """Run one node until shutdown; exit 2 with a message when it cannot start. Executors
-    need an initialised context, so they are made here, after rclpy.init."""
+    """Run one node until shutdown; exit 2 with a message when it cannot start, 0 when a
+    signal stops it, also while it starts. Executors need an initialised context, so they are
+    made here, after rclpy.init."""
+    # rclpy's signal handler shuts the context down and then calls the handler it found
+    # installed; Python's own SIGINT handler raises KeyboardInterrupt wherever the main thread
+    # is, and once that was inside threading's Thread.start (the executor starting a worker),
+    # which left a lock broken and the world exiting 1 ('release unlocked lock'; CI,
+    # 2026-11-25). A handler that does nothing lets the spin loop below see the shutdown.
+    signal.signal(signal.SIGINT, _leave_shutdown_to_rclpy)
     try:
         rclpy.init(args=args)
     except Exception as exc:  # rcl's RCLError: bad --ros-args, unreadable params file
         print(f'{name}: could not start: {exc}', file=sys.stderr)
         sys.exit(2)
+    if _interrupts:
+        # before rclpy's handler, or after it and already shut down by it: a stop either way
+        rclpy.try_shutdown()
+        print(f'{name}: stopped while starting', file=sys.stderr)
+        return
+    node = None
     try:
         node = make_node()
-    except (PickError, ParameterException) as exc:
-        print(f'{name}: bad configuration: {exc}', file=sys.stderr)
+        executor = make_executor() if make_executor else SingleThreadedExecutor()
+        executor.add_node(node)
+    except (PickError, ParameterException, _rclpy.RCLError, InvalidHandle) as exc:
+        if not rclpy.ok():
+            # A signal shut the context down while the node was starting, and the start then
+            # failed on something the shutdown took: the world's first scene ('publisher's
+            # context is invalid') or the executor's guard condition ('the given context is
+            # not valid'; CI, 2026-11-25, both). A stop, not a failure.
+            _destroy_quietly(node)
+            print(f'{name}: stopped while starting', file=sys.stderr)
+            return
+        _destroy_quietly(node)
         rclpy.try_shutdown()
+        if isinstance(exc, InvalidHandle):
+            raise
+        # RCLError: rcl refused the node, e.g. ROS_SECURITY_* it cannot honour.
+        what = 'could not start' if isinstance(exc, _rclpy.RCLError) else 'bad configuration'
+        print(f'{name}: {what}: {exc}', file=sys.stderr)
         sys.exit(2)
-    except _rclpy.RCLError as exc:  # rcl refused the node, e.g. ROS_SECURITY_* it cannot honour
-        print(f'{name}: could not start: {exc}', file=sys.stderr)
-        rclpy.try_shutdown()
-        sys.exit(2)
-    executor = make_executor() if make_executor else SingleThreadedExecutor()
-    executor.add_node(node)
     try:
         # Not rclpy.spin: on SIGTERM, rclpy's signal thread wakes the executor and only then
         # shuts the context down, so an executor that wakes in between sees the context still
@@ -221,7 +277,7 @@ def run(name: str, make_node: Callable[[], Node],
             executor.spin_once(timeout_sec=SPIN_WAKE)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
-    except (_rclpy.RCLError, _rclpy.InvalidHandle):
+    except (_rclpy.RCLError, InvalidHandle):
         # A signal shut the context down while the executor was taking or finishing work:
         # the handles it used are gone ('feedback publisher is invalid'). That is the
         # shutdown itself; with the context still up it is a failure.
