@@ -1,3 +1,5 @@
+from glob import glob
+
 from setuptools import find_packages, setup
 
 package_name = 'experiment_manager'
@@ -10,6 +12,8 @@ setup(
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml', 'README.md']),
         ('share/' + package_name + '/config', ['config/default_experiment.yaml']),
+        # the paper's test case, so that an installed workspace can run it by its share path
+        ('share/' + package_name + '/config/test_case', sorted(glob('config/test_case/*.yaml'))),
         ('share/' + package_name + '/launch', ['launch/experiment_launch.py']),
     ],
     install_requires=['setuptools'],
