@@ -2,20 +2,24 @@
 quarter of the time step, with more solver iterations, and at the former defaults (30
 iterations, pybullet's warm start of 0.1), with 95 % confidence intervals.
 
-Workloads (the experiment procedures on the cores, so the figures are the ones a run reports):
+Workloads (the experiment procedures on the cores, so the figures are the ones a run reports;
+every one with the D 8, W 3 mm gripper, GRIPPER below):
 - sweep: PTH0 capacitors dropped onto the tray at three counts, checked with all four stages:
   valid parts per check;
 - feeder: PTH0 feeder_emptying runs of 100 parts at the optimal range [80, 90] (the reduced
   test case's sweep): vibrations to empty the feeder, parts spilled;
 - bins: 480 TO-220s (PTH1) into the test case's biggest and tallest bins, 300 x 300 x 26 and
   200 x 75 x 158 mm: the container-free fraction, parts left moving at the settle's end
-  (flat-bin: the first alone, for more seeds where the intervals are close);
+  (flat-bin, tall-bin: one alone, for more seeds where the intervals are close);
+- the other parts, to tell a part's effect from a pile's: sweep-pth1 and sweep-pth2 (TO-220s
+  and the 8 mm capacitors on the tray at 20, 40 and 60 parts), flat-bin-pth2 (480 capacitors
+  into PTH2's 300 x 300 x 22 mm bin); bins also report the candidates' fraction;
 and for every workload parts tunnelled, the deepest penetration (mm), the worst tray tracking
 error and the wall time per iteration. An interval is mean +- t(0.975, n-1) s / sqrt(n); a
 setting's mean is marked '*' when it lies outside the finest setting's interval (--finest,
 default a quarter of the step).
 
-    tools/ws python bench/bench_convergence.py [--seeds 8] [--workloads sweep,feeder,bins,flat-bin]
+    tools/ws python bench/bench_convergence.py [--seeds 8] [--workloads sweep,feeder,bins,...]
         [--settings default,100-it,...] [--finest dt/4]
 
 Runs are spread over a process per CPU. What it costs: README, "Convergence".
@@ -34,11 +38,13 @@ from pick_sim_world.config import PhysicsConfig
 
 DEFAULT = PhysicsConfig()
 SETTINGS = {
-    'default': DEFAULT,                         # 1/240 s, 100 iterations, full warm start
+    'default': DEFAULT,                         # 1/480 s, 100 iterations, warm start 0.85
+    '1/240': replace(DEFAULT, time_step=1 / 240),   # pybullet's step, the default until 11-25
     'dt/2': replace(DEFAULT, time_step=DEFAULT.time_step / 2),
     'dt/4': replace(DEFAULT, time_step=DEFAULT.time_step / 4),
     'dt/8': replace(DEFAULT, time_step=DEFAULT.time_step / 8),
     '200-it': replace(DEFAULT, solver_iterations=200),
+    'warm-1': replace(DEFAULT, warm_starting_factor=1.0),   # the default of 2026-11-23 to -25
     # the defaults before issue 20's convergence study: 30 iterations, pybullet's warm start
     '30-it': replace(DEFAULT, solver_iterations=30, warm_starting_factor=0.1),
 }
@@ -58,20 +64,46 @@ WORKLOADS = {
              ('container_free', 'unsettled', 'tunnelled', 'max_penetration', 'wall_time')),
     'flat-bin': ('pth1.yaml', lambda n: [{'id': 'bins', 'type': 'bin_static', 'iterations': n,
                                           'parts': 480, 'bins_mm': [[300, 300, 26]]}],
-                 ('container_free', 'unsettled', 'tunnelled', 'max_penetration', 'wall_time')),
+                 ('candidates', 'container_free', 'unsettled', 'tunnelled', 'max_penetration',
+                  'wall_time')),
+    'tall-bin': ('pth1.yaml', lambda n: [{'id': 'bins', 'type': 'bin_static', 'iterations': n,
+                                          'parts': 480, 'bins_mm': [[200, 75, 158]]}],
+                 ('candidates', 'container_free', 'unsettled', 'tunnelled', 'max_penetration',
+                  'wall_time')),
+    # the other parts: is the step's effect the part's or the pile's?
+    'flat-bin-pth2': ('pth2.yaml', lambda n: [{'id': 'bins', 'type': 'bin_static',
+                                               'iterations': n, 'parts': 480,
+                                               'bins_mm': [[300, 300, 22]]}],
+                      ('candidates', 'container_free', 'unsettled', 'tunnelled',
+                       'max_penetration', 'wall_time')),
+    'sweep-pth1': ('pth1.yaml', lambda n: [{'id': 'sweep', 'type': 'table_sweep',
+                                            'iterations': n,
+                                            'counts': {'first': 20, 'last': 60, 'step': 20}}],
+                   ('candidates', 'valid', 'tunnelled', 'max_penetration', 'wall_time')),
+    'sweep-pth2': ('pth2.yaml', lambda n: [{'id': 'sweep', 'type': 'table_sweep',
+                                            'iterations': n,
+                                            'counts': {'first': 20, 'last': 60, 'step': 20}}],
+                   ('candidates', 'valid', 'tunnelled', 'max_penetration', 'wall_time')),
 }
+
+
+# Every workload checks with the smallest gripper that meets PTH0's yield (grippers_pth0.yaml,
+# README "Which gripper"): with the test case's 20 mm one (issue 21's validity) a capacitor on
+# the tray is rarely valid, every feeder run stops at its vibration limit, and the count of
+# vibrations to empty measures nothing.
+GRIPPER = {'body_diameter_mm': 8, 'body_length_mm': 60, 'jaw_height_mm': 15, 'jaw_depth_mm': 3}
 
 
 def job(args: tuple[str, str, int]) -> tuple[str, str, list[dict]]:
     setting, workload, seeds = args
     part_file, experiments, _ = WORKLOADS[workload]
-    rows, _ = run_on_cores(part_file, experiments(seeds), SETTINGS[setting])
+    rows, _ = run_on_cores(part_file, experiments(seeds), SETTINGS[setting], gripper=GRIPPER)
     return setting, workload, rows
 
 
 def value(row: dict, column: str) -> float:
-    if column == 'container_free':
-        return int(row['container_free']) / max(1, int(row['checked']))
+    if column in ('candidates', 'container_free'):    # fractions of the parts checked
+        return int(row[column]) / max(1, int(row['checked']))
     if column == 'max_penetration':
         return 1000.0 * float(row[column])
     if column == 'emptied':

@@ -4,11 +4,12 @@ at the defaults and under settings that could be the cause of the creep (most of
 the former defaults, where the creep was found).
 
     tools/ws python bench/bench_creep.py [--parts 150] [--bin 75x75x60] [--seed 0] [--cap 5]
-        [--settings default,former,...]
+        [--settings default,former,...] [--seconds 1]
 
 Prints per setting: settled or not (and when), wall time, parts still moving at the end, the
 deepest penetration, and over the further second the parts that moved > 0.5 mm, the median
-and the largest displacement. One process; one seed per call.
+and the largest displacement; with --seconds N, the movers in each of N further seconds (a pile
+still settling moves less each second, a creeping one does not). One process; one seed per call.
 """
 
 import argparse
@@ -29,13 +30,17 @@ import pybullet as pb
 
 PTH1 = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src',
                     'experiment_manager', 'config', 'test_case', 'pth1.yaml')
-# The defaults before issue 20's convergence study: 30 iterations, pybullet's warm start 0.1.
+# The defaults before issue 20's convergence study: 30 iterations, pybullet's warm start 0.1
+# and step of 1/240 s.
 # The probes for the cause of the creep ran on them first (README, "Piles that rest").
-FORMER = {'solver_iterations': 30, 'warm_starting_factor': 0.1}
+FORMER = {'solver_iterations': 30, 'warm_starting_factor': 0.1, 'time_step': 1 / 240}
 # name: (PhysicsConfig fields, extra setPhysicsEngineParameter arguments)
 SETTINGS = {
-    'default': ({}, {}),                    # 100 iterations, full warm start
-    'dt/2': ({'time_step': 1 / 480}, {}),
+    'default': ({}, {}),            # 1/480 s, 100 iterations, warm start 0.85 (Bullet's)
+    '1/240': ({'time_step': 1 / 240}, {}),          # the default step until 2026-11-25
+    'warm-1': ({'time_step': 1 / 240, 'warm_starting_factor': 1.0}, {}),  # 2026-11-23 to -25
+    'dt/2': ({'time_step': PhysicsConfig().time_step / 2}, {}),
+    'dt/4': ({'time_step': PhysicsConfig().time_step / 4}, {}),
     '200-it': ({'solver_iterations': 200}, {}),
     '30-it': ({'solver_iterations': 30}, {}),
     'warm-0.1': ({'warm_starting_factor': 0.1}, {}),
@@ -57,19 +62,21 @@ SETTINGS = {
     'former-breaking-5mm': ({**FORMER, 'contact_breaking_threshold': 0.005}, {}),
     'former-breaking-20mm': ({**FORMER, 'contact_breaking_threshold': 0.02}, {}),  # Bullet's
     'former-friction-anchor': (FORMER, {}),       # changeDynamics(frictionAnchor=1), parts
-    'former-no-ccd': (FORMER, {}),                # ccdSweptSphereRadius 0 on the parts
     'former-friction-0.5': (FORMER, {}),  # coefficients sqrt(0.5): Bullet's product is 0.5
     'former-scaled-x10': (FORMER, {}),    # lengths and gravity x 10, masses x 1000
+    # Bullet corrects a penetration by split impulse only when it is deeper than 40 mm
+    # (m_splitImpulsePenetrationThreshold): at our scale, always by Baumgarte velocity.
+    'split-all': ({}, {'splitImpulsePenetrationThreshold': 0.0}),
+    'contact-erp-0.05': ({}, {'contactERP': 0.05}),
 }
 # name: changeDynamics arguments for every part body, after the world creates it
 PART_DYNAMICS = {
     'former-friction-anchor': {'frictionAnchor': 1},
-    'former-no-ccd': {'ccdSweptSphereRadius': 0.0},
 }
 
 
 def creep(name: str, parts: int, size: tuple[float, float, float], seed: int, cap: float,
-          physics: dict, engine: dict) -> str:
+          physics: dict, engine: dict, seconds: int = 1) -> str:
     part = load(PTH1).part
     spec = ContainerSpec(inner_size=size, wall_thickness=0.003)
     scale = 1.0
@@ -101,7 +108,15 @@ def creep(name: str, parts: int, size: tuple[float, float, float], seed: int, ca
         _, report = world.drop(parts, max_settle_time=cap)
         wall = time.perf_counter() - start
         before = world.snapshot()
-        world._run('settling', 1.0, None, stop_when_settled=False)   # a full second
+        # every further second apart: a pile still settling moves less each second, a creeping
+        # one keeps moving
+        per_second = []
+        for _ in range(seconds):
+            start_of_second = world.snapshot()
+            world._run('settling', 1.0, None, stop_when_settled=False)   # a full second
+            step = np.linalg.norm(world.snapshot().poses[:, :3] - start_of_second.poses[:, :3],
+                                  axis=1) / scale
+            per_second.append(int((step > 0.0005).sum()))
         moved = np.linalg.norm(world.snapshot().poses[:, :3] - before.poses[:, :3],
                                axis=1) / scale
     bodies.CONTAINER_FRICTION = CONTAINER_FRICTION
@@ -110,8 +125,10 @@ def creep(name: str, parts: int, size: tuple[float, float, float], seed: int, ca
     return (f'settled {report.settled!s:5} at {report.sim_time:5.2f} s, wall {wall:5.1f} s, '
             f'moving {len(report.unsettled_ids):3d}, penetration '
             f'{1000 * report.max_penetration / scale:.2f} mm | one more second: '
-            f'{int((moved > 0.0005).sum()):3d} moved > 0.5 mm, median '
-            f'{1000 * np.median(moved):.3f} mm, max {1000 * moved.max():.2f} mm')
+            f'{per_second[0]:3d} moved > 0.5 mm, median '
+            f'{1000 * np.median(moved):.3f} mm, max {1000 * moved.max():.2f} mm'
+            + (f' | moved > 0.5 mm in each of {seconds} seconds: '
+               f'{", ".join(map(str, per_second))}' if seconds > 1 else ''))
 
 
 def main() -> None:
@@ -121,12 +138,14 @@ def main() -> None:
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--cap', type=float, default=5.0, help='settle cap, s')
     parser.add_argument('--settings', default=','.join(SETTINGS))
+    parser.add_argument('--seconds', type=int, default=1,
+                        help='further seconds, each counted apart (median and max: over all)')
     args = parser.parse_args()
     size = tuple(float(x) / 1000 for x in args.bin.split('x'))
     print(f'{args.parts} TO-220s into a {args.bin} mm bin, seed {args.seed}', flush=True)
     for name in args.settings.split(','):
         physics, engine = SETTINGS[name]
-        line = creep(name, args.parts, size, args.seed, args.cap, physics, engine)
+        line = creep(name, args.parts, size, args.seed, args.cap, physics, engine, args.seconds)
         print(f'{name:18s} {line}', flush=True)
 
 

@@ -22,16 +22,21 @@ TEST_CASE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src'
                          'experiment_manager', 'config', 'test_case')
 
 
-def run_on_cores(part_file: str, experiments: list[dict], physics: PhysicsConfig | None = None,
-                 **sections) -> tuple[list[dict], float]:
-    """Run TEST_CASE/`part_file` with its experiments replaced by `experiments` and its
-    top-level `sections` (e.g. vibration) by the ones given, on the cores with `physics` (the
-    world's defaults when None); the rows of iterations.csv and the wall time of the run, s."""
+def variant(part_file: str, experiments: list[dict], **sections) -> config.ExperimentFile:
+    """TEST_CASE/`part_file` with its experiments replaced by `experiments` and its top-level
+    `sections` (e.g. vibration, gripper) by the ones given, parsed."""
     path = os.path.join(TEST_CASE, part_file)
     with open(path, encoding='utf-8') as f:
         data = yaml.safe_load(f)
     data.update(sections, experiments=experiments)
-    file = config.parse(yaml.safe_dump(data), path)
+    return config.parse(yaml.safe_dump(data), path)
+
+
+def run_on_cores(part_file: str, experiments: list[dict], physics: PhysicsConfig | None = None,
+                 **sections) -> tuple[list[dict], float]:
+    """Run variant(part_file, experiments, **sections) on the cores with `physics` (the
+    world's defaults when None); the rows of iterations.csv and the wall time of the run, s."""
+    file = variant(part_file, experiments, **sections)
     with tempfile.TemporaryDirectory() as out:
         start = time.perf_counter()
         with LocalBackend(physics) as backend, ResultsWriter(out, file.text) as writer:

@@ -25,11 +25,12 @@ from .config import (
     TABLE_SWEEP,
 )
 
-# The physics faults an iteration is flagged with (procedures.faults); the first two leave it
+# The physics faults an iteration is flagged with (procedures.faults); the first three leave it
 # out of the figures.
-PHYSICS_FAULT, TUNNELLED, UNSETTLED = 'physics_fault', 'tunnelled', 'unsettled'
-FAULTS = (PHYSICS_FAULT, TUNNELLED, UNSETTLED)
-EXCLUDED = (PHYSICS_FAULT, TUNNELLED)
+PHYSICS_FAULT, TUNNELLED, THROWN, UNSETTLED = ('physics_fault', 'tunnelled', 'thrown',
+                                               'unsettled')
+FAULTS = (PHYSICS_FAULT, TUNNELLED, THROWN, UNSETTLED)
+EXCLUDED = (PHYSICS_FAULT, TUNNELLED, THROWN)
 
 FIT_ORDER = 4
 
@@ -177,11 +178,13 @@ def gripper_sweep(exp: Experiment, rows: list[dict], checks: list[dict]) -> dict
 
 
 def physics(rows: list[dict]) -> dict:
-    """The physics health of every iteration (left-out ones too): parts spilled and tunnelled
-    (totals), the most parts left moving at a settle's end, the deepest penetration (m) and
-    the worst tray tracking error (fraction of the command)."""
+    """The physics health of every iteration (left-out ones too): parts spilled, tunnelled and
+    thrown (totals), the most parts left moving at a settle's end, the deepest penetration (m),
+    the fastest part (m/s) and the worst tray tracking error (fraction of the command)."""
     return {'spilled': sum(r['spilled'] for r in rows),
             'tunnelled': sum(r['tunnelled'] for r in rows),
+            'thrown': sum(r['thrown'] for r in rows),
+            'max_speed': max((r['max_speed'] for r in rows), default=0.0),
             'unsettled': max((r['unsettled'] for r in rows), default=0),
             'max_penetration': max((r['max_penetration'] for r in rows), default=0.0),
             'tray_error': max((r['tray_error'] for r in rows), default=0.0)}
@@ -199,9 +202,9 @@ def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: li
               earlier: dict | None = None, checks: list[dict] = ()) -> dict:
     """The metrics of one experiment from its rows of iterations.csv, picks.csv and checks.csv.
     `earlier`: the summaries of the experiments before it (for feeder_emptying's range taken
-    from a table_sweep). Iterations that ended in a physics
-    fault or with a tunnelled part have no figures and are left out; every flagged iteration is
-    listed in `faults`, and `physics` tells the health of all."""
+    from a table_sweep). Iterations that ended in a physics fault or with a tunnelled or
+    thrown part have no figures and are left out; every flagged iteration is listed in
+    `faults`, and `physics` tells the health of all."""
     faults = fault_counts(rows)
     health = physics(rows)
     faulted = {(r['group'], r['iteration']) for r in rows

@@ -47,13 +47,15 @@ def search_order(order: str, states: PartStates, targets: np.ndarray, seed: int)
 def faults(row: dict) -> str:
     """The physics faults of an iteration, '+'-joined ('' for none): `physics_fault` (NaN
     state; the iteration stopped there), `tunnelled` (a part ended in or under the floor or in
-    a wall: solid bodies passed through each other), both of which leave the iteration out of
-    the figures; `unsettled` (a settle hit its cap with more than the moving fraction of parts
-    still moving), flagged and counted. A spill (a part over a wall) is a result, not a fault:
-    its own column. metrics.py counts them."""
+    a wall: solid bodies passed through each other), `thrown` (a part moved faster than
+    gravity and the tray can move it: the solver gave it energy), all three of which leave the
+    iteration out of the figures; `unsettled` (a settle hit its cap with more than the moving
+    fraction of parts still moving), flagged and counted. A spill (a part over a wall) is a
+    result, not a fault: its own column. metrics.py counts them."""
     if row['stop'].startswith(metrics.PHYSICS_FAULT):
         return metrics.PHYSICS_FAULT
     return '+'.join(name for name, bad in ((metrics.TUNNELLED, row['tunnelled']),
+                                           (metrics.THROWN, row['thrown']),
                                            (metrics.UNSETTLED, not row['settled'])) if bad)
 
 
@@ -95,15 +97,18 @@ class Iteration:
 
     def health(self) -> dict:
         """The physics of the iteration's world operations so far: whether every settle
-        rested, the most parts left moving, parts spilled over a wall and tunnelled (ids
-        counted once), the deepest penetration (m) and the worst tray tracking (fraction)."""
+        rested, the most parts left moving, parts spilled over a wall, tunnelled and thrown
+        (ids counted once), the deepest penetration (m), the fastest part (m/s) and the worst
+        tray tracking (fraction)."""
         r = self.reports
         tunnelled = {i for x in r for i in x.tunnelled_ids}
-        spilled = {i for x in r for i in x.spilled_ids} - tunnelled
+        thrown = {i for x in r for i in x.thrown_ids}
+        spilled = {i for x in r for i in x.spilled_ids} - tunnelled - thrown
         return {'settled': all(x.settled for x in r),
                 'unsettled': max((len(x.unsettled_ids) for x in r), default=0),
-                'spilled': len(spilled), 'tunnelled': len(tunnelled),
+                'spilled': len(spilled), 'tunnelled': len(tunnelled), 'thrown': len(thrown),
                 'max_penetration': max((x.max_penetration for x in r), default=0.0),
+                'max_speed': max((x.max_speed for x in r), default=0.0),
                 'tray_error': max((x.tray.error for x in r if x.tray), default=0.0)}
 
     def check(self, states: PartStates, neighbours: bool, vibrations: int = 0,

@@ -116,23 +116,29 @@ def plot_grippers(summary: dict, path: str) -> bool:
 
 
 def _physics_health(summary: dict) -> list[str]:
-    """Per experiment: iterations flagged (a NaN state and a tunnelled part leave an iteration
-    out of the figures; a settle that hit its cap is counted) and the physics of all of them:
-    parts spilled over a wall and tunnelled, the deepest penetration, the worst tray tracking."""
+    """Per experiment: iterations flagged (a NaN state, a tunnelled and a thrown part leave an
+    iteration out of the figures; a settle that hit its cap is counted) and the physics of all
+    of them: parts spilled over a wall, tunnelled and thrown, the deepest penetration, the
+    fastest part, the worst tray tracking."""
     rows = [[f'`{exp_id}`', len(s['faults']['flagged']), s['faults']['physics_fault'],
-             s['faults']['tunnelled'], s['faults']['unsettled'], s['physics']['spilled'],
-             s['physics']['tunnelled'], fmt(1000 * s['physics']['max_penetration'], 3),
+             s['faults']['tunnelled'], s['faults']['thrown'], s['faults']['unsettled'],
+             s['physics']['spilled'], s['physics']['tunnelled'], s['physics']['thrown'],
+             fmt(1000 * s['physics']['max_penetration'], 3), fmt(s['physics']['max_speed'], 2),
              pct(s['physics']['tray_error'])]
             for exp_id, s in summary['experiments'].items()]
     flagged = any(s['faults']['flagged'] for s in summary['experiments'].values())
     lead = [] if flagged else ['No iteration was flagged: every settle ended within its cap, '
-                               'no part tunnelled, no physics state became NaN.', '']
+                               'no part tunnelled or was thrown, no physics state became NaN.',
+                               '']
     return lead + table(['experiment', 'iterations flagged', 'NaN state (left out)',
-                  'tunnelled (left out)', 'unsettled at the cap (counted)', 'parts spilled',
-                  'parts tunnelled', 'deepest penetration (mm)', 'worst tray tracking error'],
+                  'tunnelled (left out)', 'thrown (left out)', 'unsettled at the cap (counted)',
+                  'parts spilled', 'parts tunnelled', 'parts thrown', 'deepest penetration (mm)',
+                  'fastest part (m/s)', 'worst tray tracking error'],
                  rows) + ['', 'Tunnelled: a part ended in or under the floor or in a wall, '
-                          'which solid bodies cannot do; spilled: a part went over a wall. '
-                          'Each flagged iteration has its fault in the `fault` column of '
+                          'which solid bodies cannot do; thrown: a part moved faster than a '
+                          "fall from twice the walls' height plus a bounce off the tray can "
+                          'make it, so the solver gave it energy; spilled: a part went over a '
+                          'wall. Each flagged iteration has its fault in the `fault` column of '
                           '`iterations.csv`.']
 
 
@@ -152,7 +158,7 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
              'meets it: the experiment file refuses others).', '', '## Verdict', '']
     lines += table(['option', 'verdict', 'why'],
                     [[v['option'], f'**{v["verdict"]}**', '; '.join(v['reasons'])]
-                     for v in verdicts(summary, spec)])
+                     for v in verdicts(summary)])
     statics = of_type(summary, 'bin_static')
     if statics:
         exp_id, s = statics[-1]

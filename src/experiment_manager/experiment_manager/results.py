@@ -140,6 +140,14 @@ class ResultsWriter:
             if not header:      # cut inside its header, so no rows: _open writes it anew
                 os.remove(self.path(name))
                 continue
+            columns = header.decode().rstrip('\r\n').split(',')
+            if columns != list(FILES[name]):
+                gone = [c for c in columns if c not in FILES[name]]
+                new = [c for c in FILES[name] if c not in columns]
+                raise InvalidArgument('resume', self.path(name),
+                                      f'has the columns of another version (missing: '
+                                      f'{", ".join(new) or "none"}; unknown: '
+                                      f'{", ".join(gone) or "none"}): start a new run')
             self._write_blocks(name, header, [b for b in blocks if b[0] in done])
             if name in self._rows:
                 self._rows[name] = read_csv(self.path(name))

@@ -14,8 +14,9 @@ KEY = ('experiment', 'group', 'iteration')
 ITERATION_COLUMNS = (
     'experiment', 'type', 'group', 'iteration', 'seed', 'container_x', 'container_y',
     'container_z', 'parts', 'checked', 'outside', 'candidates', 'placeable', 'container_free',
-    'valid', 'checks', 'picks', 'settled', 'unsettled', 'spilled', 'tunnelled', 'max_penetration',
-    'tray_error', 'emptied', 'vibrations', 'feeds', 'stop', 'fault', 'wall_time')
+    'valid', 'checks', 'picks', 'settled', 'unsettled', 'spilled', 'tunnelled', 'thrown',
+    'max_penetration', 'max_speed', 'tray_error', 'emptied', 'vibrations', 'feeds', 'stop',
+    'fault', 'wall_time')
 CHECK_COLUMNS = (*KEY, 'check', 'parts_on_table', 'checked', 'outside', 'candidates',
                  'placeable', 'container_free', 'valid', 'picked_id', 'searches', 'vibrations',
                  'wall_time')
@@ -25,8 +26,8 @@ PICK_COLUMNS = (*KEY, 'pick', 'check', 'part_id', 'searches', 'vibrations', 'gra
 FILES = {'iterations': ITERATION_COLUMNS, 'checks': CHECK_COLUMNS, 'parts': PART_COLUMNS,
          'picks': PICK_COLUMNS}
 TEXT = {'experiment', 'type', 'stop', 'fault'}
-FLOAT = {'container_x', 'container_y', 'container_z', 'max_penetration', 'tray_error',
-         'wall_time', *POSE, *GRIPPER_POSE}
+FLOAT = {'container_x', 'container_y', 'container_z', 'max_penetration', 'max_speed',
+         'tray_error', 'wall_time', *POSE, *GRIPPER_POSE}
 BOOL = {'settled', 'emptied', 'inside'}
 
 

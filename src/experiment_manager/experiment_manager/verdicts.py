@@ -10,7 +10,8 @@ Verdicts, per option:
   interval's parts; the report gives the time per vibration this leaves;
 - gripper (one per gripper_sweep): the smallest gripper of the sweep whose valid parts per
   check reach the experiment's min_valid at 95 % confidence; not feasible when none does.
-Iterations left out of the figures (a NaN state, a tunnelled part) make no option feasible.
+Iterations left out of the figures (a NaN state, a tunnelled or a thrown part) make no option
+feasible.
 An option whose experiment did not run is "not analysed".
 """
 
@@ -44,7 +45,7 @@ FEASIBLE, NOT_FEASIBLE, NOT_ANALYSED = 'FEASIBLE', 'NOT FEASIBLE', 'not analysed
 _STOPS = {'stop: empty': 'feeder and table empty', 'stop: vibration limit': 'vibration limit'}
 
 
-def verdicts(summary: dict, spec: dict) -> list[dict]:
+def verdicts(summary: dict) -> list[dict]:
     """The decision per option: option, verdict, and the reasons (for people)."""
     capacity = summary['requirements']['capacity']
     out = []
@@ -128,9 +129,10 @@ def interval_text(v: dict) -> str:
     return '-' if low is None else f'{fmt(low)} to {fmt(high)}'
 
 
-def _left_out(s: dict) -> int:
-    """Iterations left out of the figures (a NaN state or a tunnelled part)."""
-    return sum(s['faults'][k] for k in EXCLUDED)
+def _left_out(s: dict) -> bool:
+    """Whether iterations were left out of the figures (a NaN state, a tunnelled or a thrown
+    part)."""
+    return any(s['faults'][k] for k in EXCLUDED)
 
 
 def _fault_reason(s: dict) -> list[str]:

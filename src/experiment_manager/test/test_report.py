@@ -47,28 +47,28 @@ def test_verdicts_follow_the_emptied_runs_and_the_capacity(run_dir):
     s['requirements']['capacity'] = 10
     s['experiments']['emptying'].update(emptied=1, iterations=1)
     s['experiments']['feeder'].update(emptied=1, accepted=1, iterations=1)
-    assert [v['verdict'] for v in verdicts.verdicts(s, {})][:2] == [FEASIBLE, FEASIBLE]
+    assert [v['verdict'] for v in verdicts.verdicts(s)][:2] == [FEASIBLE, FEASIBLE]
     # An emptied run that spilled more than the requirement allows is not accepted.
     s['experiments']['feeder'].update(accepted=0, runs_spilling=1)
     s['experiments']['feeder']['physics']['spilled'] = 1
-    table = verdicts.verdicts(s, {})[1]
+    table = verdicts.verdicts(s)[1]
     assert table['verdict'] == NOT_FEASIBLE and (
         "1 part spilled over the tray's walls, in 1 runs; a run may spill 0 "
         '(requirements.max_spilled_parts): 0 of the 1 emptied runs met it') in table['reasons']
     # A tunnelled iteration (left out of the figures) leaves no option feasible.
     s['experiments']['feeder'].update(accepted=1)
     s['experiments']['feeder']['faults']['tunnelled'] = 1
-    assert verdicts.verdicts(s, {})[1]['verdict'] == NOT_FEASIBLE
+    assert verdicts.verdicts(s)[1]['verdict'] == NOT_FEASIBLE
     s['experiments']['feeder'].update(emptied=0, accepted=0)
     s['experiments']['feeder']['stops'] = {'stop: empty': 1, 'stop: vibration limit': 2}
     assert 'runs ended by: feeder and table empty 1, vibration limit 2)' in \
-        verdicts.verdicts(s, {})[1]['reasons'][0]
+        verdicts.verdicts(s)[1]['reasons'][0]
     s['requirements']['capacity'] = 480         # 30 parts cannot last a refill interval
-    bin_verdict = verdicts.verdicts(s, {})[0]
+    bin_verdict = verdicts.verdicts(s)[0]
     assert bin_verdict['verdict'] == NOT_FEASIBLE
     assert 'fewer than the 480 a refill interval needs' in bin_verdict['reasons'][-1]
     del s['experiments']['emptying'], s['experiments']['feeder'], s['experiments']['grippers']
-    assert [v['verdict'] for v in verdicts.verdicts(s, {})] == [NOT_ANALYSED, NOT_ANALYSED]
+    assert [v['verdict'] for v in verdicts.verdicts(s)] == [NOT_ANALYSED, NOT_ANALYSED]
 
 
 def test_the_gripper_verdict_names_the_smallest_gripper_that_meets_the_yield(run_dir):
@@ -77,13 +77,13 @@ def test_the_gripper_verdict_names_the_smallest_gripper_that_meets_the_yield(run
     for v in g['variants']:
         v['meets'] = False
     g['smallest'] = None
-    verdict = verdicts.verdicts(s, {})[2]
+    verdict = verdicts.verdicts(s)[2]
     assert verdict['verdict'] == NOT_FEASIBLE and verdict['option'] == 'gripper (`grippers`)'
     assert verdict['reasons'][0].startswith('no gripper of the sweep gives 1 valid parts per '
                                             'check at 95 % confidence; the most: D ')
     g['variants'][1].update(meets=True, valid_ci95=[1.5, 2.5])
     g['smallest'] = 1
-    verdict = verdicts.verdicts(s, {})[2]
+    verdict = verdicts.verdicts(s)[2]
     assert verdict['verdict'] == FEASIBLE
     assert verdict['option'] == ('gripper D 8, W 3, V 15, L 60, clearance 1 mm; grasps upright '
                                  '(`grippers`)')
@@ -94,7 +94,7 @@ def test_the_gripper_verdict_names_the_smallest_gripper_that_meets_the_yield(run
     assert '| D 8, W 3, V 15, L 60, clearance 1 mm; grasps upright |' in text
     assert '| 1.5 to 2.5 |' in text and '| **smallest** |' in text
     g['faults']['tunnelled'] = 1        # a scene left out: no answer to rely on
-    assert verdicts.verdicts(s, {})[2]['verdict'] == NOT_FEASIBLE
+    assert verdicts.verdicts(s)[2]['verdict'] == NOT_FEASIBLE
 
 
 def test_the_papers_numbers_stand_beside_ours_for_its_test_case(run_dir, tmp_path):

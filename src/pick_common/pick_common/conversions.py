@@ -207,7 +207,8 @@ def settle_from_msg(msg: SettleReportMsg) -> SettleReport:
                         steps=msg.steps, unsettled_ids=list(msg.unsettled_ids),
                         escaped_ids=list(msg.escaped_ids),
                         tunnelled_ids=list(msg.tunnelled_ids),
-                        max_penetration=msg.max_penetration, tray=tray_from_msg(msg.tray))
+                        max_penetration=msg.max_penetration, tray=tray_from_msg(msg.tray),
+                        thrown_ids=list(msg.thrown_ids), max_speed=msg.max_speed)
 
 
 def settle_to_msg(report: SettleReport) -> SettleReportMsg:
@@ -217,7 +218,8 @@ def settle_to_msg(report: SettleReport) -> SettleReportMsg:
                            escaped_ids=list(report.escaped_ids),
                            tunnelled_ids=list(report.tunnelled_ids),
                            max_penetration=report.max_penetration,
-                           tray=tray_to_msg(report.tray))
+                           tray=tray_to_msg(report.tray), thrown_ids=list(report.thrown_ids),
+                           max_speed=report.max_speed)
 
 
 def progress_to_msg(progress: Progress) -> PhysicsProgress:

@@ -81,7 +81,6 @@ class PartGeometry:
     dimensions: the model parameters used, metres (built-ins) or empty (meshes).
     center: centre of the collision compound's bounding box in the part frame, (3,) m.
     radius: radius of a sphere about `center` that encloses the compound, m.
-    thinnest: half the smallest feature thickness, m (the swept-sphere radius for CCD).
     volume: volume of the visual mesh (or of the hulls when it is not watertight), m^3.
     """
 
@@ -92,7 +91,6 @@ class PartGeometry:
     visual: trimesh.Trimesh
     center: np.ndarray
     radius: float
-    thinnest: float
     volume: float
 
 
@@ -167,7 +165,7 @@ def _radial_capacitor(d: Mapping[str, float]):
     # The two leads collide as their convex hull (a thin plate): one shape instead of two,
     # and no thin gap for another part's lead to jitter in.
     collision = [visual[0], _box((pitch / 2 + lead_r, lead_r, lead_l / 2), (0, 0, lead_z))]
-    return collision, visual, lead_r
+    return collision, visual
 
 
 def _to220(d: Mapping[str, float]):
@@ -185,7 +183,7 @@ def _to220(d: Mapping[str, float]):
     lead_z = -(h + ll) / 2
     leads = [_box((lw / 2, lt / 2, ll / 2), (k * pitch, 0, lead_z)) for k in (-1, 0, 1)]
     collision = [body, tab, _box((pitch + lw / 2, lt / 2, ll / 2), (0, 0, lead_z))]
-    return collision, [body, tab, *leads], min(lt, tab_t) / 2
+    return collision, [body, tab, *leads]
 
 
 def _dip(d: Mapping[str, float]):
@@ -207,7 +205,7 @@ def _dip(d: Mapping[str, float]):
             for s in (-1, 1) for k in range(n)]
     collision = [body] + [_box((span / 2, pt / 2, pl / 2), (0, s * rows / 2, pin_z))
                           for s in (-1, 1)]
-    return collision, [body, *pins], pt / 2
+    return collision, [body, *pins]
 
 
 _BUILDERS = {'radial_capacitor': _radial_capacitor, 'to220': _to220, 'dip': _dip}
@@ -222,7 +220,7 @@ def _check_material(spec: PartSpec, default_mass: float) -> float:
 
 
 def _finish(spec: PartSpec, dims: Mapping[str, float], mass: float,
-            collision: list[Primitive], visual: trimesh.Trimesh, thinnest: float,
+            collision: list[Primitive], visual: trimesh.Trimesh,
             volume: float) -> PartGeometry:
     corners = np.vstack([_primitive_mesh(p).bounds for p in collision])
     low, high = corners.min(axis=0), corners.max(axis=0)
@@ -231,7 +229,7 @@ def _finish(spec: PartSpec, dims: Mapping[str, float], mass: float,
     radius = float(np.linalg.norm(points - center, axis=1).max())
     return PartGeometry(spec=spec, dimensions=dict(dims), mass=mass,
                         primitives=tuple(collision), visual=visual, center=center,
-                        radius=radius, thinnest=float(thinnest), volume=float(volume))
+                        radius=radius, volume=float(volume))
 
 
 def _builtin(spec: PartSpec) -> PartGeometry:
@@ -250,10 +248,10 @@ def _builtin(spec: PartSpec) -> PartGeometry:
             dims[name] = check_number(f'part.dimensions.{name}', value, low=MIN_PART_SIZE,
                                       high=MAX_PART_SIZE)
     mass = _check_material(spec, default_mass)
-    collision, visual_parts, thinnest = _BUILDERS[spec.model](dims)
+    collision, visual_parts = _BUILDERS[spec.model](dims)
     visual = trimesh.util.concatenate([_primitive_mesh(p) for p in visual_parts])
     volume = float(sum(_primitive_mesh(p).volume for p in visual_parts))
-    return _finish(spec, dims, mass, collision, visual, thinnest, volume)
+    return _finish(spec, dims, mass, collision, visual, volume)
 
 
 def load_mesh(path: str, scale: float) -> trimesh.Trimesh:
@@ -318,9 +316,7 @@ def _mesh_part(spec: PartSpec) -> PartGeometry:
     collision = [Primitive('hull', (), vertices=np.asarray(h.vertices, dtype=np.float64),
                            faces=np.asarray(h.faces, dtype=np.int64)) for h in hulls]
     volume = mesh.volume if mesh.is_watertight else sum(h.volume for h in hulls)
-    # Half the smallest extent of any hull: the CCD swept-sphere radius.
-    thinnest = min(float(h.extents.min()) for h in hulls) / 2
-    return _finish(spec, {}, mass, collision, mesh, thinnest, volume)
+    return _finish(spec, {}, mass, collision, mesh, volume)
 
 
 def build_part(spec: PartSpec) -> PartGeometry:

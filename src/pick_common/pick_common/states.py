@@ -52,8 +52,11 @@ class SettleReport:
     unsettled_ids: parts still moving at the end. escaped_ids: parts whose centre is outside
     their container's inner volume; of them, tunnelled_ids are in or under the floor or inside
     a wall (a physics fault: solid bodies passed through each other), and the rest spilled over
-    a wall. max_penetration: the deepest overlap of two bodies at the end, m. tray: for a
-    vibration, the motion the trays delivered (TrayMotion), else None.
+    a wall. thrown_ids: parts that moved faster than gravity and the tray can move them
+    (world.speed_limit): a physics fault (the solver gave them energy), wherever they ended.
+    max_penetration: the deepest overlap of two bodies at the end, m. max_speed: the fastest
+    any part's centre moved during the operation while above its container's floor, m/s.
+    tray: for a vibration, the motion the trays delivered (TrayMotion), else None.
     """
 
     settled: bool
@@ -66,12 +69,15 @@ class SettleReport:
     tunnelled_ids: list[int] = field(default_factory=list)
     max_penetration: float = 0.0
     tray: TrayMotion | None = None
+    thrown_ids: list[int] = field(default_factory=list)
+    max_speed: float = 0.0
 
     @property
     def spilled_ids(self) -> list[int]:
-        """Parts outside their container that did not tunnel: they went over a wall."""
-        tunnelled = set(self.tunnelled_ids)
-        return [i for i in self.escaped_ids if i not in tunnelled]
+        """Parts outside their container that neither tunnelled nor were thrown: they went over
+        a wall."""
+        faults = set(self.tunnelled_ids) | set(self.thrown_ids)
+        return [i for i in self.escaped_ids if i not in faults]
 
 
 @dataclass(frozen=True, eq=False)

@@ -55,9 +55,10 @@ def test_tunnelled_points_are_in_or_under_the_floor_or_in_a_wall():
         False, True, True, True, True, False, False]
 
 
-def test_a_settle_report_tells_spilled_from_tunnelled_and_round_trips():
-    report = SettleReport(True, 1.0, 0.5, 240, escaped_ids=[3, 5, 8], tunnelled_ids=[5],
-                          max_penetration=2e-4, tray=TrayMotion(0.003, 0.00297, 0.5, 0.49))
+def test_a_settle_report_tells_spilled_from_tunnelled_and_thrown_and_round_trips():
+    report = SettleReport(True, 1.0, 0.5, 240, escaped_ids=[3, 5, 8, 9], tunnelled_ids=[5],
+                          max_penetration=2e-4, tray=TrayMotion(0.003, 0.00297, 0.5, 0.49),
+                          thrown_ids=[9], max_speed=3.6)
     assert report.spilled_ids == [3, 8]
     assert report.tray.error == pytest.approx(0.02)
     again = conversions.settle_from_msg(conversions.settle_to_msg(report))

@@ -15,7 +15,6 @@ def test_builtin_geometry_is_consistent(model):
     assert part.volume > 0
     # The bounding sphere about `center` encloses the visual and the collision compound.
     assert np.linalg.norm(part.visual.vertices - part.center, axis=1).max() <= part.radius + 1e-9
-    assert 0 < part.thinnest < part.radius
 
 
 def test_capacitor_dimensions_follow_the_parameters():

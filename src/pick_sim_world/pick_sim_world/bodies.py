@@ -88,7 +88,12 @@ def create_container(client: int, spec: ContainerSpec, origin: np.ndarray) -> in
 
 def create_part(client: int, shape: int, part: PartGeometry, pose: np.ndarray) -> int:
     """A part body of `shape` at `pose` (7,) in the world frame, with the part's material.
-    Continuous collision detection sweeps a sphere of the part's thinnest half-thickness."""
+
+    No continuous collision detection: Bullet sweeps only convex shapes
+    (btDiscreteDynamicsWorld's createPredictiveContactsInternal and integrateTransformsInternal
+    test isConvex()), and a part is a compound, so a swept sphere changed no pose (tested bit
+    for bit, world README "Thrown parts"). Streamed drops keep falls short instead, and the
+    world reports parts that tunnel or are thrown."""
     spec = part.spec
     body = pb.createMultiBody(part.mass, shape, basePosition=pose[:3].tolist(),
                               baseOrientation=pose[3:].tolist(), useMaximalCoordinates=True,
@@ -96,7 +101,6 @@ def create_part(client: int, shape: int, part: PartGeometry, pose: np.ndarray) -
     pb.changeDynamics(
         body, -1, lateralFriction=spec.lateral_friction, rollingFriction=spec.rolling_friction,
         spinningFriction=spec.spinning_friction, restitution=spec.restitution,
-        ccdSweptSphereRadius=part.thinnest,
         activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING, physicsClientId=client)
     return body
 

@@ -12,6 +12,7 @@ instance frame (origin at the centre of the container's inner floor, +Z up).
 
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
+import math
 import os
 import shutil
 import tempfile
@@ -40,9 +41,20 @@ import pybullet as pb
 
 from . import bodies, camera, spawning, stepping
 from .camera import Overlay
-from .config import check_physics, PhysicsConfig
+from .config import check_physics, GRAVITY, PhysicsConfig
 from .stepping import ProgressCallback
 from .tray import TrayDrive, vibration_amplitude, vibration_substeps
+
+
+def speed_limit(container: containers.ContainerSpec, part: PartGeometry,
+                tray_speed: float = 0.0) -> float:
+    """The fastest gravity and the tray can move a part's centre, m/s: a free fall from the
+    highest a part can be and still count as in its container (twice the walls' height,
+    containers.inside) plus a part's bounding diameter (where a drop's next layer spawns) to
+    the floor's underside, plus twice the tray's peak speed (a bounce off a moving wall). A
+    part faster than this got its energy from the solver (world README, "Thrown parts")."""
+    height = 2.0 * container.inner_size[2] + 2.0 * part.radius + container.floor_thickness
+    return math.sqrt(2.0 * GRAVITY * height) + 2.0 * tray_speed
 
 
 @dataclass
@@ -118,6 +130,8 @@ class World:
         self._instances, self._bodies, self._owner = [], {}, {}
         self._next_id, self._sim_time = 0, 0.0
         self._at_rest = True     # the last step run ended settled (the settle criterion)
+        self._peaks: dict[int, float] = {}   # part id -> peak speed in this operation, m/s
+        self._tray_speed = 0.0               # the tray's peak speed in this operation, m/s
         shutil.rmtree(self._tmp, ignore_errors=True)
         os.makedirs(self._tmp)
         self._part_shape = bodies.create_part_shape(c, part, self._tmp)
@@ -287,6 +301,8 @@ class World:
         steps = max(1, int(round(vibration.duration / dt)))
         self._drive.start(targets, amplitudes, vibration.frequency, dt)
         drive = self._drive
+        self._tray_speed = float(np.linalg.norm(amplitudes, axis=1).max()
+                                 * 2.0 * math.pi * vibration.frequency)
 
         def tell(p: Progress) -> bool:
             return progress(replace(p, tray=drive.motion()))
@@ -363,7 +379,8 @@ class World:
         """The report of a whole operation, once, at its end: `last` (how it ended) with the
         times and steps of its earlier runs `before` added in, and where the parts ended:
         outside their containers, tunnelled (centre in or under the floor or in a wall), and
-        the deepest penetration."""
+        the deepest penetration; and how fast they moved: the fastest part, and the parts
+        thrown faster than speed_limit (of removed parts too)."""
         for r in before:
             last.sim_time += r.sim_time
             last.wall_time += r.wall_time
@@ -374,6 +391,10 @@ class World:
             gone = containers.tunnelled(self._scene.container, self._centres(state))
             last.tunnelled_ids = [int(i) for i in state.ids[gone]]
         last.max_penetration = bodies.max_penetration(self._client)
+        limit = speed_limit(self._scene.container, self._part, self._tray_speed)
+        last.max_speed = max(self._peaks.values(), default=0.0)
+        last.thrown_ids = sorted(pid for pid, v in self._peaks.items() if v > limit)
+        self._peaks, self._tray_speed = {}, 0.0
         return last
 
     def _run(self, phase: str, duration: float, progress: ProgressCallback | None,
@@ -389,7 +410,8 @@ class World:
         pb.setPhysicsEngineParameter(fixedTimeStep=physics.time_step, physicsClientId=c)
         try:
             out = stepping.step(c, ids, [self._bodies[i] for i in ids], physics, phase,
-                                duration, progress, self._drive, stop_when_settled)
+                                duration, progress, self._drive, stop_when_settled,
+                                floor=-self._scene.container.floor_thickness)
         except PhysicsFault:
             self._build(self._scene, self._part)
             raise
@@ -398,6 +420,8 @@ class World:
                                          physicsClientId=c)
         self._sim_time += out.steps * physics.time_step
         self._at_rest = out.settled
+        for pid, speed in zip(ids, out.peak_speeds, strict=True):
+            self._peaks[pid] = max(speed, self._peaks.get(pid, 0.0))
         settled = out.settled if stop_when_settled else not out.canceled
         return SettleReport(settled, out.steps * physics.time_step, out.wall_time, out.steps,
                             out.moving_ids, canceled=out.canceled)
