@@ -70,6 +70,10 @@ def core_run(tmp_path_factory) -> str:
 def test_the_graph_gives_the_results_of_the_cores(graph_run, core_run):
     run_dir, _, done = graph_run
     assert 'best bin' in done.stdout and 'optimum' in done.stdout
+    # the decisions end the output: one line per option, as the report's verdict table
+    verdict_lines = done.stdout.split('verdicts:\n')[1].splitlines()
+    assert [line.split()[0] for line in verdict_lines] == ['static', 'vibrating', 'gripper']
+    assert all(re.search(r': (NOT FEASIBLE|FEASIBLE) \(.+\)$', line) for line in verdict_lines)
     report = re.search(r'^report:\s+(\S+)', done.stdout, re.M).group(1)
     assert report == os.path.join(run_dir, 'report.html')
     for name in ('report.md', 'fig14_bins.png', 'fig15_table.png', 'bin.png', 'tray.png'):
@@ -119,7 +123,9 @@ def test_every_recorded_message_decodes_and_matches_the_results(graph_run):
     for i in iterations:
         got = settles[(i['experiment'], i['group'], i['iteration'])]
         assert max(r.max_penetration for r in got) == float(i['max_penetration'])
+        assert max(r.max_speed for r in got) == float(i['max_speed'])
         assert len({t for r in got for t in r.tunnelled_ids}) == int(i['tunnelled'])
+        assert len({t for r in got for t in r.thrown_ids}) == int(i['thrown'])
     checks: dict[tuple, list] = {}
     for c in rows(run_dir, 'checks'):
         if int(c['parts_on_table']):
@@ -209,6 +215,33 @@ def test_a_bad_file_fails_before_any_node_starts(tmp_path):
                      done.stderr), done.stderr
     assert time.monotonic() - start < 30 and 'node logs' not in done.stderr
 
+
+
+def test_every_error_of_a_file_and_a_bad_option_are_named_as_given(tmp_path):
+    bad = tmp_path / 'bad.yaml'
+    bad.write_text(open(SMALL).read().replace('max_vibrations: 15', 'max_vibrations: -3')
+                   .replace('seed:', 'sed:'))
+    done = run_command(str(bad), '--output', str(tmp_path), timeout=120)
+    assert done.returncode == 2
+    assert 'run: 2 errors:' in done.stderr, done.stderr
+    assert f'{bad}: sed: ' in done.stderr and 'did you mean seed?' in done.stderr
+    assert re.search(r'experiments\[3\]\.max_vibrations: -3 must be within', done.stderr)
+    done = run_command(SMALL, '--iterations', '-1', timeout=120)
+    assert done.returncode == 2 and '--iterations -1 must be within [1, ' in done.stderr
+
+
+def test_the_reduced_copies_of_iterations_are_removed(tmp_path):
+    # --iterations writes a reduced copy of each file; a run that stops (here: on the second,
+    # bad, file) leaves none behind.
+    scratch = tmp_path / 'tmp'
+    scratch.mkdir()
+    bad = tmp_path / 'bad.yaml'
+    bad.write_text(open(SMALL).read().replace('max_vibrations: 15', 'max_vibrations: -3'))
+    done = subprocess.run([executable('experiment_manager', 'run'), SMALL, str(bad),
+                           '--iterations', '1'], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, 'TMPDIR': str(scratch)})
+    assert done.returncode == 2 and 'max_vibrations' in done.stderr, done.stderr
+    assert list(scratch.iterdir()) == []
 
 LONG = """id: long
 seed: 3

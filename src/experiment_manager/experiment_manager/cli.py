@@ -40,6 +40,7 @@ from rclpy.validate_namespace import validate_namespace
 from . import config, interrupt
 from .claim import claim, NamespaceInUse
 from .supervisor import Graph, report_dead, spin_until, start_graph
+from .verdicts import verdicts
 from .wording import gripper_label
 
 MAX_WORKERS = 64
@@ -123,6 +124,9 @@ def _parse(argv: list[str]) -> argparse.Namespace:
         parser.error('--resume runs the file of the run directory: no --iterations')
     if not 0 <= args.respawns <= 100:
         parser.error(f'--respawns {args.respawns} must be within [0, 100]')
+    if args.iterations is not None and not 1 <= args.iterations <= config.MAX_ITERATIONS:
+        parser.error(f'--iterations {args.iterations} must be within '
+                     f'[1, {config.MAX_ITERATIONS}]')
     if not 1 <= args.workers <= MAX_WORKERS:
         parser.error(f'--workers {args.workers} must be within [1, {MAX_WORKERS}]')
     try:
@@ -160,33 +164,49 @@ def _summary_lines(summary: dict) -> list[str]:
     return lines
 
 
-def _goals(args: argparse.Namespace) -> list[tuple[RunExperiment.Goal, str]]:
-    """A goal per file with the file's mesh ('' for none), every file checked first. Raises
-    InvalidArgument naming the file."""
+def _goals(args: argparse.Namespace,
+           temporary: list[str]) -> list[tuple[RunExperiment.Goal, str, str]]:
+    """A goal per file with the file's mesh ('' for none) and the path as given (the goal's may
+    be a reduced copy), every file checked first. Raises InvalidArgument naming the file
+    (InvalidFile when it has several errors). The reduced copies that --iterations writes are
+    added to `temporary`, for the caller to remove."""
     goals = []
     files = args.experiment_files or [os.path.join(args.resume, 'experiment.yaml')
                                       if args.resume else default_file()]
-    for path in [os.path.abspath(p) for p in files]:
+    for given in files:
+        path = os.path.abspath(given)
         try:
             file = config.load(path)
-            if args.iterations is not None:
-                fd, path = tempfile.mkstemp(prefix=f'{file.id}_', suffix='.yaml')
-                with os.fdopen(fd, 'w') as f:
-                    f.write(config.reduced(file, args.iterations))
-                config.load(path)
         except InvalidArgument as exc:
-            raise InvalidArgument(f'{path}: {exc.field}', exc.value, exc.rule) from None
+            named = [InvalidArgument(f'{path}: {e.field}', e.value, e.rule) for e in
+                     (exc.errors if isinstance(exc, config.InvalidFile) else [exc])]
+            raise (named[0] if len(named) == 1 else config.InvalidFile(named)) from None
+        if args.iterations is not None:
+            # the run directory keeps the file that ran; this copy goes when run ends
+            fd, path = tempfile.mkstemp(prefix=f'{file.id}_', suffix='.yaml')
+            temporary.append(path)
+            with os.fdopen(fd, 'w') as f:
+                f.write(config.reduced(file, args.iterations))
         output = os.path.abspath(os.path.expanduser(args.resume or args.output
                                                     or file.output_dir))
         goals.append((RunExperiment.Goal(experiment_file=path, resume=bool(args.resume),
-                                         output_dir=output), file.part.mesh_path))
+                                         output_dir=output), file.part.mesh_path, given))
     return goals
 
 
 def main(argv: list[str] | None = None) -> int:
     args = _parse(sys.argv[1:] if argv is None else argv)
+    temporary: list[str] = []
     try:
-        goals = _goals(args)     # fail here, before any process starts
+        return _main(args, temporary)
+    finally:
+        for path in temporary:
+            os.remove(path)
+
+
+def _main(args: argparse.Namespace, temporary: list[str]) -> int:
+    try:
+        goals = _goals(args, temporary)     # fail here, before any process starts
     except InvalidArgument as exc:
         print(f'run: {exc}', file=sys.stderr)
         return 2
@@ -204,12 +224,13 @@ def main(argv: list[str] | None = None) -> int:
     try:
         lock = claim(node, args.namespace, args.workers)   # released after our nodes stop
         graph = Graph(start_graph(args.namespace, log_dir, args.workers,
-                                  [g.experiment_file for g, _ in goals], [m for _, m in goals],
-                                  [g.output_dir for g, _ in goals], args.respawns),
+                                  [g.experiment_file for g, _, _ in goals],
+                                  [m for _, m, _ in goals],
+                                  [g.output_dir for g, _, _ in goals], args.respawns),
                       args.respawns)
         client = ActionClient(node, RunExperiment, 'run_experiment')
-        for goal, _ in goals:
-            code = _run(node, client, goal, graph, bar)
+        for goal, _, given in goals:
+            code = _run(node, client, goal, given, graph, bar)
             if code:
                 return code
         return 0
@@ -233,8 +254,8 @@ def main(argv: list[str] | None = None) -> int:
             lock.close()        # the namespace is free once our nodes are gone
 
 
-def _run(node: Node, client: ActionClient, goal, graph: Graph, bar) -> int:
-    print(f'run: {goal.experiment_file}', file=sys.stderr)
+def _run(node: Node, client: ActionClient, goal, given: str, graph: Graph, bar) -> int:
+    print(f'run: {given}', file=sys.stderr)
     manager = graph.manager
     if not report_dead(node, client.server_is_ready, graph, START_TIMEOUT, bar) \
             or not client.server_is_ready():
@@ -271,5 +292,10 @@ def _run(node: Node, client: ActionClient, goal, graph: Graph, bar) -> int:
     print(f'summary:   {os.path.join(result.results_path, "summary.json")}')
     if result.report_path:
         print(f'report:    {result.report_path}')
-    print('\n'.join(_summary_lines(json.loads(result.summary_json))))
+    summary = json.loads(result.summary_json)
+    print('\n'.join(_summary_lines(summary)))
+    # the decisions, each with its first reason (the report gives them all)
+    print('verdicts:\n' + '\n'.join(
+        f'  {v["option"].replace("`", "")}: {v["verdict"]} ({v["reasons"][0]})'
+        for v in verdicts(summary)))
     return 0

@@ -2,13 +2,16 @@
 
 A YAML file describes the part, the gripper, the containers, the requirements and a list of
 experiments. Lengths are in mm and angles in degrees only where the key says so (`size_mm`,
-`tolerance_deg`); everything is converted to SI here. Unknown keys are errors. Every error is an
-`InvalidArgument` naming the field by its path in the file (`experiments[1].bins_mm[0][2]`), the
-value and the rule. The annotated example is `config/default_experiment.yaml`.
+`tolerance_deg`); everything is converted to SI here. Unknown keys are errors, named with the
+nearest known key. Every error is an `InvalidArgument` naming the field by its path in the file
+(`experiments[1].bins_mm[0][2]`), the value and the rule; a file is checked section by section
+and experiment by experiment, and all the errors found come at once (`InvalidFile`). The
+annotated example is `config/default_experiment.yaml`.
 """
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+import difflib
 import itertools
 import math
 import os
@@ -140,6 +143,25 @@ class ExperimentFile:
         return next(e for e in self.experiments if e.id == experiment_id)
 
 
+class InvalidFile(InvalidArgument):
+    """Every error found in an experiment file: one per section or experiment at most (a
+    section's later checks may depend on its first error's value). `errors` lists them;
+    field, value and rule are the first's, and the message lists all."""
+
+    def __init__(self, errors: list[InvalidArgument]) -> None:
+        first = errors[0]
+        super().__init__(first.field, first.value, first.rule)
+        self.errors = list(errors)
+        if len(errors) > 1:
+            self.args = (f'{len(errors)} errors:\n' + '\n'.join(f'  {e}' for e in errors),)
+
+
+def _nearest(key: str, candidates) -> str | None:
+    """The candidate closest to `key`, when one is close enough to be what was meant."""
+    match = difflib.get_close_matches(str(key), [str(c) for c in candidates], n=1, cutoff=0.6)
+    return match[0] if match else None
+
+
 class _Map:
     """A mapping of the file under a path; takes its keys one by one and rejects the rest."""
 
@@ -155,6 +177,12 @@ class _Map:
         self.taken.add(key)
         if key not in self.value:
             if required:
+                # A misspelt required key reads as the typo it is, not only as a missing key.
+                typo = _nearest(key, self.value)
+                if typo is not None:
+                    raise InvalidArgument(self.where(typo), _short(self.value[typo]),
+                                          f'is not a known key here (did you mean {key}? it '
+                                          'is required)')
                 raise InvalidArgument(self.where(key), None, 'is required')
             return default
         return self.value[key]
@@ -191,11 +219,18 @@ class _Map:
     def done(self) -> None:
         """Reject every key that was not taken."""
         unknown = sorted(str(k) for k in self.value if k not in self.taken)
-        if unknown:
-            allowed = ', '.join(sorted(self.taken))
-            raise InvalidArgument(self.where(unknown[0]), self.value[unknown[0]]
-                                  if not isinstance(self.value[unknown[0]], Mapping) else '{...}',
-                                  f'is not a known key here (known: {allowed})')
+        if not unknown:
+            return
+        allowed = ', '.join(sorted(self.taken))
+        errors = []
+        for key in unknown:
+            near = _nearest(key, self.taken)
+            errors.append(InvalidArgument(
+                self.where(key), _short(self.value[key])
+                if not isinstance(self.value[key], Mapping) else '{...}',
+                'is not a known key here' + (f' (did you mean {near}?)' if near else '')
+                + f' (known: {allowed})'))
+        raise errors[0] if len(errors) == 1 else InvalidFile(errors)
 
 
 def _short(value: Any) -> Any:
@@ -493,25 +528,7 @@ def _moves(m: _Map) -> tuple[Vibration, ...]:
     return tuple(out)
 
 
-def parse(text: str, path: str = '') -> ExperimentFile:
-    """Read and check an experiment file's text. Raises InvalidArgument on the first error."""
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, 'problem_mark', None)
-        where = f'line {mark.line + 1}, column {mark.column + 1}' if mark else 'file'
-        raise InvalidArgument(where, path, f'is not valid YAML: '
-                              f'{getattr(exc, "problem", None) or exc}') from None
-    m = _Map(data, '')
-    base_dir = os.path.dirname(os.path.abspath(path)) if path else os.getcwd()
-    file_id = _id(m, 'id')
-    seed = m.integer('seed', 0, 0, MAX_SEED)
-    output_dir = m.text('output_dir', 'results')
-    part, grasps, place = _part(m.sub('part'), base_dir)
-    g = m.sub('gripper')
-    gripper = _gripper(g, Gripper())
-    g.done()
-    c = m.sub('check')
+def _check(c: _Map) -> tuple[CheckConfig, str]:
     dc = CheckConfig()
     check = CheckConfig(tolerance=c.number('tolerance_deg', dc.tolerance / DEG, scale=DEG),
                         tilt_min=c.number('tilt_min_deg', dc.tilt_min / DEG, scale=DEG),
@@ -521,43 +538,109 @@ def parse(text: str, path: str = '') -> ExperimentFile:
                                                scale=DEG),
                         rim_tolerance=c.number('rim_tolerance_mm', dc.rim_tolerance / MM,
                                                scale=MM))
-    search_order = c.text('search_order', 'top_first', SEARCH_ORDERS)
-    c.done()
-    r = m.sub('requirements')
-    requirements = Requirements(
+    return check, c.text('search_order', 'top_first', SEARCH_ORDERS)
+
+
+def _requirements(r: _Map) -> Requirements:
+    return Requirements(
         parts_per_hour=r.number('parts_per_hour', 60.0, low=0.0, high=1e6, low_open=True),
         refill_interval=r.number('refill_interval_h', 4.0, low=0.0, high=1000.0,
                                  low_open=True, scale=3600.0),
         max_dimension=r.number('max_dimension_mm', 300.0, low=0.0, high=2000.0,
                                low_open=True, scale=MM),
         max_spilled=r.integer('max_spilled_parts', 0, low=0, high=100_000))
-    r.done()
+
+
+def _tray(m: _Map) -> ContainerSpec:
     tray = ContainerSpec.tray(m.vector('tray_mm', [s / MM for s in TRAY_DEFAULT_SIZE], 3,
                                        low=0.0, low_open=True, scale=MM))
     _checked(check_container, tray, 'tray_mm')
-    moves = _moves(m)
-    bin_wall = m.number('bin_wall_mm', 3.0, low=0.5, high=100.0, scale=MM)
-    # The core's own checks, under the file's names.
-    _checked(check_gripper, gripper, 'gripper')
-    _checked(check_grasps, list(grasps), 'part.grasps')
-    _checked(check_place, place, 'part.place')
-    _checked(tilts, check, 'check')
+    return tray
+
+
+def _geometry(part: PartSpec):
     try:
-        geometry = build_part(part)
+        return build_part(part)
     except InvalidArgument as exc:
         raise InvalidArgument(f'part ({exc.field})', exc.value, exc.rule) from None
-    raw = m.get('experiments', None, required=True)
-    if not isinstance(raw, list) or not 1 <= len(raw) <= MAX_EXPERIMENTS:
-        raise InvalidArgument('experiments', _short(raw),
-                              f'must be a list of 1..{MAX_EXPERIMENTS} experiments')
-    context = {'part_geometry': geometry, 'tray': tray, 'bin_wall': bin_wall,
-               'max_dimension': requirements.max_dimension, 'gripper': gripper,
-               'grasps': grasps}
+
+
+def parse(text: str, path: str = '') -> ExperimentFile:
+    """Read and check an experiment file's text. Raises InvalidArgument for one error,
+    InvalidFile (an InvalidArgument) listing every error found when there are more."""
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, 'problem_mark', None)
+        where = f'line {mark.line + 1}, column {mark.column + 1}' if mark else 'file'
+        raise InvalidArgument(where, path, f'is not valid YAML: '
+                              f'{getattr(exc, "problem", None) or exc}') from None
+    m = _Map(data, '')
+    base_dir = os.path.dirname(os.path.abspath(path)) if path else os.getcwd()
+    errors: list[InvalidArgument] = []
+
+    def checked(step: Callable[[], Any]) -> Any:
+        """One section read and checked; its error kept, and the next section read."""
+        try:
+            return step()
+        except InvalidFile as exc:
+            errors.extend(exc.errors)
+        except InvalidArgument as exc:
+            errors.append(exc)
+        return None
+
+    file_id = checked(lambda: _id(m, 'id'))
+    seed = checked(lambda: m.integer('seed', 0, 0, MAX_SEED))
+    output_dir = checked(lambda: m.text('output_dir', 'results'))
+    part_grasps_place = checked(lambda: _part(m.sub('part'), base_dir))
+    part, grasps, place = part_grasps_place or (None, None, None)
+
+    def section(key: str, read: Callable[[_Map], Any]) -> Any:
+        """A section's value (None when it has an error), its unknown keys refused apart."""
+        sub = checked(lambda: m.sub(key))
+        if sub is None:
+            return None
+        value = checked(lambda: read(sub))
+        checked(sub.done)
+        return value
+
+    gripper = section('gripper', lambda g: _gripper(g, Gripper()))
+    check, search_order = section('check', _check) or (None, None)
+    requirements = section('requirements', _requirements)
+    tray = checked(lambda: _tray(m))
+    moves = checked(lambda: _moves(m))
+    bin_wall = checked(lambda: m.number('bin_wall_mm', 3.0, low=0.5, high=100.0, scale=MM))
+    raw = checked(lambda: m.get('experiments', None, required=True))
+    # The core's own checks, under the file's names.
+    if gripper is not None:
+        checked(lambda: _checked(check_gripper, gripper, 'gripper'))
+    if part_grasps_place is not None:
+        checked(lambda: _checked(check_grasps, list(grasps), 'part.grasps'))
+        checked(lambda: _checked(check_place, place, 'part.place'))
+    if check is not None:
+        checked(lambda: _checked(tilts, check, 'check'))
+    geometry = checked(lambda: _geometry(part)) if part is not None else None
     experiments: dict[str, Experiment] = {}
-    for i, item in enumerate(raw):
-        e = _experiment(_Map(item, f'experiments[{i}]'), context, experiments)
-        experiments[e.id] = e
-    m.done()
+    if 'experiments' not in m.value:
+        pass                # the missing key's error is kept
+    elif not isinstance(raw, list) or not 1 <= len(raw) <= MAX_EXPERIMENTS:
+        errors.append(InvalidArgument('experiments', _short(raw),
+                                      f'must be a list of 1..{MAX_EXPERIMENTS} experiments'))
+    elif None not in (geometry, tray, bin_wall, requirements, gripper, grasps):
+        context = {'part_geometry': geometry, 'tray': tray, 'bin_wall': bin_wall,
+                   'max_dimension': requirements.max_dimension, 'gripper': gripper,
+                   'grasps': grasps}
+        for i, item in enumerate(raw):
+            e = checked(lambda item=item, i=i: _experiment(_Map(item, f'experiments[{i}]'),
+                                                           context, experiments))
+            if e is not None:
+                experiments[e.id] = e
+    checked(m.done)
+    # one error per field: a misspelt required key is found missing and then unknown
+    fields: set[str] = set()
+    errors = [e for e in errors if not (e.field in fields or fields.add(e.field))]
+    if errors:
+        raise errors[0] if len(errors) == 1 else InvalidFile(errors)
     return ExperimentFile(
         id=file_id, seed=seed, output_dir=output_dir, part=part, gripper=gripper, grasps=grasps,
         place=place, check=check, search_order=search_order, tray=tray, moves=moves,

@@ -5,6 +5,7 @@ import math
 import os
 import re
 
+from ament_index_python.packages import get_package_share_directory
 from experiment_manager import config
 from pick_common.errors import InvalidArgument
 from pick_common.specs import MOVES
@@ -43,7 +44,8 @@ def test_omitted_keys_take_the_documented_defaults():
 BAD = [
     ('colour: red\n' + MINIMAL, r"colour: 'red' is not a known key here \(known: "),
     ('gripper: {body_diameter: 20}\n' + MINIMAL,
-     r'gripper\.body_diameter: 20 is not a known key here \(known: body_diameter_mm'),
+     r'gripper\.body_diameter: 20 is not a known key here \(did you mean body_diameter_mm\?\) '
+     r'\(known: body_diameter_mm'),
     ('seed: abc\n' + MINIMAL, r"seed: 'abc' is not an integer"),
     ('seed: -1\n' + MINIMAL, r'seed: -1 must be within \[0, '),
     ('check: {tolerance_deg: .nan}\n' + MINIMAL, r'check\.tolerance_deg: nan must be finite'),
@@ -99,7 +101,8 @@ BAD = [
     (SWEEP + 'grippers: {jaw_depth_mm: [3, x]}}\n',
      r"grippers\.jaw_depth_mm\[1\]: 'x' is not a number"),
     (SWEEP + 'grippers: {jaw_width_mm: 3}}\n',
-     r'grippers\.jaw_width_mm: 3 is not a known key here \(known: body_diameter_mm'),
+     r'grippers\.jaw_width_mm: 3 is not a known key here \(did you mean jaw_depth_mm\?\) '
+     r'\(known: body_diameter_mm'),
     (SWEEP + 'grippers: {body_diameter_mm: [0, 8]}}\n',
      r'grippers \(body_diameter_mm 0, body_length_mm 60, .*\) \(gripper\.body_diameter\): 0'),
     (SWEEP + 'grippers: {body_diameter_mm: [5, 6, 7, 8, 9, 10, 11, 12, 13], '
@@ -190,3 +193,44 @@ def test_feeder_moves_are_named_or_set_field_by_field():
                           r'moves\[0\] \(vibration.amplitude\[2\]\): -0.001 must be >= 0')):
         with pytest.raises(InvalidArgument, match=error):
             config.parse(text.replace('moves: [spread]', f'moves: {moves}'))
+
+
+def test_the_installed_share_holds_the_paper_test_case():
+    # A user of an installed workspace runs the test case by its share path.
+    share = os.path.join(get_package_share_directory('experiment_manager'), 'config')
+    for name in ('pth0.yaml', 'pth1.yaml', 'pth2.yaml', 'grippers_pth0.yaml'):
+        assert config.load(os.path.join(share, 'test_case', name)).experiments
+
+
+def test_every_error_of_a_file_comes_at_once():
+    # One per section or experiment: the user fixes a file in one pass, not one run per typo.
+    text = """id: t
+seed: -1
+gripper: {body_diameter_mm: 20, jaw_depht_mm: 3}
+experiments:
+  - {id: b, type: bin_static, iterations: 0, parts: 10, bins_mm: [[100, 100, 20]]}
+  - {id: s, type: table_sweep, iterations: 1, margn: 5}
+"""
+    with pytest.raises(config.InvalidFile) as info:
+        config.parse(text)
+    assert [e.field for e in info.value.errors] == [
+        'seed', 'gripper.jaw_depht_mm', 'experiments[0].iterations', 'experiments[1].margn']
+    message = str(info.value)
+    assert message.startswith('4 errors:\n')
+    assert 'gripper.jaw_depht_mm: 3 is not a known key here (did you mean jaw_depth_mm?)' in message
+    assert 'experiments[1].margn: 5 is not a known key here (did you mean margin?)' in message
+
+
+def test_an_empty_experiment_list_is_refused():
+    for text in ('id: t\nexperiments:\n', 'id: t\nexperiments: []\n'):
+        with pytest.raises(InvalidArgument, match=r'^experiments: .* must be a list of 1\.\.'):
+            config.parse(text)
+
+
+def test_a_misspelt_required_key_is_named_as_the_typo_it_is():
+    text = MINIMAL.replace('iterations: 1', 'iteration: 1')
+    with pytest.raises(InvalidArgument) as info:
+        config.parse(text)
+    assert str(info.value) == ('experiments[0].iteration: 1 is not a known key here '
+                               '(did you mean iterations? it is required)')
+    assert not isinstance(info.value, config.InvalidFile)     # one error, told once
