@@ -8,6 +8,7 @@ worker killed (the run fails, keeping what finished)."""
 
 from collections.abc import Callable
 import glob
+import json
 import os
 import re
 import signal
@@ -19,6 +20,7 @@ from experiment_manager.launcher import executable, WORKER_NODES
 from experiment_manager.local_backend import LocalBackend
 from experiment_manager.results import FILES, read_text_rows, ResultsWriter
 from experiment_manager.scheduler import Runner
+from experiment_manager.verdicts import verdicts
 from graph import SMALL, unique_namespace
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
@@ -73,7 +75,13 @@ def test_the_graph_gives_the_results_of_the_cores(graph_run, core_run):
     # the decisions end the output: one line per option, as the report's verdict table
     verdict_lines = done.stdout.split('verdicts:\n')[1].splitlines()
     assert [line.split()[0] for line in verdict_lines] == ['static', 'vibrating', 'gripper']
-    assert all(re.search(r': (NOT FEASIBLE|FEASIBLE) \(.+\)$', line) for line in verdict_lines)
+    assert all(re.search(r': (NOT FEASIBLE|FEASIBLE|UNDECIDED) \(.+\)$', line)
+               for line in verdict_lines)
+    with open(os.path.join(core_run, 'summary.json')) as f:     # the cores decide the same
+        expected = [f'  {v["option"].replace("`", "")}: {v["verdict"]} ('
+                    for v in verdicts(json.load(f))]
+    assert all(line.startswith(e) for line, e in zip(verdict_lines, expected, strict=True)), \
+        (verdict_lines, expected)
     report = re.search(r'^report:\s+(\S+)', done.stdout, re.M).group(1)
     assert report == os.path.join(run_dir, 'report.html')
     for name in ('report.md', 'fig14_bins.png', 'fig15_table.png', 'bin.png', 'tray.png'):

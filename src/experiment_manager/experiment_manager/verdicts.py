@@ -2,22 +2,27 @@
 and, for the paper's test-case files, the paper's findings checked on the run (against_paper).
 Rendering them is report.py's job.
 
-Verdicts, per option:
-- static bin: feasible when every `bin_emptying` iteration emptied the bin and the bin holds a
-  refill interval's parts (requirements.parts_per_hour x refill_interval_h);
-- vibrating table: feasible when every `feeder_emptying` run emptied the feeder spilling no more
-  than requirements.max_spilled_parts over the tray's walls, and the feeder held a refill
-  interval's parts; the report gives the time per vibration this leaves;
+Verdicts, per option, each resting on a rate with its 95 % interval (metrics.rate_interval):
+- static bin: the share of `bin_emptying` iterations that emptied the bin, against
+  requirements.success_rate; and the bin must hold a refill interval's parts
+  (requirements.parts_per_hour x refill_interval_h);
+- vibrating table: the share of `feeder_emptying` runs that emptied the feeder spilling no
+  more than requirements.max_spilled_parts over the tray's walls, against
+  requirements.success_rate; and the feeder must hold a refill interval's parts; the report
+  gives the time per vibration this leaves;
 - gripper (one per gripper_sweep): the smallest gripper of the sweep whose valid parts per
-  check reach the experiment's min_valid at 95 % confidence; not feasible when none does.
-Iterations left out of the figures (a NaN state, a tunnelled or a thrown part) make no option
-feasible.
+  check reach the experiment's min_valid at 95 % confidence; not feasible when every
+  gripper's interval lies below min_valid.
+A rate decides only where its interval clears the requirement (feasible) or lies below it
+(not feasible); otherwise the verdict is UNDECIDED, with the iterations that would decide if
+the rate seen held. Iterations left out of the figures (a NaN state, a tunnelled or a thrown
+part) make no option feasible.
 An option whose experiment did not run is "not analysed".
 """
 
 import numpy as np
 
-from .metrics import EXCLUDED, FAULTS
+from .metrics import EXCLUDED, FAULTS, iterations_to_decide
 from .wording import count, dims, fmt, gripper_label, of_type, pct, table
 
 # The paper's results (section 5) for its test case, by experiment-file id.
@@ -40,7 +45,8 @@ PAPER = {
 }
 DIFFERS = 1.25     # a figure differs from the paper's when ours is over 1.25x or under 0.8x it
 FALLS = 0.05       # past n*, the sweep's fit "falls" when it ends at least 5 % below its peak
-FEASIBLE, NOT_FEASIBLE, NOT_ANALYSED = 'FEASIBLE', 'NOT FEASIBLE', 'not analysed'
+FEASIBLE, NOT_FEASIBLE, UNDECIDED, NOT_ANALYSED = ('FEASIBLE', 'NOT FEASIBLE', 'UNDECIDED',
+                                                  'not analysed')
 # the feeder policy's stop decisions (feeder_controller.policy.NAMES), as a report says them
 _STOPS = {'stop: empty': 'feeder and table empty', 'stop: vibration limit': 'vibration limit'}
 
@@ -48,21 +54,24 @@ _STOPS = {'stop: empty': 'feeder and table empty', 'stop: vibration limit': 'vib
 def verdicts(summary: dict) -> list[dict]:
     """The decision per option: option, verdict, and the reasons (for people)."""
     capacity = summary['requirements']['capacity']
+    required = summary['requirements']['success_rate']
     out = []
     emptying = of_type(summary, 'bin_emptying')
     if emptying:
         _, s = emptying[-1]
-        reasons = [f'{s["emptied"]} of {s["iterations"]} bins emptied; parts removed per bin: '
-                   f'mean {fmt(s["removed"]["mean"])}, max {fmt(s["removed"]["max"])} '
-                   f'of {s["parts"]}']
-        ok = s['iterations'] > 0 and s['emptied'] == s['iterations'] and not _left_out(s)
+        verdict, rate = _rate_verdict(s['emptied'], s['iterations'], s['emptied_ci95'],
+                                      required, 'bins emptied')
+        reasons = [rate, f'parts removed per bin: mean {fmt(s["removed"]["mean"])}, max '
+                         f'{fmt(s["removed"]["max"])} of {s["parts"]}']
         reasons += _fault_reason(s)
+        if _left_out(s):
+            verdict = NOT_FEASIBLE
         if s['parts'] < capacity:
-            ok = False
+            verdict = NOT_FEASIBLE
             reasons.append(f'the bin was filled with {s["parts"]} parts, fewer than the '
                            f'{capacity} a refill interval needs')
-        out.append({'option': f'static bin {fmt(s["bin_mm"])} mm',
-                    'verdict': FEASIBLE if ok else NOT_FEASIBLE, 'reasons': reasons})
+        out.append({'option': f'static bin {fmt(s["bin_mm"])} mm', 'verdict': verdict,
+                    'reasons': reasons})
     else:
         out.append({'option': 'static bin', 'verdict': NOT_ANALYSED,
                     'reasons': ['no bin_emptying experiment in the file']})
@@ -70,7 +79,9 @@ def verdicts(summary: dict) -> list[dict]:
     if feeder:
         _, s = feeder[-1]
         v = s['vibrations_to_empty']
-        reasons = [f'{s["emptied"]} of {s["iterations"]} feeder runs emptied '
+        verdict, rate = _rate_verdict(s['accepted'], s['iterations'], s['accepted_ci95'],
+                                      required, 'feeder runs emptied within the spill limit')
+        reasons = [rate, f'{s["emptied"]} of {s["iterations"]} feeder runs emptied '
                    f'(optimal range {s["optimal_range"][0]}-{s["optimal_range"][1]} parts on '
                    f'the table; runs ended by: '
                    f'{", ".join(f"{_STOPS.get(k, k)} {n}" for k, n in s["stops"].items())})']
@@ -84,19 +95,40 @@ def verdicts(summary: dict) -> list[dict]:
                            f'{s["runs_spilling"]} runs; a run may spill {s["max_spilled"]} '
                            f'(requirements.max_spilled_parts): {s["accepted"]} of the '
                            f'{s["emptied"]} emptied runs met it')
-        ok = s['iterations'] > 0 and s['accepted'] == s['iterations'] and not _left_out(s)
         reasons += _fault_reason(s)
+        if _left_out(s):
+            verdict = NOT_FEASIBLE
         if s['parts'] < capacity:
-            ok = False
+            verdict = NOT_FEASIBLE
             reasons.append(f'the feeder held {s["parts"]} parts, fewer than the {capacity} a '
                            'refill interval needs')
-        out.append({'option': 'vibrating table', 'verdict': FEASIBLE if ok else NOT_FEASIBLE,
-                    'reasons': reasons})
+        out.append({'option': 'vibrating table', 'verdict': verdict, 'reasons': reasons})
     else:
         out.append({'option': 'vibrating table', 'verdict': NOT_ANALYSED,
                     'reasons': ['no feeder_emptying experiment in the file']})
     out += [_gripper_verdict(exp_id, s) for exp_id, s in of_type(summary, 'gripper_sweep')]
     return out
+
+
+def _rate_verdict(successes: int, n: int, ci95: list, required: float,
+                  what: str) -> tuple[str, str]:
+    """The verdict a rate supports, `successes` of `n` with its 95 % interval `ci95`, against
+    the `required` share, and the sentence that says why."""
+    seen = f'{successes} of {n} {what}'
+    if not n:
+        return UNDECIDED, f'{seen}: no iteration to decide on'
+    low, high = ci95
+    evidence = (f'{seen}, 95 % interval {pct(low)} to {pct(high)}; required '
+                f'{pct(required)} (requirements.success_rate)')
+    if low >= required:
+        return FEASIBLE, evidence
+    if high < required:
+        return NOT_FEASIBLE, evidence
+    more = iterations_to_decide(successes, n, required)
+    return UNDECIDED, (f'not enough iterations to decide: {evidence}; '
+                       + (f'{more} iterations would decide if the rate seen held'
+                          if more else 'no number of iterations would decide at the rate '
+                          'seen, which is the requirement itself'))
 
 
 def _gripper_verdict(exp_id: str, s: dict) -> dict:
@@ -108,11 +140,18 @@ def _gripper_verdict(exp_id: str, s: dict) -> dict:
              'container')
     if s['smallest'] is None:
         best = max(variants, key=lambda v: v['valid']['mean'] or 0.0)
-        return {'option': f'gripper (`{exp_id}`)', 'verdict': NOT_FEASIBLE, 'reasons': [
+        # not feasible only where every gripper's interval lies below min_valid
+        open_ = [v for v in variants if v['valid_ci95'][1] is None
+                 or v['valid_ci95'][1] >= s['min_valid']]
+        verdict = UNDECIDED if open_ and not _left_out(s) else NOT_FEASIBLE
+        undecided = ([f'not enough scenes to decide: {count(len(open_), "gripper")} of the '
+                      f'sweep had an interval reaching {fmt(s["min_valid"])}, or too few '
+                      'scenes for one'] if verdict == UNDECIDED else [])
+        return {'option': f'gripper (`{exp_id}`)', 'verdict': verdict, 'reasons': [
             f'no gripper of the sweep gives {fmt(s["min_valid"])} valid parts per check at '
             f'95 % confidence; the most: {gripper_label(best)}, mean '
-            f'{fmt(best["valid"]["mean"])} (95 % interval {interval_text(best)})', where,
-            *_fault_reason(s)]}
+            f'{fmt(best["valid"]["mean"])} (95 % interval {interval_text(best)})',
+            *undecided, where, *_fault_reason(s)]}
     v = variants[s['smallest']]
     return {'option': f'gripper {gripper_label(v)} (`{exp_id}`)',
             'verdict': NOT_FEASIBLE if _left_out(s) else FEASIBLE,

@@ -27,6 +27,7 @@ def test_the_default_file_parses_into_si_units():
     assert f.check.tolerance == pytest.approx(math.radians(45))
     assert f.tray.inner_size == pytest.approx((0.195, 0.150, 0.027))
     assert f.moves == (MOVES['spread'],) and f.requirements.max_spilled == 0
+    assert f.requirements.success_rate == 0.9
     assert f.requirements.refill_interval == 4 * 3600 and f.requirements.capacity == 480
     emptying = f.experiment('emptying')
     assert emptying.bin is None and emptying.bin_from == 'bins'
@@ -47,6 +48,10 @@ BAD = [
      r'gripper\.body_diameter: 20 is not a known key here \(did you mean body_diameter_mm\?\) '
      r'\(known: body_diameter_mm'),
     ('seed: abc\n' + MINIMAL, r"seed: 'abc' is not an integer"),
+    ('requirements: {success_rate: 0}\n' + MINIMAL,
+     r'requirements\.success_rate: 0 must be > 0'),
+    ('requirements: {success_rate: 1.5}\n' + MINIMAL,
+     r'requirements\.success_rate: 1\.5 must be <= 1'),
     ('seed: -1\n' + MINIMAL, r'seed: -1 must be within \[0, '),
     ('check: {tolerance_deg: .nan}\n' + MINIMAL, r'check\.tolerance_deg: nan must be finite'),
     ('check: {tolerance_deg: 120}\n' + MINIMAL, r'check \(check\.tolerance\): .* must be <='),

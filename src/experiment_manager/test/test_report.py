@@ -7,7 +7,8 @@ import os
 import shutil
 
 from experiment_manager import config, pictures, report, verdicts
-from experiment_manager.verdicts import FEASIBLE, NOT_ANALYSED, NOT_FEASIBLE
+from experiment_manager.metrics import iterations_to_decide, rate_interval
+from experiment_manager.verdicts import FEASIBLE, NOT_ANALYSED, NOT_FEASIBLE, UNDECIDED
 import pytest
 
 
@@ -42,27 +43,66 @@ def test_a_run_gets_its_report_files(run_dir):
     assert 'No iteration was flagged' in text
 
 
-def test_verdicts_follow_the_emptied_runs_and_the_capacity(run_dir):
+def _rates(s: dict, emptied: int, accepted: int, n: int) -> None:
+    """Bins emptied and feeder runs accepted, k of n, with the intervals metrics gives them."""
+    s['experiments']['emptying'].update(emptied=emptied, iterations=n,
+                                        emptied_ci95=list(rate_interval(emptied, n)))
+    s['experiments']['feeder'].update(emptied=max(emptied, accepted), accepted=accepted,
+                                      iterations=n,
+                                      accepted_ci95=list(rate_interval(accepted, n)))
+
+
+def test_the_exact_interval_of_a_rate():
+    # Clopper-Pearson's closed forms: k = n gives (alpha/2)^(1/n) to 1, k = 0 its mirror.
+    assert rate_interval(40, 40) == pytest.approx((0.025 ** (1 / 40), 1.0))
+    assert rate_interval(0, 1) == pytest.approx((0.0, 0.975))
+    low, high = rate_interval(5, 10)        # symmetric about a half
+    assert low == pytest.approx(1 - high) and 0.18 < low < 0.19
+    assert rate_interval(0, 0) == (None, None)
+
+
+def test_the_iterations_that_would_decide_a_rate():
+    # all succeeding: (0.025)^(1/n) >= 0.9 from n = 36 (35.01 solves it)
+    assert iterations_to_decide(1, 1, 0.9) == 36
+    assert iterations_to_decide(0, 1, 0.9) == 2     # 0 of 2: below 0.842
+    assert rate_interval(0, 2)[1] < 0.9 <= rate_interval(0, 1)[1]
+    assert iterations_to_decide(9, 10, 0.9) is None     # the rate seen is the requirement
+    assert iterations_to_decide(0, 0, 0.9) is None
+
+
+def test_verdicts_rest_on_the_interval_of_the_rate_and_on_the_capacity(run_dir):
     s = _summary(run_dir)
-    s['requirements']['capacity'] = 10
-    s['experiments']['emptying'].update(emptied=1, iterations=1)
-    s['experiments']['feeder'].update(emptied=1, accepted=1, iterations=1)
+    s['requirements'].update(capacity=10, success_rate=0.9)
+    # One iteration that succeeded decides nothing: it reads so, with the count that would.
+    _rates(s, 1, 1, 1)
+    static, table = verdicts.verdicts(s)[:2]
+    assert (static['verdict'], table['verdict']) == (UNDECIDED, UNDECIDED)
+    assert static['reasons'][0] == (
+        'not enough iterations to decide: 1 of 1 bins emptied, 95 % interval 2.5 % to 100.0 %; '
+        'required 90.0 % (requirements.success_rate); 36 iterations would decide if the rate '
+        'seen held')
+    _rates(s, 40, 40, 40)       # the paper's count: 40 of 40 clears 90 %
     assert [v['verdict'] for v in verdicts.verdicts(s)][:2] == [FEASIBLE, FEASIBLE]
+    _rates(s, 0, 0, 40)         # its static bins: 0 of 40
+    assert [v['verdict'] for v in verdicts.verdicts(s)][:2] == [NOT_FEASIBLE, NOT_FEASIBLE]
+    _rates(s, 36, 36, 40)       # 90 % seen, at the requirement itself
+    assert 'no number of iterations would decide' in verdicts.verdicts(s)[0]['reasons'][0]
     # An emptied run that spilled more than the requirement allows is not accepted.
-    s['experiments']['feeder'].update(accepted=0, runs_spilling=1)
-    s['experiments']['feeder']['physics']['spilled'] = 1
+    _rates(s, 40, 0, 40)
+    s['experiments']['feeder'].update(runs_spilling=40)
+    s['experiments']['feeder']['physics']['spilled'] = 40
     table = verdicts.verdicts(s)[1]
     assert table['verdict'] == NOT_FEASIBLE and (
-        "1 part spilled over the tray's walls, in 1 runs; a run may spill 0 "
-        '(requirements.max_spilled_parts): 0 of the 1 emptied runs met it') in table['reasons']
+        "40 parts spilled over the tray's walls, in 40 runs; a run may spill 0 "
+        '(requirements.max_spilled_parts): 0 of the 40 emptied runs met it') in table['reasons']
     # A tunnelled iteration (left out of the figures) leaves no option feasible.
-    s['experiments']['feeder'].update(accepted=1)
+    _rates(s, 40, 40, 40)
     s['experiments']['feeder']['faults']['tunnelled'] = 1
     assert verdicts.verdicts(s)[1]['verdict'] == NOT_FEASIBLE
     s['experiments']['feeder'].update(emptied=0, accepted=0)
     s['experiments']['feeder']['stops'] = {'stop: empty': 1, 'stop: vibration limit': 2}
     assert 'runs ended by: feeder and table empty 1, vibration limit 2)' in \
-        verdicts.verdicts(s)[1]['reasons'][0]
+        verdicts.verdicts(s)[1]['reasons'][1]
     s['requirements']['capacity'] = 480         # 30 parts cannot last a refill interval
     bin_verdict = verdicts.verdicts(s)[0]
     assert bin_verdict['verdict'] == NOT_FEASIBLE
@@ -75,12 +115,19 @@ def test_the_gripper_verdict_names_the_smallest_gripper_that_meets_the_yield(run
     s = _summary(run_dir)
     g = s['experiments']['grippers']
     for v in g['variants']:
-        v['meets'] = False
+        v.update(meets=False, valid_ci95=[0.1, 0.9])     # every interval below min_valid 1
     g['smallest'] = None
     verdict = verdicts.verdicts(s)[2]
     assert verdict['verdict'] == NOT_FEASIBLE and verdict['option'] == 'gripper (`grippers`)'
     assert verdict['reasons'][0].startswith('no gripper of the sweep gives 1 valid parts per '
                                             'check at 95 % confidence; the most: D ')
+    # One interval that reaches min_valid, and one scene that gives none: not decided.
+    g['variants'][0]['valid_ci95'] = [0.5, 1.5]
+    g['variants'][1]['valid_ci95'] = [None, None]
+    verdict = verdicts.verdicts(s)[2]
+    assert verdict['verdict'] == UNDECIDED
+    assert verdict['reasons'][1] == ('not enough scenes to decide: 2 grippers of the sweep had '
+                                     'an interval reaching 1, or too few scenes for one')
     g['variants'][1].update(meets=True, valid_ci95=[1.5, 2.5])
     g['smallest'] = 1
     verdict = verdicts.verdicts(s)[2]
