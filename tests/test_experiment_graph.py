@@ -31,6 +31,7 @@ import pytest
 import rclpy
 from rclpy.action import ActionClient
 from rclpy.signals import SignalHandlerOptions
+import yaml
 
 pytestmark = pytest.mark.graph
 NS = unique_namespace('exp')
@@ -97,6 +98,15 @@ def test_every_recorded_message_decodes_and_matches_the_results(graph_run):
         messages = [(channel.topic, message.log_time, msg) for _, channel, message, msg
                     in reader.iter_decoded_messages(log_time_order=True)]
         attachments = {a.name: a.data for a in reader.iter_attachments()}
+        channels = list(reader.get_summary().channels.values())
+    # Every channel carries what its publishers offered, in rosbag2's format (read with a plain
+    # YAML reader): the nodes' latched topics transient local, the streams volatile.
+    latched = ('scene', 'markers', 'results', 'state')
+    for c in channels:
+        offers = yaml.safe_load(c.metadata['offered_qos_profiles'])
+        want = 'transient_local' if c.topic.rsplit('/', 1)[-1] in latched else 'volatile'
+        assert offers and {(o['reliability'], o['durability']) for o in offers} == {
+            ('reliable', want)}, (c.topic, offers)
     by_topic: dict[str, list] = {}
     for topic, _, msg in messages:
         by_topic.setdefault(topic[len(NS):], []).append(msg)

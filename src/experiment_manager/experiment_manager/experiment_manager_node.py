@@ -159,7 +159,7 @@ class ExperimentManagerNode(Node):
         self._progress.publish(msg)
         if self._goal is not None:
             self._goal.publish_feedback(RunExperiment.Feedback(progress=msg))
-        self._topics.write(self._progress.topic_name, msg)
+        self._topics.write(self._progress, msg)
         self._topics.flush()   # once per iteration: a killed manager's recording keeps the rest
 
     # ------------------------------------------------------------------------- the action

@@ -8,7 +8,7 @@ per iteration); `close()` writes the summary and index. A file cut off before `c
 a closed file (`replay CUT --recover OUT`).
 """
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping
 import os
 import re
 import struct
@@ -19,7 +19,16 @@ from mcap.exceptions import McapError
 from mcap.records import Attachment, Channel, Header, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
 from mcap.writer import CompressionType, Writer
+from rclpy.duration import Duration
+from rclpy.qos import (
+    DurabilityPolicy,
+    HistoryPolicy,
+    LivelinessPolicy,
+    QoSProfile,
+    ReliabilityPolicy,
+)
 from rclpy.serialization import serialize_message
+import yaml
 
 PRIMITIVES = {'bool', 'byte', 'char', 'float32', 'float64', 'int8', 'uint8', 'int16', 'uint16',
               'int32', 'uint32', 'int64', 'uint64', 'string', 'wstring'}
@@ -33,6 +42,53 @@ def type_name(msg_type: type) -> str:
     """'pkg/msg/Type' of a generated message class."""
     package = msg_type.__module__.split('.')[0]
     return f'{package}/msg/{msg_type.__name__}'
+
+
+# The MCAP ros2 profile's channel metadata key, written as rosbag2 writes it for bag version 9
+# (Jazzy; rosbag2_storage qos.cpp): a YAML list of the offering publishers' profiles, policies
+# by their rmw names ('keep_last', 'reliable', 'transient_local', 'automatic'), durations as
+# {sec, nsec}.
+OFFERED_QOS = 'offered_qos_profiles'
+_POLICIES = (('history', HistoryPolicy), ('reliability', ReliabilityPolicy),
+             ('durability', DurabilityPolicy), ('liveliness', LivelinessPolicy))
+_DURATIONS = ('deadline', 'lifespan', 'liveliness_lease_duration')
+
+
+def qos_yaml(profiles: Iterable[QoSProfile]) -> str:
+    """The offered_qos_profiles text of a channel whose publishers offered `profiles`."""
+    out = []
+    for p in profiles:
+        entry = {'history': p.history.short_key, 'depth': p.depth,
+                 'reliability': p.reliability.short_key, 'durability': p.durability.short_key,
+                 'liveliness': p.liveliness.short_key,
+                 'avoid_ros_namespace_conventions': p.avoid_ros_namespace_conventions}
+        for key in _DURATIONS:
+            sec, nsec = divmod(getattr(p, key).nanoseconds, 10**9)
+            entry[key] = {'sec': sec, 'nsec': nsec}
+        out.append(entry)
+    return yaml.safe_dump(out, sort_keys=False)
+
+
+def qos_profiles(text: str) -> list[QoSProfile]:
+    """The profiles of an offered_qos_profiles text (qos_yaml's, or rosbag2's of version 9).
+    Raises ValueError naming what it cannot read."""
+    try:
+        entries = yaml.safe_load(text) or []
+        return [QoSProfile(
+            depth=int(e['depth']),
+            **{key: policy.get_from_short_key(e[key]) for key, policy in _POLICIES},
+            **{key: Duration(seconds=int(e[key]['sec']), nanoseconds=int(e[key]['nsec']))
+               for key in _DURATIONS},
+            avoid_ros_namespace_conventions=bool(e['avoid_ros_namespace_conventions']))
+            for e in entries]
+    except (yaml.YAMLError, KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise ValueError(f'{OFFERED_QOS} is not a list of QoS profiles: '
+                         f'{type(exc).__name__}: {exc}') from None
+
+
+def channel_qos(metadata: Mapping[str, str]) -> list[QoSProfile]:
+    """The recorded publishers' profiles of a channel; empty for a recording without them."""
+    return qos_profiles(metadata[OFFERED_QOS]) if metadata.get(OFFERED_QOS) else []
 
 
 def _msg_file(package: str, name: str) -> str:
@@ -98,7 +154,7 @@ class Recorder:
         self._channels: dict[str, int] = {}
         self.messages = 0
 
-    def _channel(self, topic: str, name: str) -> int:
+    def _channel(self, topic: str, name: str, offered: Callable[[], str]) -> int:
         channel = self._channels.get(topic)
         if channel is None:
             schema = self._schemas.get(name)
@@ -106,19 +162,24 @@ class Recorder:
                 schema = self._schemas[name] = self._writer.register_schema(
                     name=name, encoding='ros2msg', data=msg_definition(name).encode())
             channel = self._channels[topic] = self._writer.register_channel(
-                topic=topic, message_encoding='cdr', schema_id=schema)
+                topic=topic, message_encoding='cdr', schema_id=schema,
+                metadata={OFFERED_QOS: offered()})
         return channel
 
-    def write(self, topic: str, msg, log_time_ns: int | None = None) -> None:
-        """Record one message on `topic` (an absolute name, as ros2 bag records them)."""
-        self.write_serialized(topic, type_name(type(msg)), serialize_message(msg), log_time_ns)
+    def write(self, topic: str, msg, offered: Callable[[], str],
+              log_time_ns: int | None = None) -> None:
+        """Record one message on `topic` (an absolute name, as ros2 bag records them).
+        offered(): the topic's offered_qos_profiles (qos_yaml), asked for once, when the
+        topic's channel is registered."""
+        self.write_serialized(topic, type_name(type(msg)), serialize_message(msg), offered,
+                              log_time_ns)
 
-    def write_serialized(self, topic: str, name: str, data: bytes,
+    def write_serialized(self, topic: str, name: str, data: bytes, offered: Callable[[], str],
                          log_time_ns: int | None = None) -> None:
         """Record one CDR-serialized message of type `name` ('pkg/msg/Type'), as a raw
-        subscription receives it (no decode and encode again)."""
+        subscription receives it (no decode and encode again); offered() as in write()."""
         now = time.time_ns() if log_time_ns is None else log_time_ns
-        self._writer.add_message(channel_id=self._channel(topic, name), log_time=now,
+        self._writer.add_message(channel_id=self._channel(topic, name, offered), log_time=now,
                                  publish_time=now, data=data, sequence=self.messages)
         self.messages += 1
 

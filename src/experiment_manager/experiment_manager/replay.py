@@ -4,12 +4,14 @@
     replay RECORDING.mcap --recover OUT.mcap
 
 Messages go out on their recorded topics (under --prefix, if given) with the recorded spacing
-divided by the rate; `scene` and `markers` are latched (transient local) as the world publishes
-them. --info lists the topics, types, message counts and attachments, and exits. Payloads are
-published as recorded (CDR, no decode), so any type in the file replays if its package is
-installed. --recover copies every complete record of a recording cut off before it was closed
-(its manager was killed) into a closed file that every reader opens, and exits. SIGINT or
-SIGTERM stops a replay before its next message (exit 130, "stopped after N messages").
+divided by the rate, each topic with the reliability and durability its recorded publishers
+offered (the channel's offered_qos_profiles, as ros2 bag play does): `scene` and `markers` come
+out latched (transient local) as the world publishes them. --info lists the topics, types,
+message counts and attachments, and exits. Payloads are published as recorded (CDR, no decode),
+so any type in the file replays if its package is installed. --recover copies every complete
+record of a recording cut off before it was closed (its manager was killed) into a closed file
+that every reader opens, and exits. SIGINT or SIGTERM stops a replay before its next message
+(exit 130, "stopped after N messages").
 """
 
 import argparse
@@ -29,8 +31,9 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 
 from . import interrupt
-from .recording import recover
+from .recording import channel_qos, recover
 
+# Recordings made before channels carried offered_qos_profiles (2026-11-25): latched by name.
 LATCHED_TOPICS = ('scene', 'markers')
 STREAM = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 MATCH_WAIT = 2.0     # s a new topic waits by default for a subscriber to match (--match-wait)
@@ -43,6 +46,22 @@ def message_type(name: str) -> type:
     if len(parts) != 3 or parts[1] != 'msg':
         raise ValueError(f'schema {name!r} is not a ROS 2 message type name (pkg/msg/Type)')
     return getattr(importlib.import_module(f'{parts[0]}.msg'), parts[2])
+
+
+def replay_qos(topic: str, metadata: dict[str, str]) -> QoSProfile:
+    """The profile to publish a recorded topic with: the reliability and durability its
+    recorded publishers offered where they all agree (ros2 bag play's rule), STREAM where they
+    disagree. The depth is STREAM's whatever was offered: a reliable writer that keeps fewer
+    samples than a fast replay sends ahead of its readers' acknowledgements replaces them (a
+    late subscriber to a latched topic gets up to that many of its last messages). Raises
+    ValueError for unreadable metadata."""
+    offered = channel_qos(metadata)
+    if not offered:
+        return LATCHED if topic.rsplit('/', 1)[-1] in LATCHED_TOPICS else STREAM
+    if len({(p.reliability, p.durability) for p in offered}) > 1:
+        return STREAM
+    return QoSProfile(depth=STREAM.depth, reliability=offered[0].reliability,
+                      durability=offered[0].durability)
 
 
 def _parse(argv: list[str]) -> argparse.Namespace:
@@ -127,9 +146,8 @@ def main(argv: list[str] | None = None) -> int:
             if pub is None:
                 msg_type = message_type(schema.name)
                 topic = args.prefix.rstrip('/') + channel.topic if args.prefix else channel.topic
-                latched = channel.topic.rsplit('/', 1)[-1] in LATCHED_TOPICS
                 pub = publishers[channel.id] = node.create_publisher(
-                    msg_type, topic, LATCHED if latched else STREAM)
+                    msg_type, topic, replay_qos(channel.topic, channel.metadata))
                 deadline = time.monotonic() + args.match_wait
                 while pub.get_subscription_count() == 0 and time.monotonic() < deadline:
                     interrupt.sleep(0.02)

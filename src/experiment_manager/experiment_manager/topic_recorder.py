@@ -14,7 +14,7 @@ from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from visualization_msgs.msg import MarkerArray
 
-from .recording import Recorder, type_name
+from .recording import qos_yaml, Recorder, type_name
 
 RECORDED = (('parts', PartArray), ('scene', Scene), ('markers', MarkerArray),
             ('settle_reports', SettleReport), ('results', ValidityReport),
@@ -54,7 +54,16 @@ class TopicRecorder:
         except Exception:  # the context was shut down under it
             pass
 
+    def _offered(self, topic: str):
+        """offered_qos_profiles of `topic`: the profiles its publishers offer, as the graph
+        reports them (ros2 bag record asks the same). Asked for when a recording registers
+        the topic, so after its first message: a publisher that sent one has been discovered."""
+        return lambda: qos_yaml(i.qos_profile for i in
+                                self.node.get_publishers_info_by_topic(topic))
+
     def _callback(self, topic: str, name: str):
+        offered = self._offered(topic)
+
         def record(data: bytes, info: dict) -> None:
             # Not what was published before the recording started: a latched topic's history,
             # which Fast DDS sends even to this volatile subscription when it first matches.
@@ -62,15 +71,17 @@ class TopicRecorder:
                 return
             with self._lock:
                 if self._recorder is not None:
-                    self._recorder.write_serialized(topic, name, data)
+                    self._recorder.write_serialized(topic, name, data, offered)
                     self._last = time.monotonic()
         return record
 
-    def write(self, topic: str, msg) -> None:
-        """Record a message this process publishes itself (no subscription needed)."""
+    def write(self, publisher, msg) -> None:
+        """Record a message this process publishes itself with `publisher` (no subscription
+        needed; its own profile is the offer)."""
         with self._lock:
             if self._recorder is not None:
-                self._recorder.write(topic, msg)
+                self._recorder.write(publisher.topic_name, msg,
+                                     lambda: qos_yaml([publisher.qos_profile]))
 
     def flush(self) -> None:
         """Hand what was recorded so far to the OS (Recorder.flush)."""

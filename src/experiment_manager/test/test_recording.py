@@ -4,7 +4,16 @@ the schema text in the file alone (it never imports our message classes)."""
 import struct
 
 from builtin_interfaces.msg import Time
-from experiment_manager.recording import msg_definition, Recorder, recover, SEPARATOR
+from experiment_manager.recording import (
+    msg_definition,
+    OFFERED_QOS,
+    qos_profiles,
+    qos_yaml,
+    Recorder,
+    recover,
+    SEPARATOR,
+)
+from experiment_manager.replay import replay_qos, STREAM
 from geometry_msgs.msg import Vector3
 from mcap.exceptions import EndOfFile, McapError
 from mcap.reader import make_reader
@@ -13,12 +22,18 @@ from mcap.stream_reader import StreamReader
 from mcap_ros2.decoder import DecoderFactory
 from pick_common.containers import ContainerSpec
 from pick_common.conversions import states_to_msg
+from pick_common.node_runner import LATCHED
 from pick_common.specs import SceneSpec
 from pick_msgs.msg import FeederState, Part, PartArray, PartValidity, ValidityReport
 from pick_sim_world.conversions import markers_msg, scene_to_msg
 from pick_sim_world.world import World
 import pytest
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
+import yaml
+
+LATCHED_OFFER = lambda: qos_yaml([LATCHED])     # noqa: E731
+STREAM_OFFER = lambda: qos_yaml([QoSProfile(depth=10)])     # noqa: E731
 
 
 @pytest.fixture(scope='module')
@@ -51,12 +66,12 @@ def test_an_independent_reader_decodes_every_message(tmp_path, world_messages):
     state = FeederState(state=FeederState.STATE_FEEDING, parts_in_feeder=40, vibrations=2)
     path = tmp_path / 'run.mcap'
     with Recorder(str(path)) as rec:
-        rec.write('/w1/scene', scene, 1)
-        rec.write('/w1/parts', parts, 2)
-        rec.write('/w1/markers', markers, 3)
-        rec.write('/w1/results', report, 4)
-        rec.write('/feeder/state', state, 5)
-        rec.write('/w1/parts', PartArray(parts=[Part(id=99)]), 6)
+        rec.write('/w1/scene', scene, LATCHED_OFFER, 1)
+        rec.write('/w1/parts', parts, STREAM_OFFER, 2)
+        rec.write('/w1/markers', markers, LATCHED_OFFER, 3)
+        rec.write('/w1/results', report, STREAM_OFFER, 4)
+        rec.write('/feeder/state', state, STREAM_OFFER, 5)
+        rec.write('/w1/parts', PartArray(parts=[Part(id=99)]), STREAM_OFFER, 6)
         rec.attach('experiment.yaml', b'experiment_id: demo\n', 'application/yaml')
         rec.metadata('run', {'seed': '7'})
     with open(path, 'rb') as f:
@@ -84,6 +99,16 @@ def test_an_independent_reader_decodes_every_message(tmp_path, world_messages):
         assert reader.get_header().profile == 'ros2'
         attachments = list(reader.iter_attachments())
         metadata = list(reader.iter_metadata())
+        channels = reader.get_summary().channels.values()
+    # Every channel says what its publishers offered, as the ros2 profile asks (read with a
+    # plain YAML reader, not ours): the latched topics transient local, the rest volatile.
+    offered = {c.topic: yaml.safe_load(c.metadata[OFFERED_QOS]) for c in channels}
+    assert {t: [(p['reliability'], p['durability'], p['depth']) for p in o]
+            for t, o in offered.items()} == {
+        '/w1/scene': [('reliable', 'transient_local', 1)],
+        '/w1/markers': [('reliable', 'transient_local', 1)],
+        **{t: [('reliable', 'volatile', 10)]
+           for t in ('/w1/parts', '/w1/results', '/feeder/state')}}
     assert [(a.name, a.data) for a in attachments] == [('experiment.yaml',
                                                          b'experiment_id: demo\n')]
     assert metadata[0].metadata == {'seed': '7'}
@@ -98,7 +123,7 @@ def test_a_recording_cut_off_before_close_keeps_its_complete_chunks(tmp_path):
     rec.attach('experiment.yaml', b'id: cut\n', 'application/yaml')
     rec.metadata('run', {'experiment_id': 'cut'})
     for k in range(3000):
-        rec.write('/p', Vector3(x=float(k)), k)
+        rec.write('/p', Vector3(x=float(k)), STREAM_OFFER, k)
     rec._file.flush()
     data = path.read_bytes()        # the bytes the OS holds when the process is killed
     rec.flush()                     # what the manager does after each iteration
@@ -132,3 +157,46 @@ def test_a_recording_cut_off_before_close_keeps_its_complete_chunks(tmp_path):
     (tmp_path / 'not.mcap').write_bytes(b'id: not a recording\n')
     with pytest.raises(McapError, match='does not start as an MCAP file'):
         recover(str(tmp_path / 'not.mcap'), str(tmp_path / 'x.mcap'))
+
+
+# What rosbag2 (Jazzy, bag version 9) writes for a latched publisher as the graph reports it.
+ROSBAG2_LATCHED = """- history: keep_last
+  depth: 1
+  reliability: reliable
+  durability: transient_local
+  deadline:
+    sec: 9223372036
+    nsec: 854775807
+  lifespan:
+    sec: 9223372036
+    nsec: 854775807
+  liveliness: automatic
+  liveliness_lease_duration:
+    sec: 9223372036
+    nsec: 854775807
+  avoid_ros_namespace_conventions: false
+"""
+
+
+def test_offered_profiles_read_back_and_decide_how_replay_publishes():
+    (profile,) = qos_profiles(ROSBAG2_LATCHED)
+    assert (profile.durability, profile.depth) == (DurabilityPolicy.TRANSIENT_LOCAL, 1)
+    assert profile.deadline.nanoseconds == 2**63 - 1
+    assert yaml.safe_load(qos_yaml([profile])) == yaml.safe_load(ROSBAG2_LATCHED)  # same text
+    # replayed latched, with STREAM's depth: a replay at 1000x must not overwrite what its
+    # readers have not acknowledged
+    latched = replay_qos('/w/scene', {OFFERED_QOS: ROSBAG2_LATCHED})
+    assert (latched.durability, latched.reliability, latched.depth) == (
+        DurabilityPolicy.TRANSIENT_LOCAL, ReliabilityPolicy.RELIABLE, STREAM.depth)
+    # a best-effort stream keeps its reliability
+    stream = replay_qos('/w/parts', {OFFERED_QOS: qos_yaml(
+        [QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)])})
+    assert (stream.reliability, stream.durability, stream.depth) == (
+        ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE, STREAM.depth)
+    # publishers that disagree: the default offer, as ros2 bag play falls back to
+    mixed = qos_yaml([LATCHED, QoSProfile(depth=10)])
+    assert replay_qos('/w/scene', {OFFERED_QOS: mixed}) is STREAM
+    # a recording from before offered_qos_profiles: scene and markers latched by name
+    assert replay_qos('/w/scene', {}) is LATCHED and replay_qos('/w/parts', {}) is STREAM
+    with pytest.raises(ValueError, match='offered_qos_profiles is not a list of QoS profiles'):
+        replay_qos('/w/scene', {OFFERED_QOS: '- {history: sometimes}'})
