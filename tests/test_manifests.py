@@ -21,6 +21,7 @@ IMPORT_KEYS = {
     'scipy': 'python3-scipy',
     'yaml': 'python3-yaml',
     'matplotlib': 'python3-matplotlib',
+    'tqdm': 'python3-tqdm',
     'pytest': 'python3-pytest',
     'hypothesis': 'python3-hypothesis',
     'trimesh': 'python3-trimesh-pip',

@@ -36,6 +36,7 @@ from rclpy.exceptions import InvalidNamespaceException
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from rclpy.validate_namespace import validate_namespace
+from tqdm import tqdm
 
 from . import config, interrupt
 from .claim import claim, NamespaceInUse
@@ -60,11 +61,14 @@ def default_file() -> str:
 
 
 class ProgressBar:
-    """One line on a terminal, redrawn; a line per 5 % (and per experiment) otherwise."""
+    """The run's progress on `stream`: on a terminal, one tqdm line redrawn within the
+    terminal's width (`columns`, or the terminal's own as it is resized), the phase cut at its
+    end; otherwise (a log), a line per 5 % and per experiment."""
 
-    def __init__(self, stream=sys.stderr, width: int = 30) -> None:
-        self.stream, self.width = stream, width
+    def __init__(self, stream=sys.stderr, columns: int | None = None) -> None:
+        self.stream, self.columns = stream, columns
         self.tty = stream.isatty()
+        self._bar: tqdm | None = None
         self._last = (None, -1)
 
     @staticmethod
@@ -73,25 +77,28 @@ class ProgressBar:
         return f'{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}'
 
     def update(self, p) -> None:
-        fraction = p.iterations_done / p.iterations_total if p.iterations_total else 0.0
-        filled = int(fraction * self.width)
         eta = self._clock(p.eta) if p.eta else '?'
-        line = (f'[{"#" * filled}{"." * (self.width - filled)}] {p.iterations_done}/'
-                f'{p.iterations_total}  {self._clock(p.elapsed)} elapsed, eta {eta}  {p.phase}')
-        if self.tty:
-            self.stream.write('\r' + line[:150].ljust(150))
-        else:
+        status = f'{self._clock(p.elapsed)} elapsed, eta {eta}  {p.phase}'
+        if not self.tty:
+            fraction = p.iterations_done / p.iterations_total if p.iterations_total else 0.0
             key = (p.experiment_id, int(fraction * 20))
-            if key == self._last:
-                return
-            self._last = key
-            self.stream.write(line + '\n')
-        self.stream.flush()
+            if key != self._last:
+                self._last = key
+                self.stream.write(f'{p.iterations_done}/{p.iterations_total}  {status}\n')
+                self.stream.flush()
+            return
+        if self._bar is None:
+            self._bar = tqdm(total=p.iterations_total, file=self.stream, ncols=self.columns,
+                             dynamic_ncols=self.columns is None, ascii=' #', mininterval=0,
+                             bar_format='{n_fmt}/{total_fmt} [{bar:24}] {desc}')
+        self._bar.total, self._bar.n = p.iterations_total, p.iterations_done
+        self._bar.set_description_str(status, refresh=False)
+        self._bar.refresh()
 
     def close(self) -> None:
-        if self.tty:
-            self.stream.write('\n')
-            self.stream.flush()
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
 
 
 def _parse(argv: list[str]) -> argparse.Namespace:

@@ -61,12 +61,14 @@ class Unit:
         return f'iteration {self.iteration + 1}/{self.experiment.iterations}'
 
 
+def experiment_iterations(exp: Experiment) -> int:
+    """The iterations of `exp`: its iterations per bin (bin_static) or per n (table_sweep)."""
+    groups = len(exp.bins) if exp.type == BIN_STATIC else len(exp.counts) or 1
+    return groups * exp.iterations
+
+
 def count_iterations(file: ExperimentFile) -> int:
-    total = 0
-    for e in file.experiments:
-        groups = len(e.bins) if e.type == BIN_STATIC else len(e.counts) or 1
-        total += groups * e.iterations
-    return total
+    return sum(experiment_iterations(e) for e in file.experiments)
 
 
 def plan(file: ExperimentFile, exp: Experiment, summary: dict) -> list[Unit]:

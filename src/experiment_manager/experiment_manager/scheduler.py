@@ -17,7 +17,8 @@ from typing import Protocol
 from . import metrics
 from .backend import Backend, WorkerLost
 from .config import Experiment, ExperimentFile
-from .plan import count_iterations, plan, Unit
+from .estimate import Costs
+from .plan import count_iterations, experiment_iterations, plan, Unit
 from .procedures import run_unit
 from .rows import Record
 
@@ -30,7 +31,7 @@ class Progress:
     done: int
     total: int
     elapsed: float          # s
-    eta: float              # s, 0 when unknown
+    eta: float              # s, 0 when unknown (estimate.py: the iterations left, weighed)
 
 
 class Sink(Protocol):
@@ -69,7 +70,7 @@ class Runner:
         self._live = list(range(len(self.backends)))
         self._total = count_iterations(file)
         self._done = 0
-        self._ran = 0
+        self._costs = Costs()
         self._start = time.monotonic()
         self._summary: dict[str, dict] = {}
         self._rank: dict[tuple, tuple[int, int]] = {}   # key -> (experiment, plan position)
@@ -206,6 +207,7 @@ class Runner:
                 return
             with self._cond:
                 self._in_flight -= 1
+                self._costs.add(u.experiment, u.parts, record.iteration['wall_time'])
                 self._guarded(self._written, u, record)
                 self._cond.notify_all()
 
@@ -217,12 +219,13 @@ class Runner:
     def _written(self, u: Unit, record: Record) -> None:
         self.sink.write(record)
         self._done += 1
-        self._ran += 1
         self._left[u.experiment.id] -= 1
         if not self._left[u.experiment.id]:
             self._finish(u.experiment)
 
     def _report(self, exp: Experiment, phase: str) -> None:
-        elapsed = time.monotonic() - self._start
-        eta = elapsed / self._ran * (self._total - self._done) if self._ran else 0.0
-        self._progress(Progress(exp.id, exp.type, phase, self._done, self._total, elapsed, eta))
+        left = [(e, self._left[e.id]) for e in self.file.experiments if e.id in self._left]
+        left += [(e, experiment_iterations(e)) for e in self._waiting]
+        eta = self._costs.left(left, len(self._live))
+        self._progress(Progress(exp.id, exp.type, phase, self._done, self._total,
+                                time.monotonic() - self._start, eta))
