@@ -23,10 +23,20 @@ import matplotlib.pyplot as plt
 import numpy as np
 import yaml
 
-from .verdicts import against_paper, interval_text, PAPER, verdicts
+from .verdicts import (
+    against_paper,
+    FEASIBLE,
+    interval_text,
+    NOT_FEASIBLE,
+    PAPER,
+    UNDECIDED,
+    verdicts,
+)
 from .wording import dims, fmt, gripper_label, of_type, pct, table, varying
 
 FIGSIZE = (6.4, 4.0)   # inches
+# the HTML class (colour) of a bold verdict
+VERDICT_CLASS = {FEASIBLE: 'feasible', NOT_FEASIBLE: 'not-feasible', UNDECIDED: 'undecided'}
 
 
 def plot_bins(summary: dict, path: str) -> bool:
@@ -142,6 +152,18 @@ def _physics_health(summary: dict) -> list[str]:
                           '`iterations.csv`.']
 
 
+def _sizes(given: dict | None, lead: str) -> str:
+    """The sizes an experiment file gave, as people read them ('body diameter 5 mm, ...'),
+    after `lead`; '' for none. Keys ending in _mm carry the unit; a bare key is a part model's
+    dimension, in mm too (part.dimensions_mm)."""
+    if not given:
+        return ''
+    return lead + ', '.join(
+        f'{k.removesuffix("_mm").replace("_", " ")} {fmt(v) if isinstance(v, int | float) else v}'
+        + (' mm' if isinstance(v, int | float) and not isinstance(v, bool) else '')
+        for k, v in given.items())
+
+
 def markdown(summary: dict, spec: dict, figures: dict[str, bool],
              pictures: dict[str, str] | None = None) -> str:
     """The report as Markdown. pictures: {image file: caption} (pictures.py)."""
@@ -149,9 +171,10 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
     part = spec.get('part', {})
     r = summary['requirements']
     lines = [f'# Picking feasibility: {summary["id"]}', '',
-             f'Part `{part.get("model", "radial_capacitor")}` '
-             f'{json.dumps(part.get("dimensions_mm", {}))}; gripper '
-             f'{json.dumps(spec.get("gripper", {}))}; seed {summary["seed"]}.', '',
+             f'Part `{part.get("model", "radial_capacitor")}`'
+             f'{_sizes(part.get("dimensions_mm"), ", ")}; gripper'
+             f'{_sizes(spec.get("gripper"), " ") or " as the defaults"}; seed '
+             f'{summary["seed"]}.', '',
              f'Requirement: {fmt(r["parts_per_hour"])} parts per hour, a refill every '
              f'{fmt(r["refill_interval_h"])} h (capacity {r["capacity"]} parts), no bin longer '
              f'than {fmt(r["max_dimension_mm"])} mm in any dimension (every bin analysed '
@@ -210,6 +233,12 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
                       f'{s["optimal_range"][1]}' + (
                           f' (paper: n* = {paper["n_star"]}, {paper["range"][0]}-'
                           f'{paper["range"][1]}).' if paper else '.')]
+            tested = [p['n'] for p in s['per_n']]
+            if tested and s['optimal_range'][1] > max(tested):
+                lines += ['', f'**Warning**: the optimal range runs past the last count tested '
+                          f'({max(tested)} parts): beyond it the fit is an extrapolation'
+                          + (', and n* sits at that count, so the fit is still rising there: '
+                             'test higher counts' if s['n_star'] >= max(tested) else '') + '.']
     feeders = of_type(summary, 'feeder_emptying')
     if feeders:
         exp_id, s = feeders[-1]
@@ -268,6 +297,7 @@ def to_html(text: str, title: str) -> str:
     out = [f'<!DOCTYPE html><html><head><meta charset="utf-8"><title>{html.escape(title)}'
            '</title><style>body{font-family:sans-serif;max-width:60em;margin:2em auto}'
            'table{border-collapse:collapse}td,th{border:1px solid #aaa;padding:0.2em 0.5em}'
+           '.feasible{color:#1a7f37}.not-feasible{color:#c62828}.undecided{color:#9a6700}'
            '</style></head><body>']
     rows: list[list[str]] = []
     items: list[str] = []
@@ -275,7 +305,8 @@ def to_html(text: str, title: str) -> str:
     def inline(s: str) -> str:
         s = html.escape(s)
         parts = s.split('**')
-        s = ''.join(f'<b>{p}</b>' if i % 2 else p for i, p in enumerate(parts))
+        s = ''.join((f'<b class="{VERDICT_CLASS[p]}">{p}</b>' if p in VERDICT_CLASS
+                     else f'<b>{p}</b>') if i % 2 else p for i, p in enumerate(parts))
         parts = s.split('`')
         return ''.join(f'<code>{p}</code>' if i % 2 else p for i, p in enumerate(parts))
 

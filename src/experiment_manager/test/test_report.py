@@ -41,6 +41,21 @@ def test_a_run_gets_its_report_files(run_dir):
     assert 'grippers.png' in page
     assert 'paper' not in text.split('## Verdict')[1]      # id `small`: no paper numbers
     assert 'No iteration was flagged' in text
+    # a header people read, and each verdict coloured by what it says
+    assert 'Part `radial_capacitor`; gripper body diameter 8 mm, jaw depth 3 mm; seed 11.' in text
+    for v in verdicts.verdicts(_summary(run_dir)):
+        assert f'<b class="{report.VERDICT_CLASS[v["verdict"]]}">{v["verdict"]}</b>' in page
+
+
+def test_the_report_warns_where_the_optimal_range_runs_past_the_counts_tested(run_dir):
+    s = _summary(run_dir)
+    sweep = s['experiments']['sweep']
+    last = max(p['n'] for p in sweep['per_n'])
+    assert 'Warning' not in report.markdown(s, {}, {})
+    sweep.update(n_star=last, optimal_range=[last - 2, last + 2])
+    assert (f'**Warning**: the optimal range runs past the last count tested ({last} parts): '
+            'beyond it the fit is an extrapolation, and n* sits at that count') in \
+        report.markdown(s, {}, {})
 
 
 def _rates(s: dict, emptied: int, accepted: int, n: int) -> None:
