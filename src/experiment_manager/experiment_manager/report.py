@@ -105,8 +105,8 @@ def plot_grippers(summary: dict, path: str) -> bool:
     labels = [gripper_label(v, keys, sets) or f'variant {v["index"]}' for v in variants]
     mean = np.array([v['valid']['mean'] if v['valid']['mean'] is not None else np.nan
                      for v in variants])
-    low = np.array([np.nan if v['valid_ci95'][0] is None else v['valid_ci95'][0]
-                    for v in variants])
+    low = np.array([np.nan if v['valid_ci95'][0] is None else max(v['valid_ci95'][0], 0.0)
+                    for v in variants])     # from 0, as interval_text says it
     high = np.array([np.nan if v['valid_ci95'][1] is None else v['valid_ci95'][1]
                      for v in variants])
     x = np.arange(len(variants))

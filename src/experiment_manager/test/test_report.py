@@ -110,18 +110,28 @@ def test_verdicts_rest_on_the_interval_of_the_rate_and_on_the_capacity(run_dir):
     assert table['verdict'] == NOT_FEASIBLE and (
         "40 parts spilled over the tray's walls, in 40 runs; a run may spill 0 "
         '(requirements.max_spilled_parts): 0 of the 40 emptied runs met it') in table['reasons']
-    # A tunnelled iteration (left out of the figures) leaves no option feasible.
+    # A tunnelled iteration (left out of the figures) leaves no option feasible, and says so
+    # first.
     _rates(s, 40, 40, 40)
-    s['experiments']['feeder']['faults']['tunnelled'] = 1
-    assert verdicts.verdicts(s)[1]['verdict'] == NOT_FEASIBLE
+    s['experiments']['feeder']['faults'].update(
+        tunnelled=1, flagged=[{'group': 0, 'iteration': 3, 'fault': 'tunnelled'}])
+    table = verdicts.verdicts(s)[1]
+    assert table['verdict'] == NOT_FEASIBLE
+    assert table['reasons'][0] == '1 iteration flagged: tunnelled 1 (see Physics health)'
     s['experiments']['feeder'].update(emptied=0, accepted=0)
     s['experiments']['feeder']['stops'] = {'stop: empty': 1, 'stop: vibration limit': 2}
     assert 'runs ended by: feeder and table empty 1, vibration limit 2)' in \
-        verdicts.verdicts(s)[1]['reasons'][1]
-    s['requirements']['capacity'] = 480         # 30 parts cannot last a refill interval
+        verdicts.verdicts(s)[1]['reasons'][2]
+    # 30 parts cannot last a refill interval: that decides, and is said first, whatever the
+    # rate would have said (here: not enough iterations to decide)
+    s['requirements']['capacity'] = 480
+    _rates(s, 1, 1, 1)
     bin_verdict = verdicts.verdicts(s)[0]
     assert bin_verdict['verdict'] == NOT_FEASIBLE
-    assert 'fewer than the 480 a refill interval needs' in bin_verdict['reasons'][-1]
+    assert bin_verdict['option'] == 'static bin 100 x 100 x 20 mm'
+    assert bin_verdict['reasons'][0] == ('the bin was filled with 30 parts, fewer than the 480 '
+                                         'a refill interval needs')
+    assert bin_verdict['reasons'][1].startswith('not enough iterations to decide')
     del s['experiments']['emptying'], s['experiments']['feeder'], s['experiments']['grippers']
     assert [v['verdict'] for v in verdicts.verdicts(s)] == [NOT_ANALYSED, NOT_ANALYSED]
 
@@ -136,8 +146,10 @@ def test_the_gripper_verdict_names_the_smallest_gripper_that_meets_the_yield(run
     assert verdict['verdict'] == NOT_FEASIBLE and verdict['option'] == 'gripper (`grippers`)'
     assert verdict['reasons'][0].startswith('no gripper of the sweep gives 1 valid parts per '
                                             'check at 95 % confidence; the most: D ')
-    # One interval that reaches min_valid, and one scene that gives none: not decided.
-    g['variants'][0]['valid_ci95'] = [0.5, 1.5]
+    # One interval that reaches min_valid, and one scene that gives none: not decided. A
+    # count's interval is said from 0.
+    g['variants'][0]['valid_ci95'] = [-0.5, 1.5]
+    assert verdicts.interval_text(g['variants'][0]) == '0 to 1.5'
     g['variants'][1]['valid_ci95'] = [None, None]
     verdict = verdicts.verdicts(s)[2]
     assert verdict['verdict'] == UNDECIDED
