@@ -30,7 +30,9 @@ from pick_sim_world.bodies import instance_seed
 import pytest
 import rclpy
 from rclpy.action import ActionClient
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
+from rosgraph_msgs.msg import Clock
 import yaml
 
 pytestmark = pytest.mark.graph
@@ -197,6 +199,37 @@ def test_replay_republishes_a_topic_of_the_recording(graph_run, client):
     info = subprocess.run([executable('experiment_manager', 'replay'), recording, '--info'],
                           capture_output=True, text=True, timeout=60)
     assert f'{NS}/worker_0/results' in info.stdout and 'attachment iterations.csv' in info.stdout
+
+
+def test_replay_loops_and_publishes_the_recordings_clock(graph_run, client):
+    _, recording, _ = graph_run
+    topic = f'{NS}/worker_0/results'
+    with open(recording, 'rb') as f:
+        times = [m.log_time for _, _, m in make_reader(f).iter_messages(topics=[topic])]
+    prefix = unique_namespace('replay_loop')
+    received, clocks = [], []
+    client.node.create_subscription(ValidityReport, f'{prefix}{topic}', received.append, 100)
+    client.node.create_subscription(Clock, f'{prefix}/clock', clocks.append, QoSProfile(
+        depth=100, reliability=ReliabilityPolicy.BEST_EFFORT))
+    replay = subprocess.Popen([executable('experiment_manager', 'replay'), recording, '--rate',
+                               '10', '--prefix', prefix, '--match-wait', '60', '--topics', topic,
+                               '--loop', '--clock', '100'],
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    def stamps() -> list[int]:
+        return [c.clock.sec * 10**9 + c.clock.nanosec for c in clocks]
+
+    def clock_went_back() -> bool:      # a pass after the first began
+        return any(b < a for a, b in zip(stamps(), stamps()[1:], strict=False))
+    try:
+        assert client.wait(lambda: len(received) > len(times) and clock_went_back(), 120.0), (
+            f'{len(received)} of more than {len(times)} messages; clock: {stamps()}')
+        replay.send_signal(signal.SIGINT)
+        output = replay.communicate(timeout=30)[0]
+    finally:
+        replay.kill()
+    assert replay.returncode == 130, output
+    # The clock tells the recording's time: never before its first message or after its last.
+    assert times[0] <= min(stamps()) and max(stamps()) <= times[-1]
 
 
 def test_replay_stopped_with_sigint_says_how_far_it_got(graph_run, client):
@@ -484,17 +517,23 @@ experiments:
 
 def test_the_manager_finds_the_workers_under_its_namespace(tmp_path, client, start_node):
     """`ros2 run` style: two workers in sub-namespaces and a manager with its defaults; a
-    namespace with a validity node alone is not a worker."""
+    namespace with a validity node alone is not a worker. The manager is named as launch
+    names a node (`-r __node:=`), which must not rename its recorder node too."""
     ns = unique_namespace('exp_find')
     nodes = [start_node(pkg, exe, '-r', f'__ns:={ns}/{w}') for w in ('cell_a', 'cell_b')
              for pkg, exe in WORKER_NODES]
     nodes.append(start_node('pick_validity', 'validity', '-r', f'__ns:={ns}/lone'))
-    manager = start_node('experiment_manager', 'experiment_manager', '-r', f'__ns:={ns}', '-p',
-                         f'experiment_dirs:=["{tmp_path}"]', '-p', f'output_dirs:=["{tmp_path}"]')
+    manager = start_node('experiment_manager', 'experiment_manager', '-r', f'__ns:={ns}', '-r',
+                         '__node:=experiment_manager', '-p', f'experiment_dirs:=["{tmp_path}"]',
+                         '-p', f'output_dirs:=["{tmp_path}"]')
     path = tmp_path / 'tiny.yaml'
     path.write_text(TINY)
     action = ActionClient(client.node, RunExperiment, f'{ns}/run_experiment')
     assert client.wait_for_servers(action, nodes=(manager,))
+    def manager_nodes() -> list[str]:
+        return sorted(n for n, s in client.node.get_node_names_and_namespaces() if s == ns)
+    assert client.wait(lambda: len(manager_nodes()) == 2, 60.0, nodes=(manager,))
+    assert manager_nodes() == ['experiment_manager', 'experiment_manager_recorder']
     # Discovery takes the workers there at the start of the run: wait until both are up.
     def workers_up() -> bool:
         names = {n for n, _ in client.node.get_service_names_and_types()}

@@ -1,6 +1,7 @@
 """`replay`: republish a run's MCAP recording on the graph, for review without `ros2 bag`.
 
-    replay RECORDING.mcap [--rate R] [--topics T ...] [--prefix NS] [--info]
+    replay RECORDING.mcap [--rate R] [--topics T ...] [--prefix NS] [--loop] [--clock [HZ]]
+    replay RECORDING.mcap --info
     replay RECORDING.mcap --recover OUT.mcap
 
 Messages go out on their recorded topics (under --prefix, if given) with the recorded spacing
@@ -11,7 +12,9 @@ message counts and attachments, and exits. Payloads are published as recorded (C
 so any type in the file replays if its package is installed. --recover copies every complete
 record of a recording cut off before it was closed (its manager was killed) into a closed file
 that every reader opens, and exits. SIGINT or SIGTERM stops a replay before its next message
-(exit 130, "stopped after N messages").
+(exit 130, "stopped after N messages"). --loop plays the recording again and again until
+then; --clock publishes the recording's time on `clock` (under --prefix) at HZ (default 40, as
+ros2 bag play), for nodes with use_sim_time. On a terminal a progress line counts the messages.
 """
 
 import argparse
@@ -21,6 +24,7 @@ import struct
 import sys
 import time
 
+from builtin_interfaces.msg import Time
 from mcap.exceptions import McapError
 from mcap.reader import make_reader
 from pick_common.node_runner import LATCHED
@@ -29,6 +33,8 @@ from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
+from rosgraph_msgs.msg import Clock
+from tqdm import tqdm
 
 from . import interrupt
 from .recording import channel_qos, recover
@@ -38,6 +44,9 @@ LATCHED_TOPICS = ('scene', 'markers')
 STREAM = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 MATCH_WAIT = 2.0     # s a new topic waits by default for a subscriber to match (--match-wait)
 ACK_WAIT = 5.0       # s at the end for subscribers to acknowledge the last messages
+CLOCK_HZ = 40.0      # --clock's default rate, ros2 bag play's
+# rclpy's and rclcpp's time sources subscribe to /clock best effort, keeping the last one
+CLOCK_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
 
 
 def message_type(name: str) -> type:
@@ -76,6 +85,11 @@ def _parse(argv: list[str]) -> argparse.Namespace:
                         help='seconds each topic waits for a subscriber to match before its '
                         f'first message (default {MATCH_WAIT:g}; 0..600); then it publishes '
                         'anyway and says so')
+    parser.add_argument('--loop', action='store_true',
+                        help='play the recording again and again until SIGINT or SIGTERM')
+    parser.add_argument('--clock', type=float, nargs='?', const=CLOCK_HZ, default=None,
+                        metavar='HZ', help="publish the recording's time on clock (under "
+                        f'--prefix) at HZ (default {CLOCK_HZ:g}; 1..1000)')
     parser.add_argument('--info', action='store_true', help='list the content and exit')
     parser.add_argument('--recover', metavar='OUT',
                         help='copy the complete records of a cut-off recording into OUT (a '
@@ -87,6 +101,8 @@ def _parse(argv: list[str]) -> argparse.Namespace:
         parser.error(f'--rate: {args.rate:g} must be within [0.001, 1000]')
     if not 0.0 <= args.match_wait <= 600.0:
         parser.error(f'--match-wait: {args.match_wait:g} must be within [0, 600]')
+    if args.clock is not None and not 1.0 <= args.clock <= 1000.0:
+        parser.error(f'--clock: {args.clock:g} must be within [1, 1000]')
     return args
 
 
@@ -115,6 +131,91 @@ def info(path: str) -> str:
     return '\n'.join(lines)
 
 
+def _count(reader, topics: list[str] | None) -> int | None:
+    """Messages a pass plays (the progress line's total); None when the summary lacks them."""
+    try:
+        summary = reader.get_summary()
+    except (McapError, struct.error):   # cut off: no footer (play then says so)
+        return None
+    if summary is None or summary.statistics is None:
+        return None
+    return sum(n for cid, n in summary.statistics.channel_message_counts.items()
+               if not topics or summary.channels[cid].topic in topics)
+
+
+class Player:
+    """Publishes recorded messages at their recorded spacing divided by the rate: a publisher
+    per channel (made at its first message, then waiting for a subscriber to match), and the
+    recording's time on `clock` while it waits, with --clock."""
+
+    def __init__(self, node: Node, args: argparse.Namespace) -> None:
+        self.node, self.args = node, args
+        self.publishers: dict[int, object] = {}
+        self.sent = 0
+        prefix = args.prefix.rstrip('/')
+        self._clock = (node.create_publisher(Clock, f'{prefix}/clock', CLOCK_QOS)
+                       if args.clock else None)
+        self._ticked = float('-inf')
+
+    def _publisher(self, schema, channel):
+        """The channel's publisher, made and matched at its first message."""
+        pub = self.publishers.get(channel.id)
+        if pub is not None:
+            return pub
+        prefix = self.args.prefix
+        topic = prefix.rstrip('/') + channel.topic if prefix else channel.topic
+        pub = self.publishers[channel.id] = self.node.create_publisher(
+            message_type(schema.name), topic, replay_qos(channel.topic, channel.metadata))
+        deadline = time.monotonic() + self.args.match_wait
+        while pub.get_subscription_count() == 0 and time.monotonic() < deadline:
+            interrupt.sleep(0.02)
+        if pub.get_subscription_count() == 0:
+            print(f'replay: {topic}: no subscriber matched within {self.args.match_wait:g} s '
+                  '(--match-wait); publishing anyway', file=sys.stderr)
+        return pub
+
+    def _wait(self, due: float, start_log: int, start_wall: float) -> None:
+        """Sleep until `due` (monotonic s), publishing on the way, at the --clock rate, the
+        recording's time: `start_log` (ns) when the pass started at `start_wall` (monotonic
+        s), advancing at the rate. A signal ends the wait (KeyboardInterrupt)."""
+        while True:
+            now = time.monotonic()
+            if self._clock is not None and now - self._ticked >= 1.0 / self.args.clock:
+                log = start_log + (now - start_wall) * self.args.rate * 1e9
+                sec, nanosec = divmod(int(log), 10**9)
+                self._clock.publish(Clock(clock=Time(sec=sec, nanosec=nanosec)))
+                self._ticked = now
+            if now >= due:
+                interrupt.check()
+                return
+            period = 1.0 / self.args.clock if self._clock is not None else due - now
+            interrupt.sleep(min(due - now, period))
+
+    def play(self, messages, bar) -> None:
+        """One pass over (schema, channel, message) in log-time order."""
+        rate = self.args.rate
+        start_log = start_wall = None
+        for schema, channel, message in messages:
+            if channel.id not in self.publishers:
+                self._publisher(schema, channel)
+                if start_log is not None:   # keep the recorded spacing after the wait
+                    start_wall = time.monotonic() - (message.log_time - start_log) / 1e9 / rate
+            if start_log is None:
+                start_log, start_wall = message.log_time, time.monotonic()
+            self._wait(start_wall + (message.log_time - start_log) / 1e9 / rate, start_log,
+                       start_wall)
+            # SIGINT, SIGTERM: stop in the wait, not between a publish and its count
+            self.publishers[channel.id].publish(message.data)
+            self.sent += 1
+            bar.update()
+
+    def finish(self) -> None:
+        """Wait for the subscribers' acknowledgements: exiting at once would drop messages
+        still in flight."""
+        for pub in self.publishers.values():
+            pub.wait_for_all_acked(Duration(seconds=ACK_WAIT))
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parse(sys.argv[1:] if argv is None else argv)
     try:
@@ -135,46 +236,28 @@ def main(argv: list[str] | None = None) -> int:
     interrupt.install()
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     node = Node('replay')
-    publishers: dict[int, object] = {}
-    sent = 0
+    player = Player(node, args)
     try:
         reader = make_reader(f)
-        start_log = start_wall = None
-        for schema, channel, message in reader.iter_messages(
-                topics=args.topics or None, log_time_order=True):
-            pub = publishers.get(channel.id)
-            if pub is None:
-                msg_type = message_type(schema.name)
-                topic = args.prefix.rstrip('/') + channel.topic if args.prefix else channel.topic
-                pub = publishers[channel.id] = node.create_publisher(
-                    msg_type, topic, replay_qos(channel.topic, channel.metadata))
-                deadline = time.monotonic() + args.match_wait
-                while pub.get_subscription_count() == 0 and time.monotonic() < deadline:
-                    interrupt.sleep(0.02)
-                if pub.get_subscription_count() == 0:
-                    print(f'replay: {topic}: no subscriber matched within '
-                          f'{args.match_wait:g} s (--match-wait); publishing anyway',
-                          file=sys.stderr)
-                if start_log is not None:   # keep the recorded spacing after the wait
-                    start_wall = time.monotonic() - (
-                        message.log_time - start_log) / 1e9 / args.rate
-            if start_log is None:
-                start_log, start_wall = message.log_time, time.monotonic()
-            due = start_wall + (message.log_time - start_log) / 1e9 / args.rate
-            interrupt.sleep(due - time.monotonic())     # SIGINT, SIGTERM: stop here, not
-            pub.publish(message.data)                   # between a publish and its count
-            sent += 1
-        for pub in publishers.values():   # exiting at once would drop messages still in flight
-            pub.wait_for_all_acked(Duration(seconds=ACK_WAIT))
-        print(f'replay: published {sent} messages on {len(publishers)} topics',
+        with tqdm(total=_count(reader, args.topics), unit='msg', file=sys.stderr,
+                  dynamic_ncols=True, disable=not sys.stderr.isatty()) as bar:
+            while True:
+                before = player.sent
+                player.play(reader.iter_messages(topics=args.topics or None,
+                                                 log_time_order=True), bar)
+                if not args.loop or player.sent == before:     # nothing to play again
+                    break
+                bar.reset()
+        player.finish()
+        print(f'replay: published {player.sent} messages on {len(player.publishers)} topics',
               file=sys.stderr)
         return 0
     except KeyboardInterrupt:
-        print(f'\nreplay: stopped after {sent} messages', file=sys.stderr)
+        print(f'\nreplay: stopped after {player.sent} messages', file=sys.stderr)
         return 130
     except (McapError, ValueError, AttributeError, ModuleNotFoundError) as exc:
-        print(f'replay: {args.recording}: after {sent} messages: {type(exc).__name__}: {exc}',
-              file=sys.stderr)
+        print(f'replay: {args.recording}: after {player.sent} messages: {type(exc).__name__}: '
+              f'{exc}', file=sys.stderr)
         return 1
     finally:
         f.close()

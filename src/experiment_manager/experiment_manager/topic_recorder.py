@@ -29,7 +29,11 @@ class TopicRecorder:
     `namespace`) and writes what arrives to the recorder given to start(), until stop()."""
 
     def __init__(self, name: str, namespace: str, context=None) -> None:
-        self.node = Node(name, namespace=namespace, context=context)
+        # Not the process's global arguments: launch names a node with `-r __node:=NAME`,
+        # which renames every node of the process, and this one then took the manager's name
+        # ('Publisher already registered for node name'; issue 23). Its namespace is given.
+        self.node = Node(name, namespace=namespace, context=context,
+                         use_global_arguments=False)
         self._lock = threading.Lock()
         self._recorder: Recorder | None = None
         self._last = 0.0
