@@ -42,10 +42,11 @@ class NodeProcess(launcher.NodeProcess):
     """A node started as a process, its output in a temporary log file (a pipe nobody reads
     can fill and stall the node)."""
 
-    def __init__(self, package: str, name: str, args: list[str]) -> None:
+    def __init__(self, package: str, name: str, args: list[str],
+                 prefix: tuple[str, ...] = ()) -> None:
         fd, log = tempfile.mkstemp(prefix=f'{name}_', suffix='.log')
         os.close(fd)
-        super().__init__(package, name, args, log)
+        super().__init__(package, name, args, log, prefix=prefix)
 
 
 def stop_all(procs) -> None:

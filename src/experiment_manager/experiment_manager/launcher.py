@@ -37,13 +37,16 @@ def executable(package: str, name: str) -> str:
 class NodeProcess:
     """A node started as a process, its output in `log_path`. stop() sends SIGINT, then
     SIGKILL after `timeout`, and returns the exit code. `label` names it in messages (default:
-    the executable's name)."""
+    the executable's name). `prefix`: a command that runs the node (it must exec it, so that
+    the signals reach the node), e.g. `ip netns exec NS env VAR=value` for a node on another
+    network host."""
 
     def __init__(self, package: str, name: str, ros_args: list[str], log_path: str,
-                 label: str = '', append: bool = False) -> None:
+                 label: str = '', append: bool = False, prefix: tuple[str, ...] = ()) -> None:
         self.name = label or name
         self._args = (package, name, ros_args, log_path, label)
-        self.command = [executable(package, name), '--ros-args', *ros_args]
+        self._prefix = tuple(prefix)
+        self.command = [*prefix, executable(package, name), '--ros-args', *ros_args]
         self.log_path = log_path
         with open(log_path, 'ab' if append else 'wb') as log:
             # A native crash (SIGSEGV in PyBullet, FCL or rcl) then leaves every thread's
@@ -55,7 +58,7 @@ class NodeProcess:
 
     def respawn(self) -> 'NodeProcess':
         """The same node started again, its output appended to the same log."""
-        return NodeProcess(*self._args, append=True)
+        return NodeProcess(*self._args, append=True, prefix=self._prefix)
 
     @property
     def pid(self) -> int:
