@@ -4,7 +4,7 @@ finished iterations cost per part, not counted."""
 import os
 
 from experiment_manager import config
-from experiment_manager.estimate import Costs, mean_units
+from experiment_manager.estimate import Costs, mean_units, TYPE_WEIGHT
 from experiment_manager.plan import count_iterations, experiment_iterations
 import pytest
 
@@ -34,8 +34,10 @@ def test_iterations_left_are_weighed_by_their_cost_not_counted(small):
     costs = Costs()
     for n in sweep.counts:                  # 2..14 parts, 0.1 s per part
         costs.add(sweep, n, 0.1 * n)
-    # A feeder run not timed yet: taken at the rate of all (0.1 s per part) times its parts.
-    assert costs.left([(feeder, 1)], workers=1) == pytest.approx(0.1 * feeder.parts)
+    # A feeder run not timed yet: taken at the rate of all (0.1 s per part) times its parts,
+    # weighed as a feeder run's part (TYPE_WEIGHT).
+    assert costs.left([(feeder, 1)], workers=1) == pytest.approx(
+        0.1 * feeder.parts * TYPE_WEIGHT['feeder_emptying'])
     # Once one has run (30 s for 12 parts), the other takes what it took: counting
     # iterations would say 0.8 s, the sweep's mean.
     costs.add(feeder, feeder.parts, 30.0)
