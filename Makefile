@@ -11,7 +11,7 @@ DEPS_STAMP := $(VENV)/.deps-stamp
 BUILD_STAMP := install/.build-stamp
 SOURCES := $(shell find src -type f -not -path '*/__pycache__/*' -not -name '*.pyc' 2>/dev/null)
 PYTEST_ARGS ?=
-# The paper's test case (README, "The paper's test case"), one iteration per bin, per n and per
+# The paper's test case (docs/paper-test-case.md), one iteration per bin, per n and per
 # feeder run; RUN_ARGS="$(TEST_CASE)" runs the full counts, RUN_ARGS="" the built-in small file.
 TEST_CASE := $(addprefix src/experiment_manager/config/test_case/,pth0.yaml pth1.yaml pth2.yaml)
 RUN_ARGS ?= --iterations 1 $(TEST_CASE)

@@ -22,7 +22,7 @@ default a quarter of the step).
     tools/ws python bench/bench_convergence.py [--seeds 8] [--workloads sweep,feeder,bins,...]
         [--settings default,100-it,...] [--finest dt/4]
 
-Runs are spread over a process per CPU. What it costs: README, "Convergence".
+Runs are spread over a process per CPU. What it costs: docs/physics.md, "Convergence".
 """
 
 import argparse
@@ -88,9 +88,9 @@ WORKLOADS = {
 
 
 # Every workload checks with the smallest gripper that meets PTH0's yield (grippers_pth0.yaml,
-# README "Which gripper"): with the test case's 20 mm one (issue 21's validity) a capacitor on
-# the tray is rarely valid, every feeder run stops at its vibration limit, and the count of
-# vibrations to empty measures nothing.
+# docs/paper-test-case.md, "Which gripper"): with the test case's 20 mm one (issue 21's
+# validity) a capacitor on the tray is rarely valid, every feeder run stops at its vibration
+# limit, and the count of vibrations to empty measures nothing.
 GRIPPER = {'body_diameter_mm': 8, 'body_length_mm': 60, 'jaw_height_mm': 15, 'jaw_depth_mm': 3}
 
 

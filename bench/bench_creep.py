@@ -32,7 +32,7 @@ PTH1 = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src',
                     'experiment_manager', 'config', 'test_case', 'pth1.yaml')
 # The defaults before issue 20's convergence study: 30 iterations, pybullet's warm start 0.1
 # and step of 1/240 s.
-# The probes for the cause of the creep ran on them first (README, "Piles that rest").
+# The probes for the cause of the creep ran on them first (world README, "Piles that rest").
 FORMER = {'solver_iterations': 30, 'warm_starting_factor': 0.1, 'time_step': 1 / 240}
 # name: (PhysicsConfig fields, extra setPhysicsEngineParameter arguments)
 SETTINGS = {

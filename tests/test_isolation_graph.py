@@ -1,5 +1,5 @@
 """Who can reach the nodes. The Fast DDS of the PyPI wheels has no DDS Security: a node told to
-enforce it refuses to start, so enclaves cannot keep anyone out here (README, Reliability). What
+enforce it refuses to start, so enclaves cannot keep anyone out here (docs/reliability.md). What
 does isolate: another ROS_DOMAIN_ID, and ROS_AUTOMATIC_DISCOVERY_RANGE (OFF: nothing finds the
 node; LOCALHOST, which the tests use: nothing off this host, which one machine cannot test)."""
 

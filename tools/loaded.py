@@ -4,7 +4,8 @@ status is the first failing round's (0 when all passed).
 
     python3 tools/loaded.py [--rounds 3] [--loops N] -- make test
 
-`make test-loaded` runs the test command three times so (README, "Tests"). A test that passes
+`make test-loaded` runs the test command three times so (docs/reliability.md, "A busy
+machine"). A test that passes
 here only by luck of scheduling would fail on a shared CI machine or a busy workstation.
 """
 

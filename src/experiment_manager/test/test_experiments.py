@@ -43,8 +43,8 @@ def test_every_type_records_its_rows_and_metrics(small):
         n = [int(r[k]) for k in ('checked', 'candidates', 'placeable', 'container_free')]
         assert n == sorted(n, reverse=True), r      # each stage passes a subset of the last
         assert r['settled'] == 'True' and int(r['spilled']) == int(r['tunnelled']) == 0
-        # At the default step piles overlap up to about 1 mm (README, "Convergence": 0.9-1.0
-        # mm deepest in the benchmark's piles; 2.8 mm at the former solver settings).
+        # At the default step piles overlap up to about 1 mm (docs/physics.md, "Convergence":
+        # 0.9-1.0 mm deepest in the benchmark's piles; 2.8 mm at the former solver settings).
         assert float(r['max_penetration']) < 0.002
     s = summary['experiments']
     assert s['bins']['best_bin'] in (0, 1)

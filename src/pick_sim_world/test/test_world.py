@@ -234,7 +234,7 @@ def test_a_standing_part_stays_up_below_1_g_and_tips_under_the_default_move():
     # 0.3 mm at 26 Hz peaks at 0.82 g: the tray never throws the part, so nothing can tip it.
     # The default move (1.4 mm, 3.8 g, random horizontal) tosses it. (At pybullet's warm start
     # of 0.1 and 30 iterations, a 3 mm vertical shake left it standing for hundreds of
-    # shakes; every finer setting tips it at the first: README, "Piles that rest".)
+    # shakes; every finer setting tips it at the first: world README, "Piles that rest".)
     gentle = Vibration((0.0, 0.0, 0.0003), direction=FIXED)
     assert [_tipped(gentle, seed) for seed in range(3)] == [False] * 3
     assert [_tipped(Vibration(), seed, shakes=2) for seed in range(3)] == [True] * 3
