@@ -148,23 +148,23 @@ def _gripper_verdict(exp_id: str, s: dict) -> dict:
         # not feasible only where every gripper's interval lies below min_valid
         open_ = [v for v in variants if v['valid_ci95'][1] is None
                  or v['valid_ci95'][1] >= s['min_valid']]
-        verdict = UNDECIDED if open_ and not _left_out(s) else NOT_FEASIBLE
-        undecided = ([f'not enough scenes to decide: {count(len(open_), "gripper")} of the '
-                      f'sweep had an interval reaching {fmt(s["min_valid"])}, or too few '
-                      'scenes for one'] if verdict == UNDECIDED else [])
-        return {'option': f'gripper (`{exp_id}`)', 'verdict': verdict, 'reasons': [
-            f'no gripper of the sweep gives {fmt(s["min_valid"])} valid parts per check at '
-            f'95 % confidence; the most: {gripper_label(best)}, mean '
-            f'{fmt(best["valid"]["mean"])} (95 % interval {interval_text(best)})',
-            *undecided, where, *_fault_reason(s)]}
-    v = variants[s['smallest']]
-    return {'option': f'gripper {gripper_label(v)} (`{exp_id}`)',
-            'verdict': NOT_FEASIBLE if _left_out(s) else FEASIBLE,
-            'reasons': [f'the smallest of the sweep whose valid parts per check reach '
-                        f'{fmt(s["min_valid"])} at 95 % confidence: mean '
-                        f'{fmt(v["valid"]["mean"])}, 95 % interval {interval_text(v)}; '
-                        f'{v["scenes_with_valid"]} of {v["scenes"]} scenes had a valid part',
-                        where, *_fault_reason(s)]}
+        option, verdict = f'gripper (`{exp_id}`)', UNDECIDED if open_ else NOT_FEASIBLE
+        reasons = [f'no gripper of the sweep gives {fmt(s["min_valid"])} valid parts per check '
+                   f'at 95 % confidence; the most: {gripper_label(best)}, mean '
+                   f'{fmt(best["valid"]["mean"])} (95 % interval {interval_text(best)})']
+        if open_:
+            reasons.append(f'not enough scenes to decide: {count(len(open_), "gripper")} of '
+                           f'the sweep had an interval reaching {fmt(s["min_valid"])}, or too '
+                           'few scenes for one')
+    else:
+        v = variants[s['smallest']]
+        option, verdict = f'gripper {gripper_label(v)} (`{exp_id}`)', FEASIBLE
+        reasons = [f'the smallest of the sweep whose valid parts per check reach '
+                   f'{fmt(s["min_valid"])} at 95 % confidence: mean '
+                   f'{fmt(v["valid"]["mean"])}, 95 % interval {interval_text(v)}; '
+                   f'{v["scenes_with_valid"]} of {v["scenes"]} scenes had a valid part']
+    verdict, reasons = _decided(verdict, reasons + [where], s, None)
+    return {'option': option, 'verdict': verdict, 'reasons': reasons}
 
 
 def interval_text(v: dict) -> str:
