@@ -111,12 +111,12 @@ def test_a_worker_on_a_second_host_gives_the_results_of_one_host(tmp_path, secon
     path.write_text(FILE)
     action = ActionClient(client.node, RunExperiment, f'{ns}/run_experiment')
     assert client.wait_for_servers(action, nodes=nodes)
-
-    def remote_worker_seen() -> bool:
-        names = {n for n, _ in client.node.get_service_names_and_types()}
-        return {f'{ns}/worker_1/reset_scene', f'{ns}/worker_1/check_parts',
-                f'{ns}/worker_1/feed_cycle/_action/send_goal'} <= names
-    assert client.wait(remote_worker_seen, 120.0, nodes=nodes), 'the second host was not found'
+    # The manager waits for the workers it is given (server_timeout): this test process does
+    # not look for the remote worker itself. After another test had opened contexts in this
+    # process, its client did not find the remote one in 120 s (3 of 3 runs), while a client in
+    # a process of its own did; a Fast DDS node announces itself to a static peer's first four
+    # participant ids only, and this process's later participants take higher ids (likely the
+    # cause, not proven).
     handle = client.result(action.send_goal_async(RunExperiment.Goal(
         experiment_file=str(path), output_dir=str(tmp_path / 'out'))))
     result = client.result(handle.get_result_async(), 600.0).result
