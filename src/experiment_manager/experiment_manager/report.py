@@ -48,12 +48,17 @@ def plot_bins(summary: dict, path: str) -> bool:
     area = [b['xy_area_mm2'] / 100.0 for b in bins]      # cm^2
     order = np.argsort(area)
     fig, ax = plt.subplots(figsize=FIGSIZE)
-    for key, label in (('candidates', 'candidacy'), ('placeable', 'placeability'),
-                       ('container_free', 'bin collision free')):
+    # Placeability passes a subset of the candidates, and often all of them: candidacy is drawn
+    # on top, dashed with hollow rings, so that it stays visible where the two are equal (it
+    # was hidden under placeability; issue 23).
+    for key, label, style in (
+            ('candidates', 'candidacy', {'marker': 'o', 'markersize': 9, 'linestyle': '--',
+                                         'markerfacecolor': 'none', 'zorder': 3}),
+            ('placeable', 'placeability', {'marker': 's', 'markersize': 4, 'zorder': 2}),
+            ('container_free', 'bin collision free', {'marker': '^', 'zorder': 2})):
         mean = [100 * bins[i]['fractions'][key]['mean'] for i in order]
         std = [100 * bins[i]['fractions'][key]['std'] for i in order]
-        ax.errorbar([area[i] for i in order], mean, yerr=std, marker='o', capsize=3,
-                    label=label)
+        ax.errorbar([area[i] for i in order], mean, yerr=std, capsize=3, label=label, **style)
     ax.set_ylim(0, 100)
     _finish(fig, ax, path, f'{summary["id"]}: static bin analysis (figure 14)',
             'bin XY surface (cm$^2$)', 'parts passing the stage (%)')
