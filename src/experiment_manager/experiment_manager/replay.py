@@ -152,18 +152,14 @@ class Player:
         self.node, self.args = node, args
         self.publishers: dict[int, object] = {}
         self.sent = 0
-        prefix = args.prefix.rstrip('/')
-        self._clock = (node.create_publisher(Clock, f'{prefix}/clock', CLOCK_QOS)
+        self._prefix = args.prefix.rstrip('/')    # put before every (absolute) topic
+        self._clock = (node.create_publisher(Clock, f'{self._prefix}/clock', CLOCK_QOS)
                        if args.clock else None)
         self._ticked = float('-inf')
 
-    def _publisher(self, schema, channel):
+    def _open(self, schema, channel) -> None:
         """The channel's publisher, made and matched at its first message."""
-        pub = self.publishers.get(channel.id)
-        if pub is not None:
-            return pub
-        prefix = self.args.prefix
-        topic = prefix.rstrip('/') + channel.topic if prefix else channel.topic
+        topic = self._prefix + channel.topic
         pub = self.publishers[channel.id] = self.node.create_publisher(
             message_type(schema.name), topic, replay_qos(channel.topic, channel.metadata))
         deadline = time.monotonic() + self.args.match_wait
@@ -172,7 +168,6 @@ class Player:
         if pub.get_subscription_count() == 0:
             print(f'replay: {topic}: no subscriber matched within {self.args.match_wait:g} s '
                   '(--match-wait); publishing anyway', file=sys.stderr)
-        return pub
 
     def _wait(self, due: float, start_log: int, start_wall: float) -> None:
         """Sleep until `due` (monotonic s), publishing on the way, at the --clock rate, the
@@ -197,7 +192,7 @@ class Player:
         start_log = start_wall = None
         for schema, channel, message in messages:
             if channel.id not in self.publishers:
-                self._publisher(schema, channel)
+                self._open(schema, channel)
                 if start_log is not None:   # keep the recorded spacing after the wait
                     start_wall = time.monotonic() - (message.log_time - start_log) / 1e9 / rate
             if start_log is None:
