@@ -49,24 +49,25 @@ def type_name(msg_type: type) -> str:
 # by their rmw names ('keep_last', 'reliable', 'transient_local', 'automatic'), durations as
 # {sec, nsec}.
 OFFERED_QOS = 'offered_qos_profiles'
-_POLICIES = (('history', HistoryPolicy), ('reliability', ReliabilityPolicy),
-             ('durability', DurabilityPolicy), ('liveliness', LivelinessPolicy))
+# A profile's keys in rosbag2's order: policies by name, depth an int, durations {sec, nsec}.
+_POLICIES = {'history': HistoryPolicy, 'reliability': ReliabilityPolicy,
+             'durability': DurabilityPolicy, 'liveliness': LivelinessPolicy}
 _DURATIONS = ('deadline', 'lifespan', 'liveliness_lease_duration')
+_KEYS = ('history', 'depth', 'reliability', 'durability', 'deadline', 'lifespan', 'liveliness',
+         'liveliness_lease_duration', 'avoid_ros_namespace_conventions')
 
 
 def qos_yaml(profiles: Iterable[QoSProfile]) -> str:
     """The offered_qos_profiles text of a channel whose publishers offered `profiles`."""
-    out = []
-    for p in profiles:
-        entry = {'history': p.history.short_key, 'depth': p.depth,
-                 'reliability': p.reliability.short_key, 'durability': p.durability.short_key,
-                 'liveliness': p.liveliness.short_key,
-                 'avoid_ros_namespace_conventions': p.avoid_ros_namespace_conventions}
-        for key in _DURATIONS:
-            sec, nsec = divmod(getattr(p, key).nanoseconds, 10**9)
-            entry[key] = {'sec': sec, 'nsec': nsec}
-        out.append(entry)
-    return yaml.safe_dump(out, sort_keys=False)
+    def encode(key: str, value):
+        if key in _POLICIES:
+            return value.short_key
+        if key in _DURATIONS:
+            sec, nsec = divmod(value.nanoseconds, 10**9)
+            return {'sec': sec, 'nsec': nsec}
+        return value
+    return yaml.safe_dump([{k: encode(k, getattr(p, k)) for k in _KEYS} for p in profiles],
+                          sort_keys=False)
 
 
 def qos_profiles(text: str) -> list[QoSProfile]:
@@ -76,7 +77,7 @@ def qos_profiles(text: str) -> list[QoSProfile]:
         entries = yaml.safe_load(text) or []
         return [QoSProfile(
             depth=int(e['depth']),
-            **{key: policy.get_from_short_key(e[key]) for key, policy in _POLICIES},
+            **{key: policy.get_from_short_key(e[key]) for key, policy in _POLICIES.items()},
             **{key: Duration(seconds=int(e[key]['sec']), nanoseconds=int(e[key]['nsec']))
                for key in _DURATIONS},
             avoid_ros_namespace_conventions=bool(e['avoid_ros_namespace_conventions']))
