@@ -29,6 +29,7 @@ from .verdicts import (
     interval_text,
     NOT_FEASIBLE,
     PAPER,
+    shown_interval,
     UNDECIDED,
     verdicts,
 )
@@ -110,10 +111,8 @@ def plot_grippers(summary: dict, path: str) -> bool:
     labels = [gripper_label(v, keys, sets) or f'variant {v["index"]}' for v in variants]
     mean = np.array([v['valid']['mean'] if v['valid']['mean'] is not None else np.nan
                      for v in variants])
-    low = np.array([np.nan if v['valid_ci95'][0] is None else max(v['valid_ci95'][0], 0.0)
-                    for v in variants])     # from 0, as interval_text says it
-    high = np.array([np.nan if v['valid_ci95'][1] is None else v['valid_ci95'][1]
-                     for v in variants])
+    low, high = (np.array([np.nan if x is None else x for x in side]) for side in
+                 zip(*(shown_interval(v) for v in variants), strict=True))
     x = np.arange(len(variants))
     fig, ax = plt.subplots(figsize=(max(FIGSIZE[0], 0.5 * len(variants) + 2), FIGSIZE[1] + 1))
     colours = ['tab:green' if v['index'] == s['smallest'] else
@@ -163,10 +162,11 @@ def _sizes(given: dict | None, lead: str) -> str:
     dimension, in mm too (part.dimensions_mm)."""
     if not given:
         return ''
-    return lead + ', '.join(
-        f'{k.removesuffix("_mm").replace("_", " ")} {fmt(v) if isinstance(v, int | float) else v}'
-        + (' mm' if isinstance(v, int | float) and not isinstance(v, bool) else '')
-        for k, v in given.items())
+    def size(key: str, value) -> str:
+        name = key.removesuffix('_mm').replace('_', ' ')
+        number = isinstance(value, int | float) and not isinstance(value, bool)
+        return f'{name} {fmt(value)} mm' if number else f'{name} {value}'
+    return lead + ', '.join(size(k, v) for k, v in given.items())
 
 
 def markdown(summary: dict, spec: dict, figures: dict[str, bool],

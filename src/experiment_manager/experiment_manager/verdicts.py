@@ -167,13 +167,19 @@ def _gripper_verdict(exp_id: str, s: dict) -> dict:
     return {'option': option, 'verdict': verdict, 'reasons': reasons}
 
 
-def interval_text(v: dict) -> str:
-    """A gripper_sweep variant's 95 % interval of valid parts per check, as the report says it:
-    from 0 where the Student-t interval reaches below (two scenes of 4 valid parts each gave
-    -14 to 22; a count is never negative; summary.json keeps the interval as computed, and
-    `meets` is decided on it)."""
+def shown_interval(v: dict) -> tuple[float | None, float | None]:
+    """A gripper_sweep variant's 95 % interval of valid parts per check as the report shows it
+    (text and plot): from 0 where the Student-t interval reaches below (two scenes of 4 valid
+    parts each gave -14 to 22; a count is never negative). summary.json keeps the interval as
+    computed, and `meets` is decided on it."""
     low, high = v['valid_ci95']
-    return '-' if low is None else f'{fmt(max(low, 0.0))} to {fmt(high)}'
+    return (None, None) if low is None else (max(low, 0.0), high)
+
+
+def interval_text(v: dict) -> str:
+    """shown_interval, as the report's sentences and tables say it."""
+    low, high = shown_interval(v)
+    return '-' if low is None else f'{fmt(low)} to {fmt(high)}'
 
 
 def _left_out(s: dict) -> bool:
