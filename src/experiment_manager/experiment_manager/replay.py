@@ -169,15 +169,19 @@ class Player:
             print(f'replay: {topic}: no subscriber matched within {self.args.match_wait:g} s '
                   '(--match-wait); publishing anyway', file=sys.stderr)
 
-    def _wait(self, due: float, start_log: int, start_wall: float) -> None:
-        """Sleep until `due` (monotonic s), publishing on the way, at the --clock rate, the
-        recording's time: `start_log` (ns) when the pass started at `start_wall` (monotonic
-        s), advancing at the rate. A signal ends the wait (KeyboardInterrupt)."""
+    def _wait(self, due: float, due_log: int, start_log: int, start_wall: float) -> None:
+        """Sleep until `due` (monotonic s), when the message of log time `due_log` (ns) goes
+        out, publishing on the way, at the --clock rate, the recording's time: `start_log`
+        (ns) when the pass started at `start_wall` (monotonic s), advancing at the rate, and
+        never past `due_log`. In integer ns: a float of some 1.8e18 ns is 256 ns coarse (the
+        clock once read 127 ns before the first message), and a wake-up after `due` made it run
+        1 ms past the last (the graph test caught both). A signal ends the wait
+        (KeyboardInterrupt)."""
         while True:
             now = time.monotonic()
             if self._clock is not None and now - self._ticked >= 1.0 / self.args.clock:
-                log = start_log + (now - start_wall) * self.args.rate * 1e9
-                sec, nanosec = divmod(int(log), 10**9)
+                log = min(due_log, start_log + int((now - start_wall) * self.args.rate * 1e9))
+                sec, nanosec = divmod(log, 10**9)
                 self._clock.publish(Clock(clock=Time(sec=sec, nanosec=nanosec)))
                 self._ticked = now
             if now >= due:
@@ -197,8 +201,8 @@ class Player:
                     start_wall = time.monotonic() - (message.log_time - start_log) / 1e9 / rate
             if start_log is None:
                 start_log, start_wall = message.log_time, time.monotonic()
-            self._wait(start_wall + (message.log_time - start_log) / 1e9 / rate, start_log,
-                       start_wall)
+            self._wait(start_wall + (message.log_time - start_log) / 1e9 / rate,
+                       message.log_time, start_log, start_wall)
             # SIGINT, SIGTERM: stop in the wait, not between a publish and its count
             self.publishers[channel.id].publish(message.data)
             self.sent += 1
