@@ -1,6 +1,6 @@
 """`run`: bring up the graph on this machine and run experiment files through it.
 
-    run [EXPERIMENT_FILE ...] [--output DIR | --resume RUN_DIR] [--iterations N]
+    run [EXPERIMENT_FILE ...] [--output DIR | --resume RUN_DIR] [--iterations N] [--adaptive]
         [--workers N] [--respawns N] [--namespace NS] [--logs DIR]
 
 Starts N workers (`world`, `validity` and `feeder_controller` under <NS>/worker_<k>, default: a
@@ -12,7 +12,8 @@ the run fails only when no worker is left. Each node may read and write only whe
 need (mesh_dirs, experiment_dirs, output_dirs). Without a file it runs the built-in default
 (`share/experiment_manager/config/default_experiment.yaml`), or with --resume the file the run
 directory keeps. --iterations N caps every experiment at N iterations (a quick look at a long
-study; the run directory keeps the file that ran).
+study; the run directory keeps the file that ran); --adaptive runs each experiment only until
+its decision is settled (sampling.py), at most its iterations.
 
 Exit codes: 0 done; 1 the run failed (the message says why; finished iterations are kept);
 2 bad input (the experiment file, an option); 130 interrupted (Ctrl-C: the run is canceled and
@@ -119,6 +120,9 @@ def _parse(argv: list[str]) -> argparse.Namespace:
                         'worker per CPU, at most 8)')
     parser.add_argument('--iterations', type=int, metavar='N',
                         help='cap every experiment at N iterations')
+    parser.add_argument('--adaptive', action='store_true',
+                        help="sample each experiment until its decision is settled, at most "
+                        "its iterations (the file's sampling.mode: adaptive)")
     parser.add_argument('--respawns', type=int, metavar='N', default=RESPAWNS,
                         help=f'times a worker node that died is started again (default '
                         f'{RESPAWNS}; 0: never, and the manager does not wait for it)')
@@ -127,8 +131,9 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     args = parser.parse_args(argv)
     if args.resume and len(args.experiment_files) > 1:
         parser.error('--resume finishes one run: give one experiment file')
-    if args.iterations is not None and args.resume:
-        parser.error('--resume runs the file of the run directory: no --iterations')
+    if (args.iterations is not None or args.adaptive) and args.resume:
+        parser.error('--resume runs the file of the run directory: no --iterations or '
+                     '--adaptive')
     if not 0 <= args.respawns <= 100:
         parser.error(f'--respawns {args.respawns} must be within [0, 100]')
     if args.iterations is not None and not 1 <= args.iterations <= config.MAX_ITERATIONS:
@@ -168,6 +173,10 @@ def _summary_lines(summary: dict) -> list[str]:
             lines.append(f'  {exp_id} (feeder_emptying): {s["emptied"]}/{s["iterations"]} '
                          'runs emptied' + (f', {v:.4g} vibrations to empty on average'
                                            if v is not None else ''))
+        if 'sampling' in s:
+            a = s['sampling']
+            lines[-1] += (f' [adaptive: {a["iterations_run"]} of {a["most"]} iterations, '
+                          + ('settled]' if a['settled'] else 'not settled]'))
     return lines
 
 
@@ -175,7 +184,7 @@ def _goals(args: argparse.Namespace,
            temporary: list[str]) -> list[tuple[RunExperiment.Goal, str, str]]:
     """A goal per file with the file's mesh ('' for none) and the path as given (the goal's may
     be a reduced copy), every file checked first. Raises InvalidArgument naming the file
-    (InvalidFile when it has several errors). The reduced copies that --iterations writes are
+    (InvalidFile when it has several errors). The copies that --iterations and --adaptive write are
     added to `temporary`, for the caller to remove."""
     goals = []
     files = args.experiment_files or [os.path.join(args.resume, 'experiment.yaml')
@@ -188,12 +197,12 @@ def _goals(args: argparse.Namespace,
             named = [InvalidArgument(f'{path}: {e.field}', e.value, e.rule) for e in
                      (exc.errors if isinstance(exc, config.InvalidFile) else [exc])]
             raise (named[0] if len(named) == 1 else config.InvalidFile(named)) from None
-        if args.iterations is not None:
+        if args.iterations is not None or args.adaptive:
             # the run directory keeps the file that ran; this copy goes when run ends
             fd, path = tempfile.mkstemp(prefix=f'{file.id}_', suffix='.yaml')
             temporary.append(path)
             with os.fdopen(fd, 'w') as f:
-                f.write(config.reduced(file, args.iterations))
+                f.write(config.reduced(file, args.iterations, args.adaptive))
         output = os.path.abspath(os.path.expanduser(args.resume or args.output
                                                     or file.output_dir))
         goals.append((RunExperiment.Goal(experiment_file=path, resume=bool(args.resume),

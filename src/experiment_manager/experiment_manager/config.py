@@ -47,6 +47,8 @@ BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING, GRIPPER_SWEEP = (
     'bin_static', 'bin_emptying', 'table_sweep', 'feeder_emptying', 'gripper_sweep')
 TYPES = (BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING, GRIPPER_SWEEP)
 SEARCH_ORDERS = ('top_first', 'random', 'id')
+FIXED, ADAPTIVE = 'fixed', 'adaptive'
+SAMPLING_MODES = (FIXED, ADAPTIVE)
 MAX_ITERATIONS = 10_000
 MAX_BINS = 100
 MAX_EXPERIMENTS = 50
@@ -75,6 +77,20 @@ class Requirements:
     def capacity(self) -> int:
         """Parts a bin or feeder must hold to last one refill interval."""
         return math.ceil(self.parts_per_hour * self.refill_interval / 3600.0)
+
+
+@dataclass(frozen=True)
+class Sampling:
+    """How many iterations an experiment runs. fixed: its `iterations` (per bin or count), as
+    the paper's counts. adaptive: batches of `batch` iterations per group until its decision
+    is settled (sampling.py), at most its `iterations`."""
+
+    mode: str = FIXED
+    batch: int = 5
+
+    @property
+    def adaptive(self) -> bool:
+        return self.mode == ADAPTIVE
 
 
 @dataclass(frozen=True)
@@ -141,6 +157,7 @@ class ExperimentFile:
     bin_wall: float
     requirements: Requirements
     experiments: tuple[Experiment, ...]
+    sampling: Sampling = Sampling()
     path: str = ''
     text: str = field(default='', repr=False)
 
@@ -557,6 +574,11 @@ def _requirements(r: _Map) -> Requirements:
         success_rate=r.number('success_rate', 0.9, low=0.0, high=1.0, low_open=True))
 
 
+def _sampling(s: _Map) -> Sampling:
+    return Sampling(mode=s.text('mode', FIXED, SAMPLING_MODES),
+                    batch=s.integer('batch', Sampling.batch, 1, MAX_ITERATIONS))
+
+
 def _tray(m: _Map) -> ContainerSpec:
     tray = ContainerSpec.tray(m.vector('tray_mm', [s / MM for s in TRAY_DEFAULT_SIZE], 3,
                                        low=0.0, low_open=True, scale=MM))
@@ -613,6 +635,7 @@ def parse(text: str, path: str = '') -> ExperimentFile:
     gripper = section('gripper', lambda g: _gripper(g, Gripper()))
     check, search_order = section('check', _check) or (None, None)
     requirements = section('requirements', _requirements)
+    sampling = section('sampling', _sampling)
     tray = checked(lambda: _tray(m))
     moves = checked(lambda: _moves(m))
     bin_wall = checked(lambda: m.number('bin_wall_mm', 3.0, low=0.5, high=100.0, scale=MM))
@@ -651,6 +674,7 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         id=file_id, seed=seed, output_dir=output_dir, part=part, gripper=gripper, grasps=grasps,
         place=place, check=check, search_order=search_order, tray=tray, moves=moves,
         bin_wall=bin_wall, requirements=requirements, experiments=tuple(experiments.values()),
+        sampling=sampling,
         path=os.path.abspath(path) if path else '', text=text)
 
 
@@ -671,16 +695,22 @@ def load(path: str) -> ExperimentFile:
     return parse(text, path)
 
 
-def reduced(file: ExperimentFile, max_iterations: int) -> str:
-    """The text of `file` with every experiment's iterations capped at `max_iterations` and
-    the mesh path made absolute, as a file that can live anywhere (a quick look at a long
-    study; the run directory keeps the file that ran). Comments are not kept."""
-    check_int('max_iterations', max_iterations, low=1, high=MAX_ITERATIONS)
+def reduced(file: ExperimentFile, max_iterations: int | None, adaptive: bool = False) -> str:
+    """The text of `file` with every experiment's iterations capped at `max_iterations` (None:
+    as they are), with adaptive sampling when `adaptive`, and the mesh path made absolute, as
+    a file that can live anywhere (a quick look at a long study; the run directory keeps the
+    file that ran). Comments are not kept."""
     data = yaml.safe_load(file.text)
-    for item in data['experiments']:
-        item['iterations'] = min(int(item['iterations']), max_iterations)
+    said = []
+    if max_iterations is not None:
+        check_int('max_iterations', max_iterations, low=1, high=MAX_ITERATIONS)
+        for item in data['experiments']:
+            item['iterations'] = min(int(item['iterations']), max_iterations)
+        said.append(f'every experiment capped at {max_iterations} iteration(s)')
+    if adaptive:
+        data['sampling'] = {**(data.get('sampling') or {}), 'mode': ADAPTIVE}
+        said.append('adaptive sampling')
     if file.part.mesh_path:
         data['part']['mesh'] = file.part.mesh_path
-    header = (f'# {file.path or file.id}, with every experiment capped at {max_iterations} '
-              'iteration(s)\n')
+    header = f'# {file.path or file.id}, with {" and ".join(said) or "no change"}\n'
     return header + yaml.safe_dump(data, sort_keys=False)

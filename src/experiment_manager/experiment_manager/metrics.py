@@ -128,6 +128,17 @@ def bin_emptying(exp: Experiment, rows: list[dict], picks: list[dict]) -> dict:
             'first_check': _fractions(rows)}
 
 
+def fit(counts: np.ndarray, valid: np.ndarray, order: int, first: int, last: int
+        ) -> tuple[np.ndarray, np.ndarray]:
+    """The polynomial fit of `order` of valid parts against counts, and its maximum over the
+    integers in [first, last]; `valid` (N,) or (N, K): K fits at once (coefficients (order + 1,
+    K), maxima (K,))."""
+    coefficients = np.polyfit(counts, valid, order)
+    grid = np.arange(first, last + 1)
+    values = np.polyval(coefficients, grid if valid.ndim == 1 else grid[:, None])
+    return coefficients, grid[np.argmax(values, axis=0)]
+
+
 def fit_optimum(counts, valid, first: int, last: int, margin: int) -> dict:
     """The polynomial fit (order 4, lower with fewer distinct counts) of valid parts against
     parts on the table, n* at its maximum over the integers in [first, last], and the range
@@ -140,9 +151,8 @@ def fit_optimum(counts, valid, first: int, last: int, margin: int) -> dict:
         best = int(n[0])
         return {'order': 0, 'coefficients': [float(np.mean(valid))], 'n_star': best,
                 'optimal_range': [max(1, best - margin), best + margin], 'no_valid': no_valid}
-    coefficients = np.polyfit(n, np.asarray(valid, dtype=float), order)
-    grid = np.arange(first, last + 1)
-    best = int(grid[int(np.argmax(np.polyval(coefficients, grid)))])
+    coefficients, best = fit(n, np.asarray(valid, dtype=float), order, first, last)
+    best = int(best)
     return {'order': order, 'coefficients': coefficients.tolist(), 'n_star': best,
             'fit_max': float(np.polyval(coefficients, best)),
             'optimal_range': [max(1, best - margin), best + margin], 'no_valid': no_valid}
@@ -233,6 +243,13 @@ def fault_counts(rows: list[dict]) -> dict:
                          'fault': r['fault']} for r in flagged]}
 
 
+def left_out(rows: list[dict]) -> set[tuple[int, int]]:
+    """(group, iteration) of the iterations left out of the figures: those with a fault of
+    EXCLUDED."""
+    return {(r['group'], r['iteration']) for r in rows
+            if set(r['fault'].split('+')) & set(EXCLUDED)}
+
+
 def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: list[dict],
               earlier: dict | None = None, checks: list[dict] = ()) -> dict:
     """The metrics of one experiment from its rows of iterations.csv, picks.csv and checks.csv.
@@ -242,8 +259,7 @@ def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: li
     `faults`, and `physics` tells the health of all."""
     faults = fault_counts(rows)
     health = physics(rows)
-    faulted = {(r['group'], r['iteration']) for r in rows
-               if set(r['fault'].split('+')) & set(EXCLUDED)}
+    faulted = left_out(rows)
     rows = [r for r in rows if (r['group'], r['iteration']) not in faulted]
     picks = [p for p in picks if (p['group'], p['iteration']) not in faulted]
     if exp.type == BIN_STATIC:

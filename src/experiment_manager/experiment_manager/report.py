@@ -156,6 +156,24 @@ def _physics_health(summary: dict) -> list[str]:
                           '`iterations.csv`.']
 
 
+def _sampling(summary: dict) -> list[str]:
+    """With adaptive sampling: how many iterations each experiment took, and whether its
+    decision was settled or its iterations ran out."""
+    adaptive = [(exp_id, s['sampling']) for exp_id, s in summary['experiments'].items()
+                if 'sampling' in s]
+    if not adaptive:
+        return []
+    return ['', '## Sampling', '',
+            'Adaptive: each experiment ran in batches of iterations per group (bin, count) '
+            'until its decision was settled at 99.9 % confidence, at most the iterations of '
+            'its file; the figures and verdicts above come from the iterations that ran, at '
+            '95 %.', ''] + table(
+        ['experiment', 'iterations run', 'at most', 'batches', 'ended'],
+        [[f'`{exp_id}`', a['iterations_run'], a['most'], a['batches'],
+          'settled' if a['settled'] else 'at the most iterations, not settled']
+         for exp_id, a in adaptive])
+
+
 def _sizes(given: dict | None, lead: str) -> str:
     """The sizes an experiment file gave, as people read them ('body diameter 5 mm, ...'),
     after `lead`; '' for none. Keys ending in _mm carry the unit; a bare key is a part model's
@@ -187,6 +205,7 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
     lines += table(['option', 'verdict', 'why'],
                     [[v['option'], f'**{v["verdict"]}**', '; '.join(v['reasons'])]
                      for v in verdicts(summary)])
+    lines += _sampling(summary)
     statics = of_type(summary, 'bin_static')
     if statics:
         exp_id, s = statics[-1]

@@ -3,8 +3,10 @@ workers (backends), each iteration as soon as its experiment is ready, and hands
 iteration to the sink at once.
 
 An experiment is ready when the experiments it takes its bin or range from have finished (their
-metrics make its plan: plan.py); what one iteration does is procedures.py. A worker that is
-lost gives its iteration back to the queue and may come back (Backend.rejoin).
+metrics make its plan: plan.py); what one iteration does is procedures.py. With adaptive
+sampling an experiment's iterations are released a batch per group at a time, while its
+decision is not settled (sampling.py). A worker that is lost gives its iteration back to the
+queue and may come back (Backend.rejoin).
 """
 
 from collections.abc import Callable, Sequence
@@ -14,9 +16,9 @@ import threading
 import time
 from typing import Protocol
 
-from . import metrics
+from . import metrics, sampling
 from .backend import Backend, WorkerLost
-from .config import Experiment, ExperimentFile
+from .config import Experiment, ExperimentFile, GRIPPER_SWEEP
 from .estimate import Costs
 from .plan import count_iterations, experiment_iterations, plan, Unit
 from .procedures import run_unit
@@ -76,6 +78,10 @@ class Runner:
         self._rank: dict[tuple, tuple[int, int]] = {}   # key -> (experiment, plan position)
         self._ready: list[tuple[tuple[int, int], Unit]] = []    # a heap by rank
         self._left: dict[str, int] = {}                # planned experiment -> units unwritten
+        # adaptive sampling: experiment -> group -> its units not released yet, in order; and
+        # experiment -> batches released
+        self._unreleased: dict[str, dict[int, list[Unit]]] = {}
+        self._looks: dict[str, int] = {}
         self._waiting = list(file.experiments)         # not planned yet
         self._errors: list[BaseException] = []
         self.rejoined: list[int] = []     # indexes of the backends that came back, in order
@@ -139,27 +145,68 @@ class Runner:
                 self._waiting.remove(exp)
                 index = self.file.experiments.index(exp)
                 units = plan(self.file, exp, self._summary)
-                left = 0
                 for i, u in enumerate(units):
-                    key = u.key
-                    self._rank[key] = (index, i)
-                    if self.sink.is_done(*key):
-                        self._done += 1
-                    else:
-                        heapq.heappush(self._ready, ((index, i), u))
-                        left += 1
-                self._left[exp.id] = left
-                if not left:
-                    self._finish(exp)
+                    self._rank[u.key] = (index, i)
+                self._left[exp.id] = 0
+                if self.file.sampling.adaptive:
+                    self._unreleased[exp.id] = {g: [u for u in units if u.group == g]
+                                                for g in sampling.groups(exp)}
+                    self._looks[exp.id] = 0
+                    self._next_batch(exp, sampling.groups(exp))
+                else:
+                    self._queue(exp, units)
+                    if not self._left[exp.id]:
+                        self._finish(exp)
                 changed = True
+
+    def _queue(self, exp: Experiment, units: list[Unit]) -> None:
+        """Queue the units not written yet (a resumed run wrote some) (under the lock)."""
+        for u in units:
+            if self.sink.is_done(*u.key):
+                self._done += 1
+            else:
+                heapq.heappush(self._ready, (self._rank[u.key], u))
+                self._left[exp.id] += 1
+
+    def _next_batch(self, exp: Experiment, groups: list[int]) -> None:
+        """Release the next batch of an adaptive experiment's `groups`; while a batch was all
+        written already (a resumed run), look at the rows again; finish the experiment when its
+        decision is settled or its iterations are spent (under the lock)."""
+        unreleased, batch = self._unreleased[exp.id], self.file.sampling.batch
+        while True:
+            units = [u for g in groups for u in unreleased[g][:batch]]
+            for g in groups:
+                del unreleased[g][:batch]
+            if not units:
+                self._total -= sum(len(q) for q in unreleased.values())   # not needed
+                self._finish(exp)
+                return
+            self._looks[exp.id] += 1
+            self._queue(exp, units)
+            if self._left[exp.id]:
+                return
+            groups = self._unsettled(exp)
+
+    def _unsettled(self, exp: Experiment) -> list[int]:
+        """The groups of an adaptive experiment that need more iterations and have some."""
+        checks = self.sink.checks(exp.id) if exp.type == GRIPPER_SWEEP else []
+        return [g for g in sampling.unsettled(self.file, exp, self.sink.iterations(exp.id),
+                                              checks)
+                if self._unreleased[exp.id][g]]
 
     def _finish(self, exp: Experiment) -> None:
         """An experiment's last iteration is written: order the rows, summarise, release the
         experiments waiting for it (under the lock)."""
         self.sink.reorder(self._rank)
+        rows, checks = self.sink.iterations(exp.id), self.sink.checks(exp.id)
         self._summary[exp.id] = metrics.summarise(
-            self.file, exp, self.sink.iterations(exp.id), self.sink.picks(exp.id),
-            self._summary, self.sink.checks(exp.id))
+            self.file, exp, rows, self.sink.picks(exp.id), self._summary, checks)
+        if self.file.sampling.adaptive:
+            self._summary[exp.id]['sampling'] = {
+                'mode': self.file.sampling.mode, 'batch': self.file.sampling.batch,
+                'batches': self._looks[exp.id], 'iterations_run': len(rows),
+                'most': experiment_iterations(exp),
+                'settled': not sampling.unsettled(self.file, exp, rows, checks)}
         self.sink.write_summary(metrics.file_summary(self.file, self._ordered_summary()))
         self._release()
 
@@ -219,9 +266,14 @@ class Runner:
     def _written(self, u: Unit, record: Record) -> None:
         self.sink.write(record)
         self._done += 1
-        self._left[u.experiment.id] -= 1
-        if not self._left[u.experiment.id]:
-            self._finish(u.experiment)
+        exp = u.experiment
+        self._left[exp.id] -= 1
+        if self._left[exp.id]:
+            return
+        if self.file.sampling.adaptive:
+            self._next_batch(exp, self._unsettled(exp))
+        else:
+            self._finish(exp)
 
     def _report(self, exp: Experiment, phase: str) -> None:
         left = [(e, self._left[e.id]) for e in self.file.experiments if e.id in self._left]

@@ -128,7 +128,9 @@ def test_verdicts_rest_on_the_interval_of_the_rate_and_on_the_capacity(run_dir):
     _rates(s, 1, 1, 1)
     bin_verdict = verdicts.verdicts(s)[0]
     assert bin_verdict['verdict'] == NOT_FEASIBLE
-    assert bin_verdict['option'] == 'static bin 100 x 100 x 20 mm'
+    # the bin the emptying ran in, by its size in mm, as a person writes it
+    x, y, z = (f'{v:g}' for v in s['experiments']['emptying']['bin_mm'])
+    assert bin_verdict['option'] == f'static bin {x} x {y} x {z} mm'
     assert bin_verdict['reasons'][0] == ('the bin was filled with 30 parts, fewer than the 480 '
                                          'a refill interval needs')
     assert bin_verdict['reasons'][1].startswith('not enough iterations to decide')

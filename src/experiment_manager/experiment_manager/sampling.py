@@ -1,0 +1,147 @@
+"""Adaptive sampling: how many iterations an experiment needs before its decision is settled.
+
+With `sampling.mode: adaptive` an experiment's iterations run in batches of `sampling.batch`
+per group (bin, count of parts on the tray; one group otherwise), up to the file's
+`iterations`, which stay the most it may take. After each batch is written, the scheduler
+asks `unsettled` which groups still need one; when none does (or none has iterations left),
+the experiment stops. The
+iterations keep the keys and seeds of the fixed counts (plan.py), so an adaptive run is the
+first iterations of the fixed-count run of the same file, and its figures are computed from
+them exactly as the fixed counts' (metrics.py).
+
+What settles each decision, looked at after every batch:
+- bin_emptying, feeder_emptying: the success rate (bins emptied; runs emptied within the spill
+  limit) against requirements.success_rate, as the verdict reads it (verdicts.py): settled when
+  its exact interval lies wholly at or above the requirement, or wholly below it. An iteration
+  left out of the figures (a physics fault) settles it too: the verdict is NOT FEASIBLE then.
+- bin_static, a race: a bin leaves it when the interval of its mean container-free fraction lies
+  wholly below the interval of the leading bin's (the highest mean). The race ends with one bin
+  left (the best bin) or at the most iterations.
+- table_sweep: the optimum n* of the fit, bootstrapped (iterations resampled within each
+  count, BOOTSTRAP fits, a seed of the file's): settled when the interval of n* lies inside the
+  optimal range n* +- margin, so the feeder runs' range holds the optimum. Every count gets
+  each batch (the fit needs its whole curve).
+- gripper_sweep: the smallest gripper meeting min_valid (metrics.gripper_sweep): settled when,
+  in size order, every gripper before the first that meets is known not to meet (its interval
+  of valid parts per check lies below min_valid) and that one is known to meet (its interval's
+  low end at least min_valid), or every gripper is known not to meet.
+
+Looking again and again at the same growing sample and stopping at the first clear interval
+would make a 95 % interval wrong more often than 1 in 20. So a look before the last uses
+INTERIM_CONFIDENCE (99.9 %) intervals, and only the last look, at the most iterations, the 95 %
+ones every figure reports: the Haybittle-Peto rule of clinical trials (Haybittle 1971, Peto et
+al. 1976). With L looks the chance of a wrong early stop is at most L x 0.1 %.
+"""
+
+import numpy as np
+
+from . import metrics
+from .config import (
+    BIN_EMPTYING,
+    BIN_STATIC,
+    Experiment,
+    ExperimentFile,
+    FEEDER_EMPTYING,
+    GRIPPER_SWEEP,
+    TABLE_SWEEP,
+)
+
+INTERIM_CONFIDENCE = 0.999
+BOOTSTRAP = 4000        # fits of resampled iterations per look of a table_sweep
+
+
+def groups(exp: Experiment) -> list[int]:
+    """The groups of `exp`'s iterations (plan.Unit.group): its bins' indexes, its counts, or 0."""
+    if exp.type == BIN_STATIC:
+        return list(range(len(exp.bins)))
+    if exp.type == TABLE_SWEEP:
+        return list(exp.counts)
+    return [0]
+
+
+def unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict],
+              checks: list[dict] = ()) -> list[int]:
+    """The groups of `exp` that need more iterations for its decision, from `rows` (its
+    iterations written so far, any order) and `checks` (its rows of checks.csv, for a
+    gripper_sweep), at INTERIM_CONFIDENCE; [] when the decision is settled."""
+    rows = sorted(rows, key=lambda r: (r['group'], r['iteration']))
+    out = metrics.left_out(rows)
+    if out and exp.type in (BIN_EMPTYING, FEEDER_EMPTYING):
+        return []           # a left-out iteration makes the option NOT FEASIBLE: settled
+    kept = [r for r in rows if (r['group'], r['iteration']) not in out]
+    if exp.type == BIN_STATIC:
+        return _racing(exp, kept)
+    if exp.type == TABLE_SWEEP:
+        return [] if _optimum_settled(file, exp, kept) else groups(exp)
+    if exp.type == GRIPPER_SWEEP:
+        kept_keys = {(r['group'], r['iteration']) for r in kept}
+        return [] if _smallest_settled(exp, [c for c in checks if (c['group'], c['iteration'])
+                                             in kept_keys]) else groups(exp)
+    if exp.type == BIN_EMPTYING:
+        successes = sum(bool(r['emptied']) for r in kept)
+    else:
+        successes = sum(bool(r['emptied']) and r['spilled'] <= file.requirements.max_spilled
+                        for r in kept)
+    settled = rate_settled(successes, len(kept), file.requirements.success_rate)
+    return [] if settled else groups(exp)
+
+
+def rate_settled(successes: int, n: int, required: float,
+                 confidence: float = INTERIM_CONFIDENCE) -> bool:
+    """The rate's exact interval lies wholly at or above `required`, or wholly below it."""
+    if n == 0:
+        return False
+    low, high = metrics.rate_interval(successes, n, confidence)
+    return low >= required or high < required
+
+
+def _racing(exp: Experiment, rows: list[dict]) -> list[int]:
+    """The bins still in the race: every bin whose interval of the mean container-free
+    fraction reaches the leader's; all of them while any has fewer than two iterations."""
+    fractions = {g: [r['container_free'] / r['checked'] for r in rows
+                     if r['group'] == g and r['checked']] for g in groups(exp)}
+    intervals = {g: metrics.interval(v, INTERIM_CONFIDENCE) for g, v in fractions.items()}
+    if any(low is None for low, _ in intervals.values()):
+        return groups(exp)
+    leader = max(groups(exp), key=lambda g: (np.mean(fractions[g]), -g))
+    floor = intervals[leader][0]
+    racing = [g for g in groups(exp) if intervals[g][1] >= floor]
+    return racing if len(racing) > 1 else []
+
+
+def _optimum_settled(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> bool:
+    """The bootstrap interval of n* (INTERIM_CONFIDENCE) lies inside n* +- margin."""
+    by_count = [np.array([r['valid'] for r in rows if r['group'] == n], dtype=float)
+                for n in exp.counts]
+    if any(len(v) < 2 for v in by_count):
+        return False
+    counts = np.concatenate([np.full(len(v), n, dtype=float)
+                             for n, v in zip(exp.counts, by_count, strict=True)])
+    first, last = exp.counts[0], exp.counts[-1]
+    fitted = metrics.fit_optimum(counts, np.concatenate(by_count), first, last, exp.margin)
+    if fitted['order'] < 1:
+        return True         # one count: n* is that count
+    best = fitted['n_star']
+    # every column a resample of the iterations within each count
+    rng = np.random.default_rng([file.seed, len(rows)])
+    resampled = np.concatenate([v[rng.integers(0, len(v), (len(v), BOOTSTRAP))]
+                                for v in by_count])
+    _, stars = metrics.fit(counts, resampled, fitted['order'], first, last)
+    tail = (1.0 - INTERIM_CONFIDENCE) / 2.0
+    low, high = np.quantile(stars, [tail, 1.0 - tail])
+    return best - exp.margin <= low and high <= best + exp.margin
+
+
+def _smallest_settled(exp: Experiment, checks: list[dict]) -> bool:
+    """In size order: every gripper known not to meet min_valid up to one known to meet it,
+    or all known not to."""
+    for k in sorted(range(len(exp.variants)), key=lambda k: (exp.variants[k].size, k)):
+        low, high = metrics.interval([c['valid'] for c in checks if c['check'] == k],
+                                     INTERIM_CONFIDENCE, counts=True)
+        if low is None:
+            return False
+        if low >= exp.min_valid:
+            return True
+        if high >= exp.min_valid:
+            return False
+    return True

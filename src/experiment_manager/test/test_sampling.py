@@ -1,0 +1,166 @@
+"""Adaptive sampling: the rule that settles each experiment type's decision (on rows made up to
+the case), and a run that stops once it is settled, on the real cores."""
+
+from dataclasses import replace
+import json
+import os
+
+from experiment_manager import config, metrics, report, sampling
+from experiment_manager.cli import _summary_lines
+from experiment_manager.local_backend import LocalBackend
+from experiment_manager.results import read_text_rows, ResultsWriter
+from experiment_manager.scheduler import Runner
+from experiment_manager.verdicts import NOT_FEASIBLE, verdicts
+import numpy as np
+from pick_common.errors import InvalidArgument
+import pytest
+
+SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
+
+
+def small(**sampling_section) -> config.ExperimentFile:
+    text = open(SMALL).read()
+    if sampling_section:
+        text += f'sampling: {json.dumps(sampling_section)}\n'
+    return config.parse(text, SMALL)
+
+
+def row(group: int, i: int, **values) -> dict:
+    return {'group': group, 'iteration': i, 'fault': '', **values}
+
+
+def test_the_sampling_section_is_read_and_checked():
+    assert small().sampling == config.Sampling('fixed', 5)
+    assert small(mode='adaptive', batch=3).sampling.adaptive
+    with pytest.raises(InvalidArgument, match=r"sampling.mode.*'every'"):
+        small(mode='every')
+    with pytest.raises(InvalidArgument, match=r'sampling.batch'):
+        small(mode='adaptive', batch=0)
+    copy = config.parse(config.reduced(small(), None, adaptive=True), SMALL)
+    assert copy.sampling.adaptive and copy.experiments == small().experiments
+
+
+def test_a_rate_is_settled_once_its_99_9_percent_interval_clears_or_misses_the_requirement():
+    # 0 of 3: the interval reaches 0.92, above 0.9; 0 of 4 reaches 0.85 only.
+    assert not sampling.rate_settled(0, 3, 0.9)
+    assert sampling.rate_settled(0, 4, 0.9)
+    # Every iteration a success: at 99.9 % only 73 clear 0.9, where 36 do at 95 %.
+    assert not sampling.rate_settled(72, 72, 0.9) and sampling.rate_settled(73, 73, 0.9)
+    assert sampling.rate_settled(36, 36, 0.9, confidence=0.95)
+    assert not sampling.rate_settled(0, 0, 0.9)
+
+
+def test_feeder_runs_count_a_run_over_the_spill_limit_as_failed_and_a_fault_settles():
+    file = small()
+    exp = file.experiment('feeder')
+    emptied = [row(0, i, emptied=True, spilled=0) for i in range(73)]
+    assert sampling.unsettled(file, exp, emptied) == []
+    spilling = [dict(r, spilled=1) for r in emptied[:4]]
+    assert sampling.unsettled(file, exp, spilling) == []        # 0 of 4 within the limit
+    assert sampling.unsettled(file, exp, spilling[:3]) == [0]
+    # A tunnelled part leaves the run out and makes the option NOT FEASIBLE: settled.
+    tunnelled = [row(0, 0, emptied=True, spilled=0, fault='tunnelled')]
+    assert sampling.unsettled(file, exp, tunnelled) == []
+
+
+def test_bins_leave_the_race_when_they_are_clearly_behind_the_leader():
+    file = small()
+    exp = replace(file.experiment('bins'), bins=file.experiment('bins').bins * 2)  # 4 bins
+    rng = np.random.default_rng(0)
+
+    def rows(means, n):
+        return [row(g, i, checked=100, container_free=int(m + rng.integers(-2, 3)))
+                for g, m in enumerate(means) for i in range(n)]
+
+    assert sampling.unsettled(file, exp, rows([90, 89, 60, 30], 6)) == [0, 1]
+    assert sampling.unsettled(file, exp, rows([90, 50, 60, 30], 6)) == []   # one left: best
+    assert sampling.unsettled(file, exp, rows([90, 50, 60, 30], 1)) == [0, 1, 2, 3]
+
+
+def test_a_sweep_is_settled_when_the_optimum_s_interval_lies_inside_its_range():
+    file = small()
+    exp = replace(file.experiment('sweep'), counts=tuple(range(10, 101, 10)), margin=5)
+    rng = np.random.default_rng(1)
+
+    def rows(noise, n):
+        return [row(c, i, valid=max(0.0, 20 - (c - 50) ** 2 / 100 + rng.normal(0, noise)))
+                for c in exp.counts for i in range(n)]
+
+    assert sampling.unsettled(file, exp, rows(0.3, 10)) == []
+    assert sampling.unsettled(file, exp, rows(8.0, 3)) == list(exp.counts)
+    assert sampling.unsettled(file, exp, rows(0.3, 1)) == list(exp.counts)    # one each
+
+
+def test_a_gripper_sweep_is_settled_by_the_smallest_gripper_s_decision():
+    file = small()
+    exp = replace(file.experiment('grippers'), min_valid=2.0)   # 8 variants, 0 the smallest
+
+    def checks(per_variant, n=8):
+        return [{'group': 0, 'iteration': i, 'check': k, 'valid': v}
+                for k, v in enumerate(per_variant) for i in range(n)]
+
+    rows = [row(0, i) for i in range(8)]
+    # The smallest meets clearly: the rest do not matter.
+    assert sampling.unsettled(file, exp, rows, checks([30] + [0] * 7)) == []
+    # The smallest is near min_valid: not settled, whatever the others give.
+    assert sampling.unsettled(file, exp, rows, checks([2] + [30] * 7)) == [0]
+    # None meets, each clearly.
+    assert sampling.unsettled(file, exp, rows, checks([0] * 8)) == []
+
+
+def read(directory: str) -> list[dict]:
+    return read_text_rows(os.path.join(directory, 'iterations.csv'), drop=('wall_time',))
+
+
+# Feeder runs allowed one vibration cannot empty the feeder.
+HOPELESS = ('id: stop_early\nseed: 3\npart: {model: radial_capacitor}\n'
+            'gripper: {body_diameter_mm: 8, jaw_depth_mm: 3}\n'
+            'experiments:\n'
+            '  - {id: feeder, type: feeder_emptying, iterations: 6, parts: 12, '
+            'optimal_range: [4, 8], max_vibrations: 1}\n')
+
+
+def run(mode: str, directory: str, writer=ResultsWriter, resume: bool = False) -> dict:
+    file = config.parse(HOPELESS + f'sampling: {{mode: {mode}, batch: 2}}\n', SMALL)
+    with LocalBackend() as backend, writer(directory, file.text, resume) as sink:
+        return Runner(file, [backend], sink).run()
+
+
+def test_an_adaptive_run_stops_a_feeder_study_that_settled_and_keeps_the_fixed_counts_seeds(
+        tmp_path):
+    """0 of 4 settles the verdict (NOT FEASIBLE), so 4 of the 6 iterations run, in two
+    batches; they are the fixed run's first four, row for row."""
+    runs = {mode: (run(mode, str(tmp_path / mode)), read(str(tmp_path / mode)))
+            for mode in ('fixed', 'adaptive')}
+    summary, rows = runs['adaptive']
+    s = summary['experiments']['feeder']
+    assert s['sampling'] == {'mode': 'adaptive', 'batch': 2, 'batches': 2,
+                             'iterations_run': 4, 'most': 6, 'settled': True}
+    assert s['iterations'] == 4 and s['accepted'] == 0
+    assert rows == runs['fixed'][1][:4]
+    assert 'sampling' not in runs['fixed'][0]['experiments']['feeder']
+    assert verdicts(summary)[1]['verdict'] == NOT_FEASIBLE
+    assert metrics.rate_interval(0, 4)[1] < 0.9
+    # The terminal and the report say how many iterations ran and why they stopped.
+    assert '[adaptive: 4 of 6 iterations, settled]' in _summary_lines(summary)[0]
+    assert '| `feeder` | 4 | 6 | 2 | settled |' in report.markdown(summary, {}, {})
+    assert '## Sampling' not in report.markdown(runs['fixed'][0], {}, {})
+
+
+def test_an_interrupted_adaptive_run_resumes_to_the_same_batches_and_results(tmp_path):
+    class Interrupt(Exception):
+        pass
+
+    class StopAtTheThird(ResultsWriter):
+        def write(self, record):
+            if record.iteration['iteration'] == 2:      # the second batch's first
+                raise Interrupt
+            super().write(record)
+
+    whole = run('adaptive', str(tmp_path / 'whole'))
+    out = str(tmp_path / 'cut')
+    with pytest.raises(Interrupt):
+        run('adaptive', out, StopAtTheThird)
+    assert len(read(out)) == 2
+    assert run('adaptive', out, resume=True) == whole
+    assert read(out) == read(str(tmp_path / 'whole'))
