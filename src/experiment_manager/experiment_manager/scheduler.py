@@ -178,7 +178,8 @@ class Runner:
             for g in groups:
                 del unreleased[g][:batch]
             if not units:
-                self._total -= sum(len(q) for q in unreleased.values())   # not needed
+                self._total -= sum(map(len, unreleased.values()))     # not needed
+                unreleased.clear()
                 self._finish(exp)
                 return
             self._looks[exp.id] += 1
@@ -276,7 +277,10 @@ class Runner:
             self._finish(exp)
 
     def _report(self, exp: Experiment, phase: str) -> None:
-        left = [(e, self._left[e.id]) for e in self.file.experiments if e.id in self._left]
+        # an adaptive experiment's iterations not released yet count: the ETA is of the most
+        # it may take, as the total is
+        left = [(e, self._left[e.id] + sum(map(len, self._unreleased.get(e.id, {}).values())))
+                for e in self.file.experiments if e.id in self._left]
         left += [(e, experiment_iterations(e)) for e in self._waiting]
         eta = self._costs.left(left, len(self._live))
         self._progress(Progress(exp.id, exp.type, phase, self._done, self._total,

@@ -120,19 +120,23 @@ HOPELESS = ('id: stop_early\nseed: 3\npart: {model: radial_capacitor}\n'
             'optimal_range: [4, 8], max_vibrations: 1}\n')
 
 
-def run(mode: str, directory: str, writer=ResultsWriter, resume: bool = False) -> dict:
+def run(mode: str, directory: str, writer=ResultsWriter, resume: bool = False,
+        progress=None) -> dict:
     file = config.parse(HOPELESS + f'sampling: {{mode: {mode}, batch: 2}}\n', SMALL)
     with LocalBackend() as backend, writer(directory, file.text, resume) as sink:
-        return Runner(file, [backend], sink).run()
+        return Runner(file, [backend], sink, progress).run()
 
 
 def test_an_adaptive_run_stops_a_feeder_study_that_settled_and_keeps_the_fixed_counts_seeds(
         tmp_path):
     """0 of 4 settles the verdict (NOT FEASIBLE), so 4 of the 6 iterations run, in two
     batches; they are the fixed run's first four, row for row."""
-    runs = {mode: (run(mode, str(tmp_path / mode)), read(str(tmp_path / mode)))
-            for mode in ('fixed', 'adaptive')}
+    shown = []
+    runs = {mode: (run(mode, str(tmp_path / mode), progress=shown.append),
+                   read(str(tmp_path / mode))) for mode in ('fixed', 'adaptive')}
     summary, rows = runs['adaptive']
+    # the progress line ends full: the iterations not needed leave its total
+    assert (shown[-1].done, shown[-1].total, shown[-1].eta) == (4, 4, 0)
     s = summary['experiments']['feeder']
     assert s['sampling'] == {'mode': 'adaptive', 'batch': 2, 'batches': 2,
                              'iterations_run': 4, 'most': 6, 'settled': True}
