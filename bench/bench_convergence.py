@@ -47,7 +47,11 @@ SETTINGS = {
     'warm-1': replace(DEFAULT, warm_starting_factor=1.0),   # the default of 2026-11-23 to -25
     # the defaults before issue 20's convergence study: 30 iterations, pybullet's warm start
     '30-it': replace(DEFAULT, solver_iterations=30, warm_starting_factor=0.1),
+    # the parts' rolling and spinning friction arms until 2026-11-25 (PART below)
+    'arms-1mm': DEFAULT,
 }
+# the part's changes of a setting (keys of an experiment file's part section)
+PART = {'arms-1mm': {'rolling_friction_mm': 1.0, 'spinning_friction_mm': 1.0}}
 FINEST = 'dt/4'         # the reference the others are marked against
 WORKLOADS = {
     'sweep': ('pth0.yaml', lambda n: [{'id': 'sweep', 'type': 'table_sweep', 'iterations': n,
@@ -97,7 +101,8 @@ GRIPPER = {'body_diameter_mm': 8, 'body_length_mm': 60, 'jaw_height_mm': 15, 'ja
 def job(args: tuple[str, str, int]) -> tuple[str, str, list[dict]]:
     setting, workload, seeds = args
     part_file, experiments, _ = WORKLOADS[workload]
-    rows, _ = run_on_cores(part_file, experiments(seeds), SETTINGS[setting], gripper=GRIPPER)
+    rows, _ = run_on_cores(part_file, experiments(seeds), SETTINGS[setting], gripper=GRIPPER,
+                           part=PART.get(setting))
     return setting, workload, rows
 
 

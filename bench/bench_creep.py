@@ -1,10 +1,12 @@
-"""Does a settled pile stay put? Drop TO-220s (PTH1's part) into a bin, settle (a cap, 5 s), then
-step one more second and count the parts that move more than the settle tolerance (0.5 mm),
-at the defaults and under settings that could be the cause of the creep (most of them on
-the former defaults, where the creep was found).
+"""Does a settled pile stay put? Drop a test-case part (TO-220s, PTH1's, by default) into a bin,
+settle (a cap, 5 s), then step one more second and count the parts that move more than the
+settle tolerance (0.5 mm), at the defaults and under settings that could be the cause of the
+creep (most of them on the former defaults, where the creep was found; the 'former' settings
+keep that day's 1 mm rolling and spinning friction arms, the others take today's, 0.1 mm,
+unless they change them: ARMS).
 
     tools/ws python bench/bench_creep.py [--parts 150] [--bin 75x75x60] [--seed 0] [--cap 5]
-        [--settings default,former,...] [--seconds 1]
+        [--part pth1] [--settings default,former,...] [--seconds 1]
 
 Prints per setting: settled or not (and when), wall time, parts still moving at the end, the
 deepest penetration, and over the further second the parts that moved > 0.5 mm, the median
@@ -28,8 +30,8 @@ from pick_sim_world.config import GRAVITY, PhysicsConfig
 from pick_sim_world.world import World
 import pybullet as pb
 
-PTH1 = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src',
-                    'experiment_manager', 'config', 'test_case', 'pth1.yaml')
+TEST_CASE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src',
+                         'experiment_manager', 'config', 'test_case')
 # The defaults before issue 20's convergence study: 30 iterations, pybullet's warm start 0.1
 # and step of 1/240 s.
 # The probes for the cause of the creep ran on them first (world README, "Piles that rest").
@@ -68,16 +70,34 @@ SETTINGS = {
     # (m_splitImpulsePenetrationThreshold): at our scale, always by Baumgarte velocity.
     'split-all': ({}, {'splitImpulsePenetrationThreshold': 0.0}),
     'contact-erp-0.05': ({}, {'contactERP': 0.05}),
+    # the parts' rolling and spinning friction arms (issue 20's cause of the creep): the
+    # defaults until 2026-11-25 (1 mm each), one of them at a time, and other arms
+    'former-arms-1mm': ({}, {}),
+    'rolling-1mm': ({}, {}), 'spinning-1mm': ({}, {}),
+    'rolling-0': ({}, {}), 'rolling-0.2mm': ({}, {}), 'rolling-0.5mm': ({}, {}),
+    'arms-0.01mm': ({}, {}),
+    'damped': ({}, {}),             # Bullet's damping 0.04 -> 0.1, linear and angular
 }
+# The parts' rolling and spinning friction arms, m, where a setting changes them. The 'former'
+# settings keep the arms of their day (1 mm each), so that their figures stand.
+FORMER_ARMS = (1e-3, 1e-3)
+ARMS = {'former-arms-1mm': FORMER_ARMS, 'rolling-1mm': (1e-3, None),
+        'spinning-1mm': (None, 1e-3), 'rolling-0': (0.0, None), 'rolling-0.2mm': (2e-4, None),
+        'rolling-0.5mm': (5e-4, None), 'arms-0.01mm': (1e-5, 1e-5)}
 # name: changeDynamics arguments for every part body, after the world creates it
 PART_DYNAMICS = {
     'former-friction-anchor': {'frictionAnchor': 1},
+    'damped': {'linearDamping': 0.1, 'angularDamping': 0.1},
 }
 
 
 def creep(name: str, parts: int, size: tuple[float, float, float], seed: int, cap: float,
-          physics: dict, engine: dict, seconds: int = 1) -> str:
-    part = load(PTH1).part
+          physics: dict, engine: dict, seconds: int = 1, case: str = 'pth1') -> str:
+    part = load(os.path.join(TEST_CASE, f'{case}.yaml')).part
+    rolling, spinning = ARMS.get(name, FORMER_ARMS if name.startswith('former') else
+                                 (None, None))
+    part = replace(part, rolling_friction=part.rolling_friction if rolling is None else rolling,
+                   spinning_friction=part.spinning_friction if spinning is None else spinning)
     spec = ContainerSpec(inner_size=size, wall_thickness=0.003)
     scale = 1.0
     if name.endswith('friction-0.5'):
@@ -136,16 +156,20 @@ def main() -> None:
     parser.add_argument('--parts', type=int, default=150)
     parser.add_argument('--bin', default='75x75x60', help='inner size, mm')
     parser.add_argument('--seed', type=int, default=0)
+    parser.add_argument('--part', default='pth1', choices=('pth0', 'pth1', 'pth2'),
+                        help='the test-case file whose part is dropped (pth1: TO-220s)')
     parser.add_argument('--cap', type=float, default=5.0, help='settle cap, s')
     parser.add_argument('--settings', default=','.join(SETTINGS))
     parser.add_argument('--seconds', type=int, default=1,
                         help='further seconds, each counted apart (median and max: over all)')
     args = parser.parse_args()
     size = tuple(float(x) / 1000 for x in args.bin.split('x'))
-    print(f'{args.parts} TO-220s into a {args.bin} mm bin, seed {args.seed}', flush=True)
+    print(f'{args.parts} parts of {args.part} into a {args.bin} mm bin, seed {args.seed}',
+          flush=True)
     for name in args.settings.split(','):
         physics, engine = SETTINGS[name]
-        line = creep(name, args.parts, size, args.seed, args.cap, physics, engine, args.seconds)
+        line = creep(name, args.parts, size, args.seed, args.cap, physics, engine, args.seconds,
+                     args.part)
         print(f'{name:18s} {line}', flush=True)
 
 

@@ -22,13 +22,16 @@ TEST_CASE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src'
                          'experiment_manager', 'config', 'test_case')
 
 
-def variant(part_file: str, experiments: list[dict], **sections) -> config.ExperimentFile:
-    """TEST_CASE/`part_file` with its experiments replaced by `experiments` and its top-level
-    `sections` (e.g. vibration, gripper) by the ones given, parsed."""
+def variant(part_file: str, experiments: list[dict], part: dict | None = None,
+            **sections) -> config.ExperimentFile:
+    """TEST_CASE/`part_file` with its experiments replaced by `experiments`, its top-level
+    `sections` (e.g. vibration, gripper) by the ones given, and the keys of its part section
+    in `part` changed, parsed."""
     path = os.path.join(TEST_CASE, part_file)
     with open(path, encoding='utf-8') as f:
         data = yaml.safe_load(f)
     data.update(sections, experiments=experiments)
+    data['part'].update(part or {})
     return config.parse(yaml.safe_dump(data), path)
 
 

@@ -312,8 +312,10 @@ def _part(m: _Map, base_dir: str) -> tuple[PartSpec, tuple[GraspPose, ...], Plac
     spec = PartSpec(
         model=model, dimensions=dimensions, mass=mass or None,
         lateral_friction=m.number('lateral_friction', 0.5, low=0.0, high=10.0),
-        rolling_friction=m.number('rolling_friction_mm', 1.0, low=0.0, high=100.0, scale=MM),
-        spinning_friction=m.number('spinning_friction_mm', 1.0, low=0.0, high=100.0, scale=MM),
+        rolling_friction=m.number('rolling_friction_mm', PartSpec.rolling_friction / MM,
+                                  low=0.0, high=100.0, scale=MM),
+        spinning_friction=m.number('spinning_friction_mm', PartSpec.spinning_friction / MM,
+                                   low=0.0, high=100.0, scale=MM),
         restitution=m.number('restitution', 0.0, low=0.0, high=1.0),
         mesh_path=mesh, scale=m.number('mesh_scale', 1.0, low=0.0, high=1000.0, low_open=True))
     place_map = m.sub('place')

@@ -48,8 +48,8 @@ class PartSpec:
     dimensions: Mapping[str, float] = field(default_factory=dict)
     mass: float | None = None
     lateral_friction: float = 0.5
-    rolling_friction: float = 0.001
-    spinning_friction: float = 0.001
+    rolling_friction: float = 0.0001
+    spinning_friction: float = 0.0001
     restitution: float = 0.0
     mesh_path: str = ''
     scale: float = 1.0
