@@ -61,10 +61,18 @@ class Unit:
         return f'iteration {self.iteration + 1}/{self.experiment.iterations}'
 
 
+def groups(exp: Experiment) -> list[int]:
+    """The groups of `exp`'s iterations (Unit.group): its bins' indexes, its counts, or 0."""
+    if exp.type == BIN_STATIC:
+        return list(range(len(exp.bins)))
+    if exp.type == TABLE_SWEEP:
+        return list(exp.counts)
+    return [0]
+
+
 def experiment_iterations(exp: Experiment) -> int:
     """The iterations of `exp`: its iterations per bin (bin_static) or per n (table_sweep)."""
-    groups = len(exp.bins) if exp.type == BIN_STATIC else len(exp.counts) or 1
-    return groups * exp.iterations
+    return len(groups(exp)) * exp.iterations
 
 
 def count_iterations(file: ExperimentFile) -> int:

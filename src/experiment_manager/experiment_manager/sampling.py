@@ -45,18 +45,10 @@ from .config import (
     GRIPPER_SWEEP,
     TABLE_SWEEP,
 )
+from .plan import groups
 
 INTERIM_CONFIDENCE = 0.999
 BOOTSTRAP = 4000        # fits of resampled iterations per look of a table_sweep
-
-
-def groups(exp: Experiment) -> list[int]:
-    """The groups of `exp`'s iterations (plan.Unit.group): its bins' indexes, its counts, or 0."""
-    if exp.type == BIN_STATIC:
-        return list(range(len(exp.bins)))
-    if exp.type == TABLE_SWEEP:
-        return list(exp.counts)
-    return [0]
 
 
 def unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict],

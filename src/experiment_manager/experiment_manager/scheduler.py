@@ -149,10 +149,12 @@ class Runner:
                     self._rank[u.key] = (index, i)
                 self._left[exp.id] = 0
                 if self.file.sampling.adaptive:
-                    self._unreleased[exp.id] = {g: [u for u in units if u.group == g]
-                                                for g in sampling.groups(exp)}
+                    unreleased: dict[int, list[Unit]] = {}
+                    for u in units:
+                        unreleased.setdefault(u.group, []).append(u)
+                    self._unreleased[exp.id] = unreleased
                     self._looks[exp.id] = 0
-                    self._next_batch(exp, sampling.groups(exp))
+                    self._next_batch(exp, list(unreleased))
                 else:
                     self._queue(exp, units)
                     if not self._left[exp.id]:
