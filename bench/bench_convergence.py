@@ -11,6 +11,8 @@ every one with the D 8, W 3 mm gripper, GRIPPER below):
 - bins: 480 TO-220s (PTH1) into the test case's biggest and tallest bins, 300 x 300 x 26 and
   200 x 75 x 158 mm: the container-free fraction, parts left moving at the settle's end
   (flat-bin, tall-bin: one alone, for more seeds where the intervals are close);
+- emptying: 480 TO-220s into the 300 x 300 x 26 mm bin, picked until no part is valid: parts
+  removed per bin (the settle after each pick is where freezing acts most);
 - the other parts, to tell a part's effect from a pile's: sweep-pth1 and sweep-pth2 (TO-220s
   and the 8 mm capacitors on the tray at 20, 40 and 60 parts), flat-bin-pth2 (480 capacitors
   into PTH2's 300 x 300 x 22 mm bin); bins also report the candidates' fraction;
@@ -49,6 +51,9 @@ SETTINGS = {
     '30-it': replace(DEFAULT, solver_iterations=30, warm_starting_factor=0.1),
     # the parts' rolling and spinning friction arms until 2026-11-25 (PART below)
     'arms-1mm': DEFAULT,
+    # every part stepped to the end of every settle: the default until 2026-11-26
+    'no-freeze': replace(DEFAULT, settle_freeze=False),
+    'dt/2-no-freeze': replace(DEFAULT, time_step=DEFAULT.time_step / 2, settle_freeze=False),
 }
 # the part's changes of a setting (keys of an experiment file's part section)
 PART = {'arms-1mm': {'rolling_friction_mm': 1.0, 'spinning_friction_mm': 1.0}}
@@ -74,6 +79,10 @@ WORKLOADS = {
                                           'parts': 480, 'bins_mm': [[200, 75, 158]]}],
                  ('candidates', 'container_free', 'unsettled', 'tunnelled', 'max_penetration',
                   'wall_time')),
+    'emptying': ('pth1.yaml', lambda n: [{'id': 'emptying', 'type': 'bin_emptying',
+                                          'iterations': n, 'parts': 480,
+                                          'bin': [300, 300, 26]}],
+                 ('picks', 'unsettled', 'tunnelled', 'max_penetration', 'wall_time')),
     # the other parts: is the step's effect the part's or the pile's?
     'flat-bin-pth2': ('pth2.yaml', lambda n: [{'id': 'bins', 'type': 'bin_static',
                                                'iterations': n, 'parts': 480,

@@ -101,6 +101,12 @@ class PartStates:
                           self.inside[mask], self.sim_time)
 
 
+def quaternion_angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Rotation angle between quaternion pairs (n, 4) and (n, 4) xyzw, rad."""
+    dot = np.abs(np.einsum('ij,ij->i', a, b))
+    return 2.0 * np.arccos(np.clip(dot, 0.0, 1.0))
+
+
 def rotate(quaternions: np.ndarray, vector: np.ndarray) -> np.ndarray:
     """Rotate one vector (3,) by each quaternion (n, 4) xyzw; returns (n, 3)."""
     xyz, w = quaternions[:, :3], quaternions[:, 3:4]

@@ -7,7 +7,7 @@ and vibration specs every package shares are pick_common.specs.
 
 from dataclasses import dataclass
 
-from pick_common.errors import Limit
+from pick_common.errors import InvalidArgument, Limit
 
 GRAVITY = 9.81                  # m/s^2, standard gravity
 
@@ -48,6 +48,10 @@ class PhysicsConfig:
     the scene is settled when at most `settle_moving_fraction` of its parts (rounded down) do
     not rest: 0 waits for every part. Checked every `settle_check_period` s of simulated time.
     `max_settle_time`: the cap on simulated time, s, reported when hit.
+    settle_freeze: while a settle runs, freeze the parts that rest (static until a moving part
+    comes near; freezing.py): a settle costs a fraction of the steps' time, with answers inside
+    the converged intervals (docs/physics.md, "Freezing rested parts"). False steps every part
+    to the end.
     """
 
     time_step: float = 1.0 / 480.0
@@ -60,6 +64,7 @@ class PhysicsConfig:
     settle_angular_tolerance: float = 0.035
     settle_moving_fraction: float = 0.02
     max_settle_time: float = 10.0
+    settle_freeze: bool = True
 
 
 def check_physics(cfg: PhysicsConfig) -> PhysicsConfig:
@@ -77,4 +82,6 @@ def check_physics(cfg: PhysicsConfig) -> PhysicsConfig:
     check('settle.angular_tolerance', cfg.settle_angular_tolerance)
     check('settle.moving_fraction', cfg.settle_moving_fraction)
     check('settle.max_time', cfg.max_settle_time, cfg.settle_window)
+    if not isinstance(cfg.settle_freeze, bool):
+        raise InvalidArgument('settle.freeze', cfg.settle_freeze, 'must be true or false')
     return cfg

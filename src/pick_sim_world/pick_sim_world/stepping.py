@@ -3,7 +3,8 @@
 A part rests when, over the settle window, its position changed by at most the linear tolerance
 and its orientation by at most the angular tolerance; the scene is settled when at most the
 moving fraction of its parts do not rest. Bullet's sleeping is not used for this: it does not
-trigger for a jittering pile.
+trigger for a jittering pile, and it wakes a whole touching group at once. Parts that rest may
+be frozen instead (freezing.py), which this loop does when given a Freezer.
 """
 
 from collections import deque
@@ -14,11 +15,12 @@ import time
 
 import numpy as np
 from pick_common.errors import PhysicsFault
-from pick_common.states import Progress
+from pick_common.states import Progress, quaternion_angles
 import pybullet as pb
 
 from .bodies import base_poses
 from .config import PhysicsConfig
+from .freezing import Freezer
 
 ProgressCallback = Callable[[Progress], bool]
 
@@ -38,12 +40,6 @@ class Outcome:
     peak_speeds: list[float]
 
 
-def quaternion_angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Rotation angle between quaternion pairs (n, 4) and (n, 4), rad."""
-    dot = np.abs(np.einsum('ij,ij->i', a, b))
-    return 2.0 * np.arccos(np.clip(dot, 0.0, 1.0))
-
-
 def raise_peak_speeds(client: int, bodies: Sequence[int], floor: float,
                       peaks: list[float]) -> None:
     """Raise peaks[i] to body i's linear speed (m/s, of its centre of mass) where that is
@@ -60,10 +56,12 @@ def raise_peak_speeds(client: int, bodies: Sequence[int], floor: float,
 def step(client: int, ids: Sequence[int], bodies: Sequence[int], cfg: PhysicsConfig,
          phase: str, duration: float, progress: ProgressCallback | None,
          before_step: Callable[[], None] | None = None,
-         stop_when_settled: bool = True, floor: float = 0.0) -> Outcome:
+         stop_when_settled: bool = True, floor: float = 0.0,
+         freezer: Freezer | None = None) -> Outcome:
     """Step for up to `duration` s of simulated time, checking rest every check period; the
     parts are `ids` with their `bodies`. progress() is called once per check and cancels by
-    returning False. Every part's speed is read after every step (a solver blow-up lasts a
+    returning False. With a `freezer`, it freezes and wakes parts at every check
+    (Freezer.check). Every part's speed is read after every step (a solver blow-up lasts a
     step or two: a check period would miss it). Raises PhysicsFault naming the parts whose
     poses became non-finite."""
     dt = cfg.time_step
@@ -74,8 +72,10 @@ def step(client: int, ids: Sequence[int], bodies: Sequence[int], cfg: PhysicsCon
     tolerated = int(cfg.settle_moving_fraction * len(ids))
     history: deque[np.ndarray] = deque(maxlen=window + 1)
     history.append(base_poses(client, bodies))
+    if freezer is not None:
+        freezer.check(bodies, history[0], 0.0)     # where the parts start from
     start = time.perf_counter()
-    steps = 0
+    steps = checked = 0
     moving = np.ones(len(ids), dtype=bool)
     peaks = [0.0] * len(ids)
     settled = canceled = False
@@ -105,6 +105,9 @@ def step(client: int, ids: Sequence[int], bodies: Sequence[int], cfg: PhysicsCon
         if stop_when_settled and full and moving.sum() <= tolerated:
             settled = True
             break
+        if freezer is not None:
+            freezer.check(bodies, poses, (steps - checked) * dt)
+            checked = steps
     wall = time.perf_counter() - start
     return Outcome(settled, canceled, steps, wall, [ids[i] for i in np.flatnonzero(moving)],
                    peaks)

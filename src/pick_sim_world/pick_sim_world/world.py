@@ -11,6 +11,7 @@ instance frame (origin at the centre of the container's inner floor, +Z up).
 """
 
 from collections.abc import Iterable, Sequence
+from contextlib import nullcontext
 from dataclasses import dataclass, field, replace
 import math
 import os
@@ -42,6 +43,7 @@ import pybullet as pb
 from . import bodies, camera, spawning, stepping
 from .camera import Overlay
 from .config import check_physics, GRAVITY, PhysicsConfig
+from .freezing import Freezer
 from .stepping import ProgressCallback
 from .tray import TrayDrive, vibration_amplitude, vibration_substeps
 
@@ -247,20 +249,23 @@ class World:
         left = dict.fromkeys(targets, count)
         new_ids: list[int] = []
         stream: list[SettleReport] = []
-        while True:
-            for k in targets:
-                n = min(per_layer[k], left[k])
-                if n:
-                    new_ids += self._add_parts(self._instances[k], self.spawn_poses(k, n, zone))
-                    left[k] -= n
-            if not any(left.values()):
-                break
-            stream.append(self._run('dropping', spawning.layer_interval(self._part), progress,
-                                    stop_when_settled=False))
-            if stream[-1].canceled:
-                return new_ids, self._finished(stream[-1], stream[:-1])
-        return new_ids, self._finished(self._settle('dropping', max_settle_time, progress),
-                                       stream)
+        with self._freezer() as freezer:     # parts that landed rest while the next fall
+            while True:
+                for k in targets:
+                    n = min(per_layer[k], left[k])
+                    if n:
+                        new_ids += self._add_parts(self._instances[k],
+                                                   self.spawn_poses(k, n, zone))
+                        left[k] -= n
+                if not any(left.values()):
+                    break
+                stream.append(self._run('dropping', spawning.layer_interval(self._part),
+                                        progress, stop_when_settled=False, freezer=freezer))
+                if stream[-1].canceled:
+                    break
+            if not stream or not stream[-1].canceled:
+                stream.append(self._settle('dropping', max_settle_time, progress, freezer))
+        return new_ids, self._finished(stream[-1], stream[:-1])
 
     def _add_parts(self, inst: Instance, poses: np.ndarray) -> list[int]:
         ids = []
@@ -315,7 +320,9 @@ class World:
         report.tray = delivered
         if report.canceled:
             return self._finished(report)
-        settle = self._finished(self._settle('settling', max_settle_time, progress), [report])
+        with self._freezer() as freezer:
+            settle = self._settle('settling', max_settle_time, progress, freezer)
+        settle = self._finished(settle, [report])
         settle.tray = delivered
         return settle
 
@@ -339,13 +346,35 @@ class World:
         if not ids:
             raise InvalidArgument('part_ids', [], 'is empty: name at least one part')
         touched = self._touch_other_parts(ids)
+        # From a scene at rest, only the parts near the removed ones settle at first: the rest
+        # start frozen, and wake when a moving part comes near (freezing.py).
+        near = self._parts_near(ids) if self._at_rest and self._physics.settle_freeze else None
         for pid in ids:
             pb.removeBody(self._bodies.pop(pid), physicsClientId=self._client)
             self._instances[self._owner.pop(pid)].part_ids.remove(pid)
         if settle and (touched or not self._at_rest):
-            return ids, self._finished(self._settle('settling', max_settle_time, progress))
+            with self._freezer() as freezer:
+                if freezer is not None and near is not None:
+                    freezer.freeze(body for pid, body in self._bodies.items()
+                                   if pid not in near)
+                report = self._settle('settling', max_settle_time, progress, freezer)
+            return ids, self._finished(report)
         self._at_rest = self._at_rest and not touched
         return ids, self._finished(SettleReport(True, 0.0, 0.0, 0))
+
+    def _parts_near(self, ids: list[int]) -> set[int]:
+        """The parts not in `ids` whose bounding boxes come within a part's length (its
+        enclosing diameter) of the bounding box of a part of `ids`."""
+        c, reach = self._client, 2.0 * self._part.radius
+        part_of = {body: pid for pid, body in self._bodies.items()}
+        near = set()
+        for pid in ids:
+            low, high = pb.getAABB(self._bodies[pid], physicsClientId=c)
+            overlapping = pb.getOverlappingObjects(np.subtract(low, reach).tolist(),
+                                                   np.add(high, reach).tolist(),
+                                                   physicsClientId=c)
+            near.update(part_of[body] for body, _ in overlapping or () if body in part_of)
+        return near - set(ids)
 
     def _touch_other_parts(self, ids: list[int]) -> bool:
         """Whether a part of `ids` touches (is within the contact-breaking threshold of) a part
@@ -363,13 +392,26 @@ class World:
     def settle(self, max_settle_time: float | None = None,
                progress: ProgressCallback | None = None) -> SettleReport:
         """Step until every part rests or the time cap is hit."""
-        return self._finished(self._settle('settling', max_settle_time, progress))
+        with self._freezer() as freezer:
+            report = self._settle('settling', max_settle_time, progress, freezer)
+        return self._finished(report)
 
     def _settle(self, phase: str, max_settle_time: float | None,
-                progress: ProgressCallback | None) -> SettleReport:
+                progress: ProgressCallback | None, freezer: Freezer | None) -> SettleReport:
         cap = self._physics.max_settle_time if not max_settle_time else check_number(
             'max_settle_time', max_settle_time, low=self._physics.settle_window, high=600.0)
-        return self._run(phase, cap, progress)
+        return self._run(phase, cap, progress, freezer=freezer)
+
+    def _freezer(self) -> Freezer | nullcontext:
+        """What holds the parts that rest frozen through one operation's falls and settles
+        (freezing.py; the trays static meanwhile): a Freezer, or with `settle_freeze` off a
+        context of None."""
+        p = self._physics
+        if not p.settle_freeze:
+            return nullcontext()
+        trays = [inst.body for inst in self._instances] if self._drive is not None else []
+        return Freezer(self._client, trays, p.settle_linear_tolerance,
+                       p.settle_angular_tolerance, p.settle_window)
 
     def _centres(self, state: PartStates) -> np.ndarray:
         """Centres (N, 3) of the parts' bounding boxes in their instance frames, m."""
@@ -398,10 +440,12 @@ class World:
         return last
 
     def _run(self, phase: str, duration: float, progress: ProgressCallback | None,
-             stop_when_settled: bool = True, time_step: float | None = None) -> SettleReport:
+             stop_when_settled: bool = True, time_step: float | None = None,
+             freezer: Freezer | None = None) -> SettleReport:
         """Step every part of the scene for up to `duration` s (stepping.step) at `time_step`
-        (the physics step when None); a fault resets the scene before it is raised. The report
-        has no health yet: an operation made of several runs gets it once (`_finished`)."""
+        (the physics step when None), freezing and waking parts with `freezer`. A fault
+        resets the scene before it is raised. The report has no health yet: an operation made
+        of several runs gets it once (`_finished`)."""
         ids = [pid for inst in self._instances for pid in inst.part_ids]
         physics = self._physics
         if time_step is not None and time_step != physics.time_step:
@@ -411,8 +455,10 @@ class World:
         try:
             out = stepping.step(c, ids, [self._bodies[i] for i in ids], physics, phase,
                                 duration, progress, self._drive, stop_when_settled,
-                                floor=-self._scene.container.floor_thickness)
+                                floor=-self._scene.container.floor_thickness, freezer=freezer)
         except PhysicsFault:
+            if freezer is not None:
+                freezer.abandon()
             self._build(self._scene, self._part)
             raise
         finally:

@@ -169,7 +169,10 @@ class WorldNode(Node):
                                            'largest fraction of parts still moving when '
                                            'settled'),
             max_settle_time=setting('settle.max_time', cfg.max_settle_time,
-                                    'cap on simulated settle time, s'))
+                                    'cap on simulated settle time, s'),
+            settle_freeze=get('settle.freeze', cfg.settle_freeze,
+                              'freeze parts that rest while a settle runs (false: step every '
+                              'part to the end)'))
         vib = Vibration()
         vibration = Vibration(
             amplitude=tuple(get('vibration.amplitude', list(vib.amplitude),

@@ -10,10 +10,9 @@ from pick_common.containers import ContainerSpec
 from pick_common.errors import InvalidArgument, PhysicsFault, UnknownInstance, UnknownPart
 from pick_common.parts import BUILTIN_MODELS, PartSpec
 from pick_common.specs import FIXED, RANDOM, SceneSpec, Vibration
-from pick_common.states import rotate
+from pick_common.states import quaternion_angles, rotate
 from pick_sim_world import spawning
 from pick_sim_world.config import PhysicsConfig
-from pick_sim_world.stepping import quaternion_angles
 from pick_sim_world.tray import vibration_amplitude
 from pick_sim_world.world import speed_limit, World
 import pybullet as pb
