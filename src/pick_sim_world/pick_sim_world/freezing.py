@@ -97,6 +97,10 @@ class Freezer:
             self.frozen.discard(body)
             self._since.pop(body, None)      # anchored afresh at the next check
 
+    def thawed(self, bodies: Sequence[int]) -> list[int]:
+        """The indices into `bodies` of those not frozen."""
+        return [i for i, b in enumerate(bodies) if b not in self.frozen]
+
     def check(self, bodies: Sequence[int], poses: np.ndarray, elapsed: float) -> None:
         """At a rest check, `elapsed` s after the last (poses (N, 7) of `bodies`, world frame):
         wake the frozen parts within reach of a part that moved more than the tolerance since

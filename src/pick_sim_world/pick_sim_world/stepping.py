@@ -41,12 +41,14 @@ class Outcome:
 
 
 def raise_peak_speeds(client: int, bodies: Sequence[int], floor: float,
-                      peaks: list[float]) -> None:
+                      peaks: list[float], indices: Sequence[int]) -> None:
     """Raise peaks[i] to body i's linear speed (m/s, of its centre of mass) where that is
-    higher and the body's origin is at or above `floor` (world z, m): a part falling beside or
-    under its container gains speed without end (the world has no ground). The position is
-    read only for a speed that would raise the peak, which most steps' speeds do not."""
-    for i, b in enumerate(bodies):
+    higher and the body's origin is at or above `floor` (world z, m), for each i of `indices`
+    (a frozen part does not move): a part falling beside or under its container gains speed
+    without end (the world has no ground). The position is read only for a speed that would
+    raise the peak, which most steps' speeds do not."""
+    for i in indices:
+        b = bodies[i]
         speed = math.hypot(*pb.getBaseVelocity(b, physicsClientId=client)[0])
         if speed > peaks[i] and \
                 pb.getBasePositionAndOrientation(b, physicsClientId=client)[0][2] >= floor:
@@ -72,8 +74,10 @@ def step(client: int, ids: Sequence[int], bodies: Sequence[int], cfg: PhysicsCon
     tolerated = int(cfg.settle_moving_fraction * len(ids))
     history: deque[np.ndarray] = deque(maxlen=window + 1)
     history.append(base_poses(client, bodies))
+    awake = range(len(bodies))     # indices of the bodies not frozen
     if freezer is not None:
         freezer.check(bodies, history[0], 0.0)     # where the parts start from
+        awake = freezer.thawed(bodies)
     start = time.perf_counter()
     steps = checked = 0
     moving = np.ones(len(ids), dtype=bool)
@@ -85,7 +89,7 @@ def step(client: int, ids: Sequence[int], bodies: Sequence[int], cfg: PhysicsCon
                 before_step()
             pb.stepSimulation(physicsClientId=client)
             steps += 1
-            raise_peak_speeds(client, bodies, floor, peaks)
+            raise_peak_speeds(client, bodies, floor, peaks, awake)
         poses = base_poses(client, bodies)
         if not np.isfinite(poses).all():
             bad = [ids[i] for i in np.flatnonzero(~np.isfinite(poses).all(axis=1))]
@@ -108,6 +112,7 @@ def step(client: int, ids: Sequence[int], bodies: Sequence[int], cfg: PhysicsCon
         if freezer is not None:
             freezer.check(bodies, poses, (steps - checked) * dt)
             checked = steps
+            awake = freezer.thawed(bodies)
     wall = time.perf_counter() - start
     return Outcome(settled, canceled, steps, wall, [ids[i] for i in np.flatnonzero(moving)],
                    peaks)
