@@ -9,7 +9,9 @@ VENV := .venv
 WS := tools/ws
 DEPS_STAMP := $(VENV)/.deps-stamp
 BUILD_STAMP := install/.build-stamp
-SOURCES := $(shell find src -type f -not -path '*/__pycache__/*' -not -name '*.pyc' 2>/dev/null)
+SOURCES := $(shell find src vendor -type f -not -path '*/__pycache__/*' -not -name '*.pyc' 2>/dev/null)
+# vendor/ packages (COLCON_IGNORE'd) built only where the environment lacks them: vendor/README.md
+VENDORED := $(if $(wildcard $(VENV)/share/tf2_msgs/package.xml /opt/ros/jazzy/share/tf2_msgs/package.xml),,vendor/tf2_msgs)
 PYTEST_ARGS ?=
 # The paper's test case (docs/paper-test-case.md), one iteration per bin, per n and per
 # feeder run; RUN_ARGS="$(TEST_CASE)" runs the full counts, RUN_ARGS="" the built-in small file.
@@ -35,7 +37,8 @@ $(DEPS_STAMP): requirements.txt constraints.txt tools/fix_cmake_paths.py
 deps: $(DEPS_STAMP)
 
 $(BUILD_STAMP): $(DEPS_STAMP) $(SOURCES) colcon.meta
-	$(WS) colcon build --event-handlers console_cohesion- summary+ status- \
+	$(WS) colcon build --base-paths . $(VENDORED) \
+	    --event-handlers console_cohesion- summary+ status- \
 	    --cmake-args -DBUILD_TESTING=OFF -Wno-dev
 	touch $@
 

@@ -15,6 +15,7 @@ import signal
 import subprocess
 import time
 
+from ament_index_python.packages import get_package_share_directory
 from experiment_manager import config, interrupt, supervisor
 from experiment_manager.launcher import executable, WORKER_NODES
 from experiment_manager.local_backend import LocalBackend
@@ -103,21 +104,35 @@ def test_every_recorded_message_decodes_and_matches_the_results(graph_run):
         channels = list(reader.get_summary().channels.values())
     # Every channel carries what its publishers offered, in rosbag2's format (read with a plain
     # YAML reader): the nodes' latched topics transient local, the streams volatile.
-    latched = ('scene', 'markers', 'results', 'state')
+    latched = ('scene', 'markers', 'results', 'state', 'tf_static')
     for c in channels:
         offers = yaml.safe_load(c.metadata['offered_qos_profiles'])
         want = 'transient_local' if c.topic.rsplit('/', 1)[-1] in latched else 'volatile'
         assert offers and {(o['reliability'], o['durability']) for o in offers} == {
             ('reliable', want)}, (c.topic, offers)
+    tf_static = [msg for topic, _, msg in messages if topic == '/tf_static']
     by_topic: dict[str, list] = {}
     for topic, _, msg in messages:
-        by_topic.setdefault(topic[len(NS):], []).append(msg)
+        if topic != '/tf_static':
+            by_topic.setdefault(topic[len(NS):], []).append(msg)
     workers = [f'/worker_{k}' for k in range(WORKERS)]
     assert set(by_topic) <= {'/progress'} | {f'{w}/{t}' for w in workers for t in (
         'parts', 'scene', 'markers', 'settle_reports', 'results', 'feeder/state')}
     assert all(f'{w}/results' in by_topic for w in workers), 'a worker ran no iteration'
     iterations = rows(run_dir, 'iterations')
     assert sum(len(by_topic[f'{w}/scene']) for w in workers) == len(iterations)  # a reset each
+    # /tf_static puts every instance frame of every scene in the world frame (RViz, Foxglove):
+    # each scene's transforms as the scene gives them, in a message of its own.
+    static = {(t.header.frame_id, t.child_frame_id, t.transform.translation.x,
+               t.transform.translation.y, t.transform.translation.z)
+              for m in tf_static for t in m.transforms}
+    for w in workers:
+        for scene in by_topic[f'{w}/scene']:
+            for inst in scene.instances:
+                assert inst.frame_id.startswith(f'{NS[1:]}{w}/instance_')
+                assert (scene.header.frame_id, inst.frame_id, inst.transform.translation.x,
+                        inst.transform.translation.y, inst.transform.translation.z) in static
+    assert len(tf_static) == len(iterations)
     progress = by_topic['/progress'][-1]
     assert progress.iterations_done == progress.iterations_total == len(iterations)
 
@@ -170,6 +185,34 @@ def test_every_recorded_message_decodes_and_matches_the_results(graph_run):
     for name in ('iterations.csv', 'checks.csv', 'parts.csv', 'picks.csv', 'summary.json'):
         with open(os.path.join(run_dir, name), 'rb') as f:
             assert attachments[name] == f.read(), name
+
+
+def test_the_foxglove_layout_shows_recorded_topics_and_fields(graph_run):
+    """The installed layout (for a run in the root namespace) names, in its 3D, plot and raw
+    message panels, only topics the recording has, and fields their messages have."""
+    _, recording, _ = graph_run
+    share = get_package_share_directory('experiment_manager')
+    with open(os.path.join(share, 'foxglove', 'pick_sim_layout.json'), encoding='utf-8') as f:
+        layout = json.load(f)
+    def any_worker(topic: str) -> str:      # which worker ran what varies from run to run
+        return re.sub(r'/worker_\d+/', '/worker_k/', topic)
+
+    with open(recording, 'rb') as f:
+        last = {any_worker(channel.topic): msg for _, channel, _, msg in
+                make_reader(f, decoder_factories=[DecoderFactory()]).iter_decoded_messages()}
+    named = []                     # (topic, field or None)
+    for panel in layout['configById'].values():
+        named += [(t, None) for t in panel.get('topics', {})]
+        named += [tuple(p['value'].split('.', 1)) for p in panel.get('paths', [])]
+        if 'topicPath' in panel:
+            named.append((panel['topicPath'], None))
+    assert len(named) >= 6
+    for topic, field in named:
+        recorded = any_worker(f'{NS}{topic}')
+        assert recorded in last, (topic, sorted(last))
+        assert field is None or hasattr(last[recorded], field), (topic, field)
+    assert layout['configById']['3D!scene']['followTf'] == 'world'
+    assert '/tf_static' in last
 
 
 def start_replay(client, recording: str, name: str, rate: str) -> tuple[subprocess.Popen, list]:

@@ -34,7 +34,7 @@ IMPORT_KEYS = {
 ROS_PACKAGES = {
     'rclpy', 'launch', 'launch_ros', 'ament_index_python', 'action_msgs', 'builtin_interfaces',
     'geometry_msgs', 'rcl_interfaces', 'rosgraph_msgs', 'shape_msgs', 'std_msgs',
-    'visualization_msgs',
+    'tf2_msgs', 'visualization_msgs',
 }
 # Keys a package.xml may name beyond the two sets above: the build tools of the interface
 # package, and the rosdep keys in IMPORT_KEYS. The pip keys are the names in rosdistro's

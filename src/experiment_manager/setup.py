@@ -15,6 +15,8 @@ setup(
         # the paper's test case, so that an installed workspace can run it by its share path
         ('share/' + package_name + '/config/test_case', sorted(glob('config/test_case/*.yaml'))),
         ('share/' + package_name + '/launch', ['launch/experiment_launch.py']),
+        # the Foxglove layout for recordings of a run in the root namespace (README)
+        ('share/' + package_name + '/foxglove', ['foxglove/pick_sim_layout.json']),
     ],
     install_requires=['setuptools'],
     zip_safe=True,

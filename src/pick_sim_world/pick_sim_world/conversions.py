@@ -8,7 +8,7 @@ No rclpy here: messages are plain Python classes. Times are passed in as builtin
 from collections.abc import Sequence
 
 from builtin_interfaces.msg import Time
-from geometry_msgs.msg import Point, Quaternion, Transform, Vector3
+from geometry_msgs.msg import Point, Quaternion, Transform, TransformStamped, Vector3
 import numpy as np
 from pick_common import containers
 from pick_common.conversions import container_to_msg, instance_frame, pose_msg
@@ -18,6 +18,7 @@ from pick_msgs.msg import Instance as InstanceMsg
 from pick_msgs.msg import PartModel, Scene
 from shape_msgs.msg import Mesh, MeshTriangle, SolidPrimitive
 from std_msgs.msg import ColorRGBA, Header
+from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import Marker, MarkerArray
 
 from .world import World
@@ -70,6 +71,15 @@ def scene_to_msg(world: World, stamp: Time, frame_id: str, prefix: str) -> Scene
                                 rotation=Quaternion(w=1.0)),
             container=container, part_count=len(inst.part_ids)))
     return msg
+
+
+def tf_static_msg(scene: Scene) -> TFMessage:
+    """The transforms of a scene's instance frames from its frame (the world), for
+    /tf_static: so that RViz or Foxglove put a worker's markers (in instance frames) and parts
+    in one frame."""
+    return TFMessage(transforms=[
+        TransformStamped(header=scene.header, child_frame_id=inst.frame_id,
+                         transform=inst.transform) for inst in scene.instances])
 
 
 # ----------------------------------------------------------------------------- markers

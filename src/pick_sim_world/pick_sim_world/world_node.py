@@ -36,6 +36,7 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos_overriding_options import QoSOverridingOptions
+from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
 from . import conversions as conv
@@ -65,6 +66,8 @@ class WorldNode(Node):
                                                   qos_overriding_options=qos_options)
         self._reports_pub = self.create_publisher(SettleReportMsg, 'settle_reports', 10,
                                                   qos_overriding_options=qos_options)
+        # Absolute, as tf2_ros's static broadcaster: every worker's frames on the one topic.
+        self._tf_static_pub = self.create_publisher(TFMessage, '/tf_static', LATCHED)
         self.create_service(ResetScene, 'reset_scene', self._reset_scene, callback_group=group)
         self.create_service(GetParts, 'get_parts', self._get_parts, callback_group=group)
         for action_type, name, execute in ((DropParts, 'drop_parts', self._drop_parts),
@@ -197,6 +200,7 @@ class WorldNode(Node):
             self._scene_msg = conv.scene_to_msg(self._world, stamp, self._frame_id,
                                                 self._prefix)
             self._scene_pub.publish(self._scene_msg)
+            self._tf_static_pub.publish(conv.tf_static_msg(self._scene_msg))
         parts = common.states_to_msg(self._states, stamp, self._frame_id, self._prefix)
         self._parts_pub.publish(parts)
         if self._publish_markers:
