@@ -106,6 +106,8 @@ class Freezer:
         wake the frozen parts within reach of a part that moved more than the tolerance since
         the last check (its reach: how far it moved), then freeze the parts that stayed near
         their anchor pose for a window."""
+        if not len(bodies):
+            return
         c = self._client
         last = np.array([self._last.get(b, p) for b, p in zip(bodies, poses, strict=True)])
         shift = np.linalg.norm(poses[:, :3] - last[:, :3], axis=1)

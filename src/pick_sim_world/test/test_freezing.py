@@ -83,6 +83,12 @@ def test_the_tray_is_dynamic_again_after_a_settle_and_vibrates_as_commanded():
         assert _masses(world) == {world.part.mass}
 
 
+def test_an_empty_tray_settles_and_vibrates():
+    with World(SceneSpec(ContainerSpec.tray(), PartSpec(), 1, 1), PhysicsConfig()) as world:
+        assert world.settle().settled
+        assert world.vibrate(Vibration()).settled
+
+
 def test_settle_freeze_must_be_a_boolean():
     with pytest.raises(InvalidArgument, match="settle.freeze: 'yes' must be true or false"):
         World(physics=PhysicsConfig(settle_freeze='yes'))
