@@ -11,8 +11,9 @@ every one with the D 8, W 3 mm gripper, GRIPPER below):
 - bins: 480 TO-220s (PTH1) into the test case's biggest and tallest bins, 300 x 300 x 26 and
   200 x 75 x 158 mm: the container-free fraction, parts left moving at the settle's end
   (flat-bin, tall-bin: one alone, for more seeds where the intervals are close);
-- emptying: 480 TO-220s into the 300 x 300 x 26 mm bin, picked until no part is valid: parts
-  removed per bin (the settle after each pick is where freezing acts most);
+- emptying: 150 TO-220s into a 100 x 100 x 48 mm bin, picked until no part is valid: parts
+  removed per bin (the settle after each pick is where freezing acts most; 480 parts in the
+  300 x 300 x 26 mm bin took 250 s per iteration at the default, too long for many seeds);
 - the other parts, to tell a part's effect from a pile's: sweep-pth1 and sweep-pth2 (TO-220s
   and the 8 mm capacitors on the tray at 20, 40 and 60 parts), flat-bin-pth2 (480 capacitors
   into PTH2's 300 x 300 x 22 mm bin); bins also report the candidates' fraction;
@@ -80,8 +81,8 @@ WORKLOADS = {
                  ('candidates', 'container_free', 'unsettled', 'tunnelled', 'max_penetration',
                   'wall_time')),
     'emptying': ('pth1.yaml', lambda n: [{'id': 'emptying', 'type': 'bin_emptying',
-                                          'iterations': n, 'parts': 480,
-                                          'bin': [300, 300, 26]}],
+                                          'iterations': n, 'parts': 150,
+                                          'bin': [100, 100, 48]}],
                  ('picks', 'unsettled', 'tunnelled', 'max_penetration', 'wall_time')),
     # the other parts: is the step's effect the part's or the pile's?
     'flat-bin-pth2': ('pth2.yaml', lambda n: [{'id': 'bins', 'type': 'bin_static',
