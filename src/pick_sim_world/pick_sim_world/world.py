@@ -320,9 +320,7 @@ class World:
         report.tray = delivered
         if report.canceled:
             return self._finished(report)
-        with self._freezer() as freezer:
-            settle = self._settle('settling', max_settle_time, progress, freezer)
-        settle = self._finished(settle, [report])
+        settle = self._finished(self._settle('settling', max_settle_time, progress), [report])
         settle.tray = delivered
         return settle
 
@@ -353,12 +351,9 @@ class World:
             pb.removeBody(self._bodies.pop(pid), physicsClientId=self._client)
             self._instances[self._owner.pop(pid)].part_ids.remove(pid)
         if settle and (touched or not self._at_rest):
-            with self._freezer() as freezer:
-                if freezer is not None and near is not None:
-                    freezer.freeze(body for pid, body in self._bodies.items()
-                                   if pid not in near)
-                report = self._settle('settling', max_settle_time, progress, freezer)
-            return ids, self._finished(report)
+            asleep = [] if near is None else [b for p, b in self._bodies.items() if p not in near]
+            return ids, self._finished(self._settle('settling', max_settle_time, progress,
+                                                    asleep=asleep))
         self._at_rest = self._at_rest and not touched
         return ids, self._finished(SettleReport(True, 0.0, 0.0, 0))
 
@@ -392,15 +387,21 @@ class World:
     def settle(self, max_settle_time: float | None = None,
                progress: ProgressCallback | None = None) -> SettleReport:
         """Step until every part rests or the time cap is hit."""
-        with self._freezer() as freezer:
-            report = self._settle('settling', max_settle_time, progress, freezer)
-        return self._finished(report)
+        return self._finished(self._settle('settling', max_settle_time, progress))
 
     def _settle(self, phase: str, max_settle_time: float | None,
-                progress: ProgressCallback | None, freezer: Freezer | None) -> SettleReport:
+                progress: ProgressCallback | None, freezer: Freezer | None = None,
+                asleep: Iterable[int] = ()) -> SettleReport:
+        """Step until the parts rest, freezing with the operation's `freezer`, or else with
+        a freezer of its own in which the bodies `asleep` start frozen."""
         cap = self._physics.max_settle_time if not max_settle_time else check_number(
             'max_settle_time', max_settle_time, low=self._physics.settle_window, high=600.0)
-        return self._run(phase, cap, progress, freezer=freezer)
+        if freezer is not None:
+            return self._run(phase, cap, progress, freezer=freezer)
+        with self._freezer() as own:
+            if own is not None:
+                own.freeze(asleep)
+            return self._run(phase, cap, progress, freezer=own)
 
     def _freezer(self) -> Freezer | nullcontext:
         """What holds the parts that rest frozen through one operation's falls and settles
