@@ -48,10 +48,10 @@ class PhysicsConfig:
     the scene is settled when at most `settle_moving_fraction` of its parts (rounded down) do
     not rest: 0 waits for every part. Checked every `settle_check_period` s of simulated time.
     `max_settle_time`: the cap on simulated time, s, reported when hit.
-    settle_freeze: while a settle runs, freeze the parts that rest (static until a moving part
-    comes near; freezing.py): a settle costs a fraction of the steps' time, with answers inside
-    the converged intervals (docs/physics.md, "Freezing rested parts"). False steps every part
-    to the end.
+    settle_freeze: while parts fall and settle, freeze the parts that rest (static until a
+    moving part comes near; freezing.py): 1.25 to 3.3 times faster, with the answers inside the
+    intervals of stepping every part (docs/physics.md, "Freezing what rests"). False steps
+    every part to the end.
     """
 
     time_step: float = 1.0 / 480.0
