@@ -115,6 +115,14 @@ def base_poses(client: int, bodies: list[int]) -> np.ndarray:
     return poses
 
 
+def bodies_near(client: int, body: int, reach: float) -> list[int]:
+    """The bodies whose bounding boxes come within `reach` (m) of `body`'s (itself included)."""
+    low, high = pb.getAABB(body, physicsClientId=client)
+    near = pb.getOverlappingObjects(np.subtract(low, reach).tolist(),
+                                    np.add(high, reach).tolist(), physicsClientId=client)
+    return [b for b, _ in near or ()]
+
+
 def max_penetration(client: int) -> float:
     """The deepest overlap of any two bodies in contact now, m (0 when none overlap)."""
     contacts = pb.getContactPoints(physicsClientId=client)

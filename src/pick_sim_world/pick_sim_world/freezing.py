@@ -22,6 +22,8 @@ import numpy as np
 from pick_common.states import quaternion_angles
 import pybullet as pb
 
+from .bodies import bodies_near
+
 
 class Freezer:
     """Freezes and wakes part bodies of one part model and holds the `trays` static for one
@@ -116,11 +118,7 @@ class Freezer:
             woken = set()
             movers = (shift > self._linear) | (turn > self._angular)   # new parts: 0
             for i in np.flatnonzero(movers):
-                low, high = pb.getAABB(bodies[i], physicsClientId=c)
-                near = pb.getOverlappingObjects(np.subtract(low, shift[i]).tolist(),
-                                                np.add(high, shift[i]).tolist(),
-                                                physicsClientId=c)
-                woken.update(b for b, _ in near or () if b in self.frozen)
+                woken.update(b for b in bodies_near(c, bodies[i], shift[i]) if b in self.frozen)
             self.thaw(woken)
         frozen = np.array([b in self.frozen for b in bodies], dtype=bool)
         anchor = np.array([self._anchor.get(b, p) for b, p in zip(bodies, poses, strict=True)])

@@ -364,11 +364,8 @@ class World:
         part_of = {body: pid for pid, body in self._bodies.items()}
         near = set()
         for pid in ids:
-            low, high = pb.getAABB(self._bodies[pid], physicsClientId=c)
-            overlapping = pb.getOverlappingObjects(np.subtract(low, reach).tolist(),
-                                                   np.add(high, reach).tolist(),
-                                                   physicsClientId=c)
-            near.update(part_of[body] for body, _ in overlapping or () if body in part_of)
+            near.update(part_of[body] for body in bodies.bodies_near(c, self._bodies[pid], reach)
+                        if body in part_of)
         return near - set(ids)
 
     def _touch_other_parts(self, ids: list[int]) -> bool:
