@@ -26,7 +26,7 @@ from graph import SMALL, unique_namespace
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 from pick_msgs.action import RunExperiment
-from pick_msgs.msg import ValidityReport
+from pick_msgs.msg import ValidityReport, Verdict
 from pick_sim_world.bodies import instance_seed
 import pytest
 import rclpy
@@ -213,6 +213,26 @@ def test_the_foxglove_layout_shows_recorded_topics_and_fields(graph_run):
         assert field is None or hasattr(last[recorded], field), (topic, field)
     assert layout['configById']['3D!scene']['followTf'] == 'world'
     assert '/tf_static' in last
+
+
+def test_the_run_s_verdicts_are_published_recorded_and_printed(graph_run):
+    """The decisions of the run: on the latched `verdicts` topic (recorded, once), as the
+    report computes them from summary.json, and in run's last lines."""
+    run_dir, recording, done = graph_run
+    with open(recording, 'rb') as f:
+        got = [msg for _, channel, _, msg in make_reader(
+            f, decoder_factories=[DecoderFactory()]).iter_decoded_messages()
+            if channel.topic == f'{NS}/verdicts']
+    with open(os.path.join(run_dir, 'summary.json')) as f:
+        expected = verdicts(json.load(f))
+    assert len(got) == 1 and got[0].run_directory == run_dir
+    assert [(v.option, v.verdict, list(v.reasons)) for v in got[0].verdicts] == [
+        (v['option'], v['verdict'], v['reasons']) for v in expected]
+    assert {v.verdict for v in got[0].verdicts} <= {
+        Verdict.FEASIBLE, Verdict.NOT_FEASIBLE, Verdict.UNDECIDED, Verdict.NOT_ANALYSED}
+    printed = done.stdout[done.stdout.index('verdicts:\n'):].splitlines()[1:]
+    for line, v in zip(printed, expected, strict=True):
+        assert line.startswith(f'  {v["option"].replace("`", "")}: {v["verdict"]} ('), line
 
 
 def start_replay(client, recording: str, name: str, rate: str) -> tuple[subprocess.Popen, list]:

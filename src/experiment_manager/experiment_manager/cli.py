@@ -42,7 +42,6 @@ from tqdm import tqdm
 from . import config, interrupt
 from .claim import claim, NamespaceInUse
 from .supervisor import Graph, report_dead, spin_until, start_graph
-from .verdicts import verdicts
 from .wording import gripper_label
 
 MAX_WORKERS = 64
@@ -310,8 +309,8 @@ def _run(node: Node, client: ActionClient, goal, given: str, graph: Graph, bar) 
         print(f'report:    {result.report_path}')
     summary = json.loads(result.summary_json)
     print('\n'.join(_summary_lines(summary)))
-    # the decisions, each with its first reason (the report gives them all)
+    # the manager's decisions, each with its first reason (the report gives them all)
     print('verdicts:\n' + '\n'.join(
-        f'  {v["option"].replace("`", "")}: {v["verdict"]} ({v["reasons"][0]})'
-        for v in verdicts(summary)))
+        f'  {v.option.replace("`", "")}: {v.verdict} ({v.reasons[0]})'
+        for v in result.verdicts))
     return 0

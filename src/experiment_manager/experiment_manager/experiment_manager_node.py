@@ -1,6 +1,7 @@
 """The `experiment_manager` node: runs experiment files over workers' nodes and records them.
 
-Action `run_experiment` (feedback: ExperimentProgress); topic `progress`. It drives one or more
+Action `run_experiment` (feedback: ExperimentProgress); topics `progress` and `verdicts`
+(latched: the decisions of the last finished run). It drives one or more
 workers, each a `world`, `validity` and `feeder_controller` under its own namespace
 (graph_backend.py). A goal becomes a run session (session.py): iterations are spread over the
 workers (scheduler.py), and one whose worker dies or stops answering runs again on another;
@@ -16,9 +17,9 @@ import time
 
 from ament_index_python.packages import get_package_share_directory
 from pick_common.errors import InvalidArgument, Limit
-from pick_common.node_runner import answer_error, declare, run
+from pick_common.node_runner import answer_error, declare, LATCHED, run
 from pick_msgs.action import RunExperiment
-from pick_msgs.msg import ExperimentProgress
+from pick_msgs.msg import ExperimentProgress, RunVerdicts, Verdict
 from rcl_interfaces.msg import ParameterDescriptor, ParameterType
 from rclpy.action import ActionServer, CancelResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
@@ -32,6 +33,7 @@ from .graph_backend import GraphBackend, GraphError
 from .scheduler import Progress
 from .session import RunSession
 from .topic_recorder import TopicRecorder
+from .verdicts import verdicts
 
 STOP_WAIT = 15.0        # s a shutdown waits for the run to close its files
 DISCOVERY_SETTLE = 3.0  # s the worker list must stay the same before discovery ends
@@ -89,6 +91,7 @@ class ExperimentManagerNode(Node):
         self._lock = threading.Lock()
         self._goal = None
         self._progress = self.create_publisher(ExperimentProgress, 'progress', 10)
+        self._verdicts = self.create_publisher(RunVerdicts, 'verdicts', LATCHED)
         self._backends: dict[str, GraphBackend] = {}
         self._topics = TopicRecorder(f'{self.get_name()}_recorder', self.get_namespace(),
                                      self.context)
@@ -162,6 +165,16 @@ class ExperimentManagerNode(Node):
         self._topics.write(self._progress, msg)
         self._topics.flush()   # once per iteration: a killed manager's recording keeps the rest
 
+    def _publish_verdicts(self, session: RunSession, summary: dict) -> list[Verdict]:
+        """The run's decisions, published (latched) and recorded with the run."""
+        msg = RunVerdicts(header=Header(stamp=self.get_clock().now().to_msg()),
+                          experiment_id=session.file.id, run_directory=session.run_dir,
+                          verdicts=[Verdict(option=v['option'], verdict=v['verdict'],
+                                            reasons=v['reasons']) for v in verdicts(summary)])
+        self._verdicts.publish(msg)
+        self._topics.write(self._verdicts, msg)
+        return msg.verdicts
+
     # ------------------------------------------------------------------------- the action
     def _run(self, goal_handle) -> RunExperiment.Result:
         """Map the goal to a run session, and what fails to an error code."""
@@ -185,6 +198,7 @@ class ExperimentManagerNode(Node):
             summary = session.run(backends, self._publish_progress, self._abort,
                                   [b.worker or '.' for b in backends])
             result.summary_json = json.dumps(summary)
+            result.verdicts = self._publish_verdicts(session, summary)
             result.report_path = session.write_report()
             goal_handle.succeed()
         except Exception as exc:  # core and worker errors get their code, bugs INTERNAL
