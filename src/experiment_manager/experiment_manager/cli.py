@@ -169,9 +169,11 @@ def _summary_lines(summary: dict) -> list[str]:
                 f'no gripper of {len(s["variants"])} meets {s["min_valid"]:g} valid per check'))
         else:
             v = s['vibrations_to_empty']['mean']
+            rate = s['parts_per_hour']['mean']
             lines.append(f'  {exp_id} (feeder_emptying): {s["emptied"]}/{s["iterations"]} '
                          'runs emptied' + (f', {v:.4g} vibrations to empty on average'
-                                           if v is not None else ''))
+                                           if v is not None else '')
+                         + (f', {rate:.4g} parts per hour' if rate is not None else ''))
         if 'sampling' in s:
             a = s['sampling']
             lines[-1] += (f' [adaptive: {a["iterations_run"]} of {a["most"]} iterations, '

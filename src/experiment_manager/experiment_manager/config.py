@@ -80,6 +80,19 @@ class Requirements:
 
 
 @dataclass(frozen=True)
+class Cell:
+    """The picking cell's own times, for its throughput (metrics.feeder_emptying): the robot's
+    pick-and-place cycle per part, s, and the vision system's image per check (after every
+    pick and every vibration), s. The table's time comes from the simulation: each feed's and
+    vibration's simulated duration until the parts rest. 4 s per pick: the fast end of the 4
+    to 10 s a hand insertion of a wired part takes (docs/decisions.md); 0 s per image: not
+    counted unless set. Set both to the cell's measured figures."""
+
+    pick_time: float = 4.0      # s
+    image_time: float = 0.0     # s
+
+
+@dataclass(frozen=True)
 class Sampling:
     """How many iterations an experiment runs. fixed: its `iterations` (per bin or count), as
     the paper's counts. adaptive: batches of `batch` iterations per group until its decision
@@ -158,6 +171,7 @@ class ExperimentFile:
     requirements: Requirements
     experiments: tuple[Experiment, ...]
     sampling: Sampling = Sampling()
+    cell: Cell = Cell()
     path: str = ''
     text: str = field(default='', repr=False)
 
@@ -576,6 +590,12 @@ def _requirements(r: _Map) -> Requirements:
         success_rate=r.number('success_rate', 0.9, low=0.0, high=1.0, low_open=True))
 
 
+def _cell(c: _Map) -> Cell:
+    return Cell(pick_time=c.number('pick_s', Cell.pick_time, low=0.0, high=3600.0,
+                                   low_open=True),
+                image_time=c.number('image_s', Cell.image_time, low=0.0, high=3600.0))
+
+
 def _sampling(s: _Map) -> Sampling:
     return Sampling(mode=s.text('mode', FIXED, SAMPLING_MODES),
                     batch=s.integer('batch', Sampling.batch, 1, MAX_ITERATIONS))
@@ -638,6 +658,7 @@ def parse(text: str, path: str = '') -> ExperimentFile:
     check, search_order = section('check', _check) or (None, None)
     requirements = section('requirements', _requirements)
     sampling = section('sampling', _sampling)
+    cell = section('cell', _cell)
     tray = checked(lambda: _tray(m))
     moves = checked(lambda: _moves(m))
     bin_wall = checked(lambda: m.number('bin_wall_mm', 3.0, low=0.5, high=100.0, scale=MM))
@@ -676,7 +697,7 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         id=file_id, seed=seed, output_dir=output_dir, part=part, gripper=gripper, grasps=grasps,
         place=place, check=check, search_order=search_order, tray=tray, moves=moves,
         bin_wall=bin_wall, requirements=requirements, experiments=tuple(experiments.values()),
-        sampling=sampling,
+        sampling=sampling, cell=cell,
         path=os.path.abspath(path) if path else '', text=text)
 
 

@@ -175,13 +175,16 @@ def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
                     optimal_range) -> dict:
     """`emptied`: runs that emptied the feeder and the table; `accepted`: of them, those that
     spilled at most requirements.max_spilled_parts over the tray's walls, and `accepted_ci95`
-    the 95 % interval of that share of the runs (rate_interval)."""
+    the 95 % interval of that share of the runs (rate_interval); `parts_per_hour`: the cell's
+    throughput per run that picked (cell_throughput) and its 95 % interval (interval)."""
     emptied = [r for r in rows if r['emptied']]
+    hourly = [cell_throughput(file.cell, r) for r in rows   # (none for a run directory of
+              if r['picks'] and 'table_time' in r]          # before 2026-11-26: no column)
     tolerated = file.requirements.max_spilled
     accepted = sum(r['spilled'] <= tolerated for r in emptied)
     vibrations = stats([r['vibrations'] for r in emptied])
-    interval = file.requirements.refill_interval
-    per_vibration = (interval / vibrations['mean'] / 60.0
+    refill = file.requirements.refill_interval
+    per_vibration = (refill / vibrations['mean'] / 60.0
                      if vibrations['mean'] else None)
     return {'iterations': len(rows), 'parts': exp.parts, 'optimal_range': list(optimal_range),
             'max_vibrations': exp.max_vibrations, 'emptied': len(emptied),
@@ -190,7 +193,18 @@ def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
             'vibrations_to_empty': vibrations, 'feeds': stats([r['feeds'] for r in rows]),
             'stops': {s: sum(r['stop'] == s for r in rows) for s in sorted({r['stop']
                                                                             for r in rows})},
-            'minutes_per_vibration_allowed': per_vibration}
+            'minutes_per_vibration_allowed': per_vibration,
+            'parts_per_hour': stats(hourly), 'parts_per_hour_ci95': list(interval(hourly)),
+            'cell': {'pick_s': file.cell.pick_time, 'image_s': file.cell.image_time}}
+
+
+def cell_throughput(cell, row: dict) -> float:
+    """The parts per hour a feeder run's cell would pick: its picks over the time they take
+    (each pick `cell.pick_time`, each check an image of `cell.image_time`) plus the time the
+    table's feeds and vibrations took until the parts rested (simulated, `table_time`)."""
+    busy = (row['picks'] * cell.pick_time + row['checks'] * cell.image_time
+            + row['table_time'])
+    return 3600.0 * row['picks'] / busy
 
 
 def gripper_sweep(exp: Experiment, rows: list[dict], checks: list[dict]) -> dict:

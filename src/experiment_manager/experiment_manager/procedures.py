@@ -82,7 +82,8 @@ def run_unit(file: ExperimentFile, u: Unit, backend: Backend) -> Record:
         **{k: first.get(k, 0) for k in ('checked', 'outside', 'candidates', 'placeable',
                                          'container_free', 'valid')},
         'checks': len(record.checks), 'picks': len(record.picks),
-        **row, 'fault': faults(row), 'wall_time': time.monotonic() - start}
+        **row, 'fault': faults(row), 'table_time': iteration.table_time,
+        'wall_time': time.monotonic() - start}
     return record
 
 
@@ -94,6 +95,7 @@ class Iteration:
         self.record = Record(iteration={})
         self.key = {'experiment': u.experiment.id, 'group': u.group, 'iteration': u.iteration}
         self.reports: list[SettleReport] = []
+        self.table_time = 0.0   # s the feeder's feeds and vibrations took, simulated
 
     def health(self) -> dict:
         """The physics of the iteration's world operations so far: whether every settle
@@ -202,6 +204,7 @@ class Iteration:
         backend = self.backend
         step = backend.feed(0, 0, self.u.feeder)
         self.reports += step.reports
+        self.table_time += sum(r.sim_time for r in step.reports)
         states = backend.parts()
         for _ in range(MAX_FEED_CYCLES):
             outside = states.ids[~states.inside].tolist()
@@ -212,6 +215,7 @@ class Iteration:
             valid = report.counts['valid'] if report else 0
             step = backend.feed(valid, int(states.inside.sum()), None)
             self.reports += step.reports
+            self.table_time += sum(r.sim_time for r in step.reports)
             if step.decision == PICK:
                 pid = self.pick(report, order, step.vibrations)
                 states, settle = backend.remove([pid])

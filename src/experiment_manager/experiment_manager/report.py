@@ -33,7 +33,7 @@ from .verdicts import (
     UNDECIDED,
     verdicts,
 )
-from .wording import dims, fmt, gripper_label, of_type, pct, table, varying
+from .wording import count, dims, fmt, gripper_label, of_type, pct, table, varying
 
 FIGSIZE = (6.4, 4.0)   # inches
 # the HTML class (colour) of a bold verdict
@@ -281,6 +281,17 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
                   f'{fmt(s["minutes_per_vibration_allowed"])} min. Parts spilled over the '
                   f'walls: {s["physics"]["spilled"]} (in {s["runs_spilling"]} runs; a run may '
                   f'spill {s["max_spilled"]}); runs emptied within that: {s["accepted"]}.']
+        rate = s.get('parts_per_hour')     # absent in run directories before 2026-11-26
+        if rate and rate['mean'] is not None:
+            low, high = s['parts_per_hour_ci95']
+            lines += ['', f'The cell would pick {fmt(rate["mean"], 4)} parts per hour (mean of '
+                      f'{count(rate["n"], "run")}'
+                      + (f', 95 % interval {fmt(low, 4)} to {fmt(high, 4)}' if low is not None
+                         else '') + f'; required {fmt(summary["requirements"]["parts_per_hour"])}'
+                      f'): {fmt(s["cell"]["pick_s"])} s per pick (`cell.pick_s`), '
+                      f'{fmt(s["cell"]["image_s"])} s per image after every pick and vibration '
+                      '(`cell.image_s`), and the simulated time each feed and vibration took '
+                      'until the parts rested.']
     gripper_sweeps = of_type(summary, 'gripper_sweep')
     for exp_id, s in gripper_sweeps:
         lines += ['', f'## Gripper sweep (`{exp_id}`)', '']

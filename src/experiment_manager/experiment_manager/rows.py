@@ -16,7 +16,7 @@ ITERATION_COLUMNS = (
     'container_z', 'parts', 'checked', 'outside', 'candidates', 'placeable', 'container_free',
     'valid', 'checks', 'picks', 'settled', 'unsettled', 'spilled', 'tunnelled', 'thrown',
     'max_penetration', 'max_speed', 'tray_error', 'emptied', 'vibrations', 'feeds', 'stop',
-    'fault', 'wall_time')
+    'fault', 'table_time', 'wall_time')
 CHECK_COLUMNS = (*KEY, 'check', 'parts_on_table', 'checked', 'outside', 'candidates',
                  'placeable', 'container_free', 'valid', 'picked_id', 'searches', 'vibrations',
                  'wall_time')
@@ -27,7 +27,7 @@ FILES = {'iterations': ITERATION_COLUMNS, 'checks': CHECK_COLUMNS, 'parts': PART
          'picks': PICK_COLUMNS}
 TEXT = {'experiment', 'type', 'stop', 'fault'}
 FLOAT = {'container_x', 'container_y', 'container_z', 'max_penetration', 'max_speed',
-         'tray_error', 'wall_time', *POSE, *GRIPPER_POSE}
+         'tray_error', 'table_time', 'wall_time', *POSE, *GRIPPER_POSE}
 BOOL = {'settled', 'emptied', 'inside'}
 
 

@@ -8,8 +8,9 @@ Verdicts, per option, each resting on a rate with its 95 % interval (metrics.rat
   (requirements.parts_per_hour x refill_interval_h);
 - vibrating table: the share of `feeder_emptying` runs that emptied the feeder spilling no
   more than requirements.max_spilled_parts over the tray's walls, against
-  requirements.success_rate; and the feeder must hold a refill interval's parts; the report
-  gives the time per vibration this leaves;
+  requirements.success_rate; the feeder must hold a refill interval's parts; and the cell's
+  throughput (its 95 % interval) must reach requirements.parts_per_hour; the report gives
+  the time per vibration the refill interval leaves;
 - gripper (one per gripper_sweep): the smallest gripper of the sweep whose valid parts per
   check reach the experiment's min_valid at 95 % confidence; not feasible when every
   gripper's interval lies below min_valid.
@@ -85,6 +86,7 @@ def verdicts(summary: dict) -> list[dict]:
             reasons.append(f'vibrations to empty the feeder: mean {fmt(v["mean"], 4)}; the '
                            f'refill interval allows one vibration every '
                            f'{fmt(s["minutes_per_vibration_allowed"])} min')
+        verdict, reasons = _throughput(verdict, reasons, s, summary['requirements'])
         spilled = s['physics']['spilled']
         if spilled:
             reasons.append(f'{count(spilled, "part")} spilled over the tray\'s walls, in '
@@ -113,6 +115,30 @@ def _decided(verdict: str, reasons: list[str], s: dict,
     if shortfall or left_out:
         verdict = NOT_FEASIBLE
     return verdict, first + reasons + ([] if left_out else faults)
+
+
+def _throughput(verdict: str, reasons: list[str], s: dict,
+                requirements: dict) -> tuple[str, list[str]]:
+    """A feeder option's verdict and reasons after its cell's throughput (the parts per hour
+    that its picks, feeds and vibrations allow) against requirements.parts_per_hour: not
+    feasible where the 95 % interval lies below it (that reason first), undecided where a
+    feasible verdict's interval reaches below it or there is none (one run); said either
+    way."""
+    rate, (low, high) = s.get('parts_per_hour'), s.get('parts_per_hour_ci95', (None, None))
+    if not rate or rate['mean'] is None:
+        return verdict, reasons
+    required = requirements['parts_per_hour']
+    cell = s['cell']
+    text = (f'the cell would pick {fmt(rate["mean"], 4)} parts per hour'
+            + (f' (95 % interval {fmt(low, 4)} to {fmt(high, 4)})' if low is not None else '')
+            + f'; required {fmt(required)} (requirements.parts_per_hour), at '
+            f'{fmt(cell["pick_s"])} s per pick and {fmt(cell["image_s"])} s per image '
+            '(cell.pick_s, cell.image_s) and the simulated time of the feeds and vibrations')
+    if high is not None and high < required:
+        return NOT_FEASIBLE, [text] + reasons
+    if verdict == FEASIBLE and (low is None or low < required):
+        return UNDECIDED, reasons + [f'not enough runs to decide: {text}']
+    return verdict, reasons + [text]
 
 
 def _rate_verdict(successes: int, n: int, ci95: list, required: float,

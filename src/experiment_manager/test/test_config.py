@@ -28,11 +28,20 @@ def test_the_default_file_parses_into_si_units():
     assert f.tray.inner_size == pytest.approx((0.195, 0.150, 0.027))
     assert f.moves == (MOVES['spread'],) and f.requirements.max_spilled == 0
     assert f.requirements.success_rate == 0.9
-    assert f.requirements.refill_interval == 4 * 3600 and f.requirements.capacity == 480
+    assert f.requirements.refill_interval == 4 * 3600 and f.requirements.capacity == 60
     emptying = f.experiment('emptying')
     assert emptying.bin is None and emptying.bin_from == 'bins'
     assert f.experiment('feeder').range_from == 'sweep'
     assert f.experiment('sweep').counts == tuple(range(5, 61, 5))
+
+
+def test_the_default_file_s_containers_hold_a_refill_interval_s_parts():
+    # Otherwise its bin and table could never come out feasible (issue 23: it once loaded 150
+    # parts into a cell that needed 480).
+    f = config.load(DEFAULT)
+    loads = {e.id: e.parts for e in f.experiments
+             if e.type in ('bin_emptying', 'feeder_emptying')}
+    assert len(loads) == 2 and min(loads.values()) >= f.requirements.capacity, loads
 
 
 def test_omitted_keys_take_the_documented_defaults():
@@ -198,6 +207,21 @@ def test_feeder_moves_are_named_or_set_field_by_field():
                           r'moves\[0\] \(vibration.amplitude\[2\]\): -0.001 must be >= 0')):
         with pytest.raises(InvalidArgument, match=error):
             config.parse(text.replace('moves: [spread]', f'moves: {moves}'))
+
+
+def test_the_cell_s_times_default_and_are_checked():
+    text = open(DEFAULT).read()
+    assert config.parse(MINIMAL).cell == config.Cell(pick_time=4.0, image_time=0.0)
+    f = config.parse(text.replace('pick_s: 4', 'pick_s: 2.5').replace('image_s: 0',
+                                                                    'image_s: 0.3'))
+    assert f.cell == config.Cell(pick_time=2.5, image_time=0.3)
+    for old, new, error in (('pick_s: 4', 'pick_s: 0', r'cell.pick_s: 0 must be > 0'),
+                            ('image_s: 0', 'image_s: -1', r'cell.image_s: -1 must be >= 0'),
+                            ('pick_s: 4', 'pick_time: 4',
+                             r'cell.pick_time: 4 is not a known key here \(did you mean '
+                             r'pick_s\?\)')):
+        with pytest.raises(InvalidArgument, match=error):
+            config.parse(text.replace(old, new))
 
 
 def test_the_installed_share_holds_the_paper_test_case():

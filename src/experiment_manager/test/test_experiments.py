@@ -74,6 +74,16 @@ def test_every_type_records_its_rows_and_metrics(small):
     assert feeder['stop'] in NAMES and int(feeder['vibrations']) <= 15
     assert int(feeder['picks']) + int(feeder['spilled']) <= 12
     assert 0 < float(feeder['tray_error']) < 0.05    # the tray moved as commanded
+    # The table's time: each vibration lasts its move's duration and then settles, the first
+    # feed streams its parts in; no other type has one.
+    file = config.load(SMALL)
+    shaking = int(feeder['vibrations']) * sum(m.duration for m in file.moves)
+    assert shaking < float(feeder['table_time']) < shaking + 10.0 * (int(feeder['vibrations'])
+                                                                      + int(feeder['feeds']))
+    assert {float(r['table_time']) for r in rows if r['type'] != 'feeder_emptying'} == {0.0}
+    hourly = 3600.0 * int(feeder['picks']) / (int(feeder['picks']) * file.cell.pick_time
+                                              + float(feeder['table_time']))
+    assert s['feeder']['parts_per_hour']['mean'] == pytest.approx(hourly)
     with open(os.path.join(directory, 'summary.json')) as f:
         assert json.load(f) == summary
 
@@ -415,12 +425,16 @@ def test_the_health_of_an_iteration_counts_spilled_tunnelled_and_thrown_parts_ap
     assert (health['spilled'], health['tunnelled'], health['thrown']) == (1, 1, 1)
     assert {'tunnelled', 'thrown'} <= set(faults({**health, 'stop': ''}).split('+'))
     rows = [{'group': 0, 'iteration': 0, **health, 'fault': faults({**health, 'stop': ''}),
-             'emptied': True, 'vibrations': 5, 'feeds': 1, 'stop': 'stop: empty'},
+             'emptied': True, 'vibrations': 5, 'feeds': 1, 'stop': 'stop: empty',
+             'picks': 5, 'checks': 10, 'table_time': 9.0},
             {'group': 0, 'iteration': 1, **health, 'tunnelled': 0, 'thrown': 0, 'fault': '',
-             'emptied': True, 'vibrations': 7, 'feeds': 1, 'stop': 'stop: empty'}]
+             'emptied': True, 'vibrations': 7, 'feeds': 1, 'stop': 'stop: empty',
+             'picks': 7, 'checks': 14, 'table_time': 20.0}]
     s = metrics.summarise(file, exp, rows, [], {'sweep': {'optimal_range': [2, 4]}})
     assert s['faults']['tunnelled'] == 1 and s['iterations'] == 1    # left out
     assert s['physics']['spilled'] == 2 and s['accepted'] == 0       # counted, not accepted
+    # the kept run's throughput: 7 picks of 4 s and 20 s of the table's, no image time
+    assert s['parts_per_hour']['mean'] == pytest.approx(3600 * 7 / (7 * 4 + 20))
 
 
 def test_an_unwritable_output_directory_is_named(tmp_path):

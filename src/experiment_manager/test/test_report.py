@@ -4,6 +4,7 @@ Markdown and HTML of the same content."""
 import copy
 import json
 import os
+import re
 import shutil
 
 from experiment_manager import config, pictures, report, verdicts
@@ -41,6 +42,8 @@ def test_a_run_gets_its_report_files(run_dir):
     assert 'grippers.png' in page
     assert 'paper' not in text.split('## Verdict')[1]      # id `small`: no paper numbers
     assert 'No iteration was flagged' in text
+    assert re.search(r'The cell would pick [\d.]+ parts per hour \(mean of 1 run; required '
+                     r'60\): 4 s per pick', text)
     # a header people read, and each verdict coloured by what it says
     assert 'Part `radial_capacitor`; gripper body diameter 8 mm, jaw depth 3 mm; seed 11.' in text
     for v in verdicts.verdicts(_summary(run_dir)):
@@ -65,6 +68,36 @@ def _rates(s: dict, emptied: int, accepted: int, n: int) -> None:
     s['experiments']['feeder'].update(emptied=max(emptied, accepted), accepted=accepted,
                                       iterations=n,
                                       accepted_ci95=list(rate_interval(accepted, n)))
+    # a throughput far above any requirement here, known to 95 % once there are two runs
+    s['experiments']['feeder']['parts_per_hour'].update(n=n, mean=1000.0)
+    s['experiments']['feeder']['parts_per_hour_ci95'] = [900.0, 1100.0] if n > 1 else [None,
+                                                                                      None]
+
+
+def test_the_table_verdict_rests_on_the_cell_s_throughput_too(run_dir):
+    s = _summary(run_dir)
+    s['requirements'].update(capacity=10, success_rate=0.9, parts_per_hour=120)
+    _rates(s, 40, 40, 40)
+    feeder = s['experiments']['feeder']
+
+    def table(mean, low, high):
+        feeder['parts_per_hour']['mean'] = mean
+        feeder['parts_per_hour_ci95'] = [low, high]
+        return verdicts.verdicts(s)[1]
+    fast = table(300.0, 250.0, 350.0)
+    assert fast['verdict'] == FEASIBLE
+    assert fast['reasons'][-1].startswith('the cell would pick 300 parts per hour (95 % '
+                                          'interval 250 to 350); required 120')
+    slow = table(100.0, 90.0, 110.0)    # every run emptied, but too slowly: that decides
+    assert slow['verdict'] == NOT_FEASIBLE
+    assert slow['reasons'][0].startswith('the cell would pick 100 parts per hour')
+    near = table(130.0, 100.0, 160.0)
+    assert near['verdict'] == UNDECIDED
+    assert near['reasons'][-1].startswith('not enough runs to decide: the cell would pick 130')
+    one = table(300.0, None, None)      # one run: no interval, no decision on it
+    assert one['verdict'] == UNDECIDED
+    _rates(s, 0, 0, 40)                 # not feasible on its rate: the throughput only said
+    assert table(300.0, 250.0, 350.0)['verdict'] == NOT_FEASIBLE
 
 
 def test_the_exact_interval_of_a_rate():
