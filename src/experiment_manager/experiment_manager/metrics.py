@@ -178,8 +178,7 @@ def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
     the 95 % interval of that share of the runs (rate_interval); `parts_per_hour`: the cell's
     throughput per run that picked (cell_throughput) and its 95 % interval (interval)."""
     emptied = [r for r in rows if r['emptied']]
-    hourly = [cell_throughput(file.cell, r) for r in rows   # (none for a run directory of
-              if r['picks'] and 'table_time' in r]          # before 2026-11-26: no column)
+    hourly = throughputs(file.cell, rows)
     tolerated = file.requirements.max_spilled
     accepted = sum(r['spilled'] <= tolerated for r in emptied)
     vibrations = stats([r['vibrations'] for r in emptied])
@@ -196,6 +195,12 @@ def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
             'minutes_per_vibration_allowed': per_vibration,
             'parts_per_hour': stats(hourly), 'parts_per_hour_ci95': list(interval(hourly)),
             'cell': {'pick_s': file.cell.pick_time, 'image_s': file.cell.image_time}}
+
+
+def throughputs(cell, rows: list[dict]) -> list[float]:
+    """cell_throughput of each feeder run that picked (none for a run directory written
+    before 2026-11-26, which has no table_time)."""
+    return [cell_throughput(cell, r) for r in rows if r['picks'] and 'table_time' in r]
 
 
 def cell_throughput(cell, row: dict) -> float:

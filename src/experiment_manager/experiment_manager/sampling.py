@@ -12,8 +12,12 @@ them exactly as the fixed counts' (metrics.py).
 What settles each decision, looked at after every batch:
 - bin_emptying, feeder_emptying: the success rate (bins emptied; runs emptied within the spill
   limit) against requirements.success_rate, as the verdict reads it (verdicts.py): settled when
-  its exact interval lies wholly at or above the requirement, or wholly below it. An iteration
-  left out of the figures (a physics fault) settles it too: the verdict is NOT FEASIBLE then.
+  its exact interval lies wholly at or above the requirement, or wholly below it; for
+  feeder_emptying the cell's throughput too (metrics.throughputs against
+  requirements.parts_per_hour): settled when its interval lies wholly below (NOT FEASIBLE
+  whatever the rate), and a rate above needs the throughput's interval wholly above. An
+  iteration left out of the figures (a physics fault) settles it too: the verdict is NOT
+  FEASIBLE then.
 - bin_static, a race: a bin leaves it when the interval of its mean container-free fraction lies
   wholly below the interval of the leading bin's (the highest mean). The race ends with one bin
   left (the best bin) or at the most iterations.
@@ -69,13 +73,28 @@ def unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict],
         kept_keys = {(r['group'], r['iteration']) for r in kept}
         return [] if _smallest_settled(exp, [c for c in checks if (c['group'], c['iteration'])
                                              in kept_keys]) else groups(exp)
+    required = file.requirements
     if exp.type == BIN_EMPTYING:
         successes = sum(bool(r['emptied']) for r in kept)
-    else:
-        successes = sum(bool(r['emptied']) and r['spilled'] <= file.requirements.max_spilled
-                        for r in kept)
-    settled = rate_settled(successes, len(kept), file.requirements.success_rate)
-    return [] if settled else groups(exp)
+        return [] if rate_settled(successes, len(kept), required.success_rate) else groups(exp)
+    successes = sum(bool(r['emptied']) and r['spilled'] <= required.max_spilled for r in kept)
+    return [] if _feeder_settled(file, successes, kept) else groups(exp)
+
+
+def _feeder_settled(file: ExperimentFile, successes: int, rows: list[dict]) -> bool:
+    """The table's verdict is known: its rate of runs emptied within the spill limit lies
+    wholly below the required share, or the interval of its throughput wholly below the
+    required parts per hour (either makes it NOT FEASIBLE), or the rate lies wholly at or above
+    the share and the throughput's interval at or above the parts per hour."""
+    required = file.requirements
+    if not rows:
+        return False
+    low, high = metrics.rate_interval(successes, len(rows), INTERIM_CONFIDENCE)
+    fast, slow = metrics.interval(metrics.throughputs(file.cell, rows), INTERIM_CONFIDENCE)
+    if high < required.success_rate or (slow is not None and slow < required.parts_per_hour):
+        return True
+    return low >= required.success_rate and fast is not None and (
+        fast >= required.parts_per_hour)
 
 
 def rate_settled(successes: int, n: int, required: float,

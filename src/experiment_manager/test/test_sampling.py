@@ -50,17 +50,40 @@ def test_a_rate_is_settled_once_its_99_9_percent_interval_clears_or_misses_the_r
     assert not sampling.rate_settled(0, 0, 0.9)
 
 
+def feeder_run(i: int, table_time: float = 60.0, **values) -> dict:
+    """A feeder run of 12 picks and 30 checks (about 480 parts per hour at 4 s a pick)."""
+    return row(0, i, **{'emptied': True, 'spilled': 0, 'picks': 12, 'checks': 30,
+                        'table_time': table_time, **values})
+
+
 def test_feeder_runs_count_a_run_over_the_spill_limit_as_failed_and_a_fault_settles():
     file = small()
     exp = file.experiment('feeder')
-    emptied = [row(0, i, emptied=True, spilled=0) for i in range(73)]
+    emptied = [feeder_run(i, 60.0 + i % 3) for i in range(73)]
     assert sampling.unsettled(file, exp, emptied) == []
     spilling = [dict(r, spilled=1) for r in emptied[:4]]
     assert sampling.unsettled(file, exp, spilling) == []        # 0 of 4 within the limit
     assert sampling.unsettled(file, exp, spilling[:3]) == [0]
     # A tunnelled part leaves the run out and makes the option NOT FEASIBLE: settled.
-    tunnelled = [row(0, 0, emptied=True, spilled=0, fault='tunnelled')]
+    tunnelled = [feeder_run(0, fault='tunnelled')]
     assert sampling.unsettled(file, exp, tunnelled) == []
+
+
+def test_feeder_runs_settle_on_their_throughput_too():
+    file = small()      # 60 parts per hour required
+    exp = file.experiment('feeder')
+    # Every run emptied, but the cell picks about 40 parts per hour (12 picks in 18 min):
+    # the table is NOT FEASIBLE whatever the rate, once the interval says so.
+    slow = [feeder_run(i, 1032.0 + 10 * (i % 3)) for i in range(4)]
+    assert metrics.interval(metrics.throughputs(file.cell, slow), 0.999)[1] < 60
+    assert sampling.unsettled(file, exp, slow) == []
+    assert sampling.unsettled(file, exp, slow[:1]) == [0]       # one run: no interval yet
+    # The rate clears 0.9 at 73 runs; a throughput whose interval reaches below the
+    # requirement keeps the study open, one wholly above settles it.
+    spread = [feeder_run(i, 60.0 if i % 6 == 0 else 20000.0) for i in range(73)]
+    low, high = metrics.interval(metrics.throughputs(file.cell, spread), 0.999)
+    assert low < 60 < high and sampling.unsettled(file, exp, spread) == [0]
+    assert sampling.unsettled(file, exp, [feeder_run(i, 60.0 + i % 3) for i in range(73)]) == []
 
 
 def test_bins_leave_the_race_when_they_are_clearly_behind_the_leader():
