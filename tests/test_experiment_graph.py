@@ -104,7 +104,7 @@ def test_every_recorded_message_decodes_and_matches_the_results(graph_run):
         channels = list(reader.get_summary().channels.values())
     # Every channel carries what its publishers offered, in rosbag2's format (read with a plain
     # YAML reader): the nodes' latched topics transient local, the streams volatile.
-    latched = ('scene', 'markers', 'results', 'state', 'tf_static')
+    latched = ('scene', 'markers', 'results', 'state', 'tf_static', 'verdicts')
     for c in channels:
         offers = yaml.safe_load(c.metadata['offered_qos_profiles'])
         want = 'transient_local' if c.topic.rsplit('/', 1)[-1] in latched else 'volatile'
@@ -116,7 +116,7 @@ def test_every_recorded_message_decodes_and_matches_the_results(graph_run):
         if topic != '/tf_static':
             by_topic.setdefault(topic[len(NS):], []).append(msg)
     workers = [f'/worker_{k}' for k in range(WORKERS)]
-    assert set(by_topic) <= {'/progress'} | {f'{w}/{t}' for w in workers for t in (
+    assert set(by_topic) <= {'/progress', '/verdicts'} | {f'{w}/{t}' for w in workers for t in (
         'parts', 'scene', 'markers', 'settle_reports', 'results', 'feeder/state')}
     assert all(f'{w}/results' in by_topic for w in workers), 'a worker ran no iteration'
     iterations = rows(run_dir, 'iterations')

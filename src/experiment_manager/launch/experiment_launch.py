@@ -56,7 +56,7 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('server_timeout', default_value='10.0',
                               description="longest wait for the workers' services and actions "
                               'at the start of a run, s'),
-        DeclareLaunchArgument('rejoin_timeout', default_value='600.0',
+        DeclareLaunchArgument('rejoin_timeout', default_value='60.0',
                               description='longest wait for a lost worker to come back, s; 0: '
                               'do not wait'),
         DeclareLaunchArgument('recording.chunk_size', default_value='1048576',
