@@ -104,8 +104,8 @@ def bin_picture(file: ExperimentFile, summary: dict, run_dir: str) -> str | None
             position = np.array([float(rejected[k]) for k in ('x', 'y', 'z')])
             part_rotation = Rotation.from_quat([float(rejected[k])
                                                 for k in ('qx', 'qy', 'qz', 'qw')])
-            frames = validator.gripper_frames(part_rotation.as_matrix()[None],
-                                              np.array([index]))
+            frames = validator.approach_frames(part_rotation.as_matrix()[None],
+                                               np.array([index]))
             tilt = int(np.abs(validator.tilts).argmin())
             rotation = Rotation.from_matrix(frames[0, tilt])
             origin = position + part_rotation.apply(g.point)

@@ -54,6 +54,7 @@ def test_the_report_warns_where_the_optimal_range_runs_past_the_counts_tested(ru
     s = _summary(run_dir)
     sweep = s['experiments']['sweep']
     last = max(p['n'] for p in sweep['per_n'])
+    sweep.update(n_star=last - 4, optimal_range=[last - 6, last - 2])
     assert 'Warning' not in report.markdown(s, {}, {})
     sweep.update(n_star=last, optimal_range=[last - 2, last + 2])
     assert (f'**Warning**: the optimal range runs past the last count tested ({last} parts): '

@@ -13,8 +13,13 @@ Per part, in order, stopping at the first stage that fails:
 
 The gripper closes along the grasp's closing axis as the part lies (x), and its axis (z) is
 the most vertical one perpendicular to it, turned by the wrist tilt about x; its origin is at
-the grasp point. So the part-in-gripper pose, and with it placeability, depends on how the part
-lies: the same grasp of a part tilted one way can be placed and tilted the other way not.
+the grasp point. Jaws that close across a round body (the grasp point on the axis of a cylinder
+of the part, the closing axis across that axis) grip it at any angle about the axis, as a cell
+does, whose camera cannot see a cylinder's roll: the grasp is turned about the axis to bring
+its up axis nearest world +Z before the stages (`Validator.free_axes`); a capacitor lying on
+its side is then approached from above whatever its roll. So the part-in-gripper pose, and
+with it placeability, depends on how the part lies: the same grasp of a part tilted one way
+can be placed and tilted the other way not.
 Container and neighbour stages decide what exact bounds can decide and ask FCL the rest;
 `naive_check` asks FCL everything, with no broadphase and no caching, and must give identical
 results.
@@ -36,6 +41,7 @@ from pick_common.containers import ContainerSpec
 from pick_common.errors import InvalidArgument, UnknownPart
 from pick_common.parts import PartGeometry
 from scipy.spatial import cKDTree
+from scipy.spatial.transform import Rotation
 
 from .config import (
     check_grasps,
@@ -51,6 +57,8 @@ from .config import (
 from .geometry import (
     bounds,
     collide,
+    contains,
+    CYLINDER,
     grasped_extent,
     gripper_shapes,
     matrix_to_quaternion,
@@ -69,6 +77,8 @@ STAGE_NONE, STAGE_CANDIDACY, STAGE_PLACEABILITY, STAGE_CONTAINER, STAGE_NEIGHBOU
 # was not checked).
 ORDER = (STAGE_CANDIDACY, STAGE_PLACEABILITY, STAGE_CONTAINER, STAGE_NEIGHBOUR, STAGE_VALID)
 CENTRE_TOLERANCE = 0.001      # m beyond the inner walls and floor a part's centre may lie
+TIE = 1e-6                    # rad: grasps whose up axes are this near in angle tie (acos near 0
+#                               is only good to about 1e-8 rad)
 QUATERNION_TOLERANCE = 1e-3   # |norm - 1| accepted (and normalised); larger is refused
 MAX_PARTS = 20000
 MAX_POSITION = 10.0           # m from the instance frame; a container is at most 2 m wide
@@ -194,6 +204,59 @@ class Validator:
                                for g, depth in zip(self.grasps, self.finger_depths, strict=True)]
         self._gripper_objects = [[s.fcl_object() for s in shapes]
                                  for shapes in self.gripper_shapes]
+        # per grasp: the axis (part frame) of the round body its jaws close across, about which
+        # it may turn; zero for a grasp that is fixed to the part
+        self.free_axes = np.stack([self._free_axis(g) for g in self.grasps])
+
+    def _free_axis(self, grasp: Grasp) -> np.ndarray:
+        """The axis of a cylinder of the part that holds the grasp point on its axis and that
+        the closing axis crosses at a right angle, or zeros."""
+        for shape in self.part_shapes:
+            axis = shape.rotation[:, 2]
+            off = grasp.point - shape.center
+            if (shape.kind == CYLINDER and contains(shape, grasp.point)
+                    and abs(float(axis @ grasp.closing)) < 1e-6
+                    and np.linalg.norm(off - (off @ axis) * axis) < 1e-9):
+                return axis.copy()
+        return np.zeros(3)
+
+    def turned(self, rotations: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """For parts at rotations (n, 3, 3): each grasp's angle from world +Z (n, G) once
+        turned about its free axis to the most vertical, and that turn (n, G), rad (0 for a
+        fixed grasp). With w the world +Z in the part frame and u the up axis, a turn t about
+        the unit axis a gives the up axis a height of A cos t + B sin t + C, where
+        A = w.u - (a.u)(a.w), B = w.(a x u), C = (a.u)(a.w): largest at t = atan2(B, A)."""
+        ups = np.stack([g.up for g in self.grasps])                     # (G, 3)
+        w = rotations[:, 2, :]                                          # (n, 3)
+        a = self.free_axes
+        au = np.einsum('gk,gk->g', a, ups)
+        aw = w @ a.T                                                    # (n, G)
+        big_a = w @ ups.T - au * aw
+        big_b = w @ np.cross(a, ups).T
+        free = np.linalg.norm(a, axis=1) > 0
+        turn = np.where(free, np.arctan2(big_b, big_a), 0.0)
+        height = np.where(free, np.hypot(big_a, big_b) + au * aw, w @ ups.T)
+        return np.arccos(np.clip(height, -1.0, 1.0)), turn
+
+    def approach_frames(self, rotations: np.ndarray, grasp_index: np.ndarray) -> np.ndarray:
+        """The gripper's rotations (n, T, 3, 3) for parts at rotations (n, 3, 3) held with the
+        grasps `grasp_index` (n,), each grasp turned about its free axis as the check turns it
+        (gripper_frames of the turned part)."""
+        _, turns = self.turned(rotations)
+        turn = turns[np.arange(len(rotations)), grasp_index]
+        return self.gripper_frames(self._grip_rotations(rotations, grasp_index, turn),
+                                   grasp_index)
+
+    def _grip_rotations(self, rotations: np.ndarray, grasp_index: np.ndarray,
+                        turn: np.ndarray) -> np.ndarray:
+        """The part rotations (n, 3, 3) as the gripper takes them: turned by `turn` (n,) about
+        the free axis of each part's grasp (Rodrigues)."""
+        a = self.free_axes[grasp_index]                                 # (n, 3)
+        k = np.zeros((len(a), 3, 3))
+        k[:, 0, 1], k[:, 0, 2], k[:, 1, 2] = -a[:, 2], a[:, 1], -a[:, 0]
+        k -= np.swapaxes(k, 1, 2)
+        s, c = np.sin(turn)[:, None, None], np.cos(turn)[:, None, None]
+        return rotations @ (np.eye(3) + s * k + (1.0 - c) * (k @ k))
 
     def _finger_depth(self, grasp: Grasp) -> float:
         """How far below the grasp point the fingertips go, m: to `finger_clearance` above
@@ -264,12 +327,10 @@ class Validator:
                 container, centres[n], self.config.rim_tolerance))
         inner = [row for row, ok in zip(rows, located, strict=True) if ok]
 
-        # 1. candidacy, vectorised over targets and grasps.
-        ups = np.stack([g.up for g in self.grasps])                     # (G, 3)
-        z = np.einsum('njk,gk->ngj', rotations[inner], ups)[:, :, 2]    # (n, G)
-        angles = np.arccos(np.clip(z, -1.0, 1.0))
-        best = angles.argmin(axis=1) if len(inner) else np.zeros(0, dtype=int)
-        frames = self.gripper_frames(rotations[inner], best)            # (n, T, 3, 3)
+        # 1. candidacy, vectorised over targets and grasps (turned on round bodies).
+        angles, turns = self.turned(rotations[inner])                   # (n, G)
+        best = nearest_grasp(angles, turns)
+        frames = self.approach_frames(rotations[inner], best)           # (n, T, 3, 3)
         approach = self._approachable(frames)
         placeable = self._placeable(rotations[inner], frames, best) & approach
         kept: dict[int, np.ndarray] = {}
@@ -324,6 +385,16 @@ class Validator:
         result.gripper_pose = np.concatenate([origin, matrix_to_quaternion(frames[k])])
         result.reason = (f'valid with grasp {self.grasps[g].name!r} at {len(valid)} of '
                          f'{len(self.tilts)} tilts')
+
+
+def nearest_grasp(angles: np.ndarray, turns: np.ndarray) -> np.ndarray:
+    """Per part (rows of (n, G)), the grasp whose up axis is nearest +Z, and among those as
+    near (within TIE, rad: on a round body lying flat, every side grasp turns to vertical)
+    the one turned least; then the first."""
+    if not len(angles):
+        return np.zeros(0, dtype=int)
+    near = angles <= angles.min(axis=1, keepdims=True) + TIE
+    return np.where(near, np.abs(turns), np.inf).argmin(axis=1)
 
 
 def _outside_reason(container: ContainerSpec, centre: np.ndarray, rim: float) -> str:
@@ -507,10 +578,21 @@ def naive_check(validator: Validator, container: ContainerSpec, ids: Sequence[in
                                  v.config.rim_tolerance)[0]:
             results.append(PartResult(ids[row], STAGE_OUTSIDE, 'outside'))
             continue
-        angles = [math.acos(max(-1.0, min(1.0, float((rotation @ g.up)[2]))))
-                  for g in v.grasps]
-        g = int(np.argmin(angles))
-        grasp = v.grasps[g]
+        # each grasp as the gripper takes it: on a round body, turned about its axis by the
+        # angle from the up axis to world +Z, both seen across the axis
+        turns, turned = [], []
+        for g, a in zip(v.grasps, v.free_axes, strict=True):
+            w = rotation.T @ np.array([0.0, 0.0, 1.0])
+            u_across, w_across = g.up - (g.up @ a) * a, w - (w @ a) * a
+            turn = math.atan2(float(a @ np.cross(u_across, w_across)),
+                              float(u_across @ w_across)) if a.any() else 0.0
+            turns.append(turn)
+            turned.append(rotation @ Rotation.from_rotvec(turn * a).as_matrix())
+        angles = [math.acos(max(-1.0, min(1.0, float((r @ g.up)[2]))))
+                  for g, r in zip(v.grasps, turned, strict=True)]
+        g = min((k for k in range(len(angles)) if angles[k] <= min(angles) + TIE),
+                key=lambda k: (abs(turns[k]), k))
+        grasp, gripped = v.grasps[g], turned[g]
         result = PartResult(ids[row], STAGE_CANDIDACY, '', g, angles[g],
                             jaw_opening=grasp.jaw_opening)
         results.append(result)
@@ -519,11 +601,11 @@ def naive_check(validator: Validator, container: ContainerSpec, ids: Sequence[in
             continue
         shapes = gripper_shapes(v.gripper, grasp.jaw_opening, v.finger_depths[g])
         objects = [s.fcl_object() for s in shapes]
-        closing = rotation @ grasp.closing
+        closing = gripped @ grasp.closing
         # the vertical made perpendicular to the closing axis, turned by each tilt about it
         axis = np.array([0.0, 0.0, 1.0]) - closing[2] * closing
         if np.linalg.norm(axis) < 1e-9:
-            axis = rotation @ grasp.up
+            axis = gripped @ grasp.up
         axis /= np.linalg.norm(axis)
         side = np.cross(axis, closing)
         frames = []
