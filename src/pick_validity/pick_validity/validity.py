@@ -238,11 +238,13 @@ class Validator:
         height = np.where(free, np.hypot(big_a, big_b) + au * aw, w @ ups.T)
         return np.arccos(np.clip(height, -1.0, 1.0)), turn
 
-    def approach_frames(self, rotations: np.ndarray, grasp_index: np.ndarray) -> np.ndarray:
+    def approach_frames(self, rotations: np.ndarray, grasp_index: np.ndarray,
+                        turns: np.ndarray | None = None) -> np.ndarray:
         """The gripper's rotations (n, T, 3, 3) for parts at rotations (n, 3, 3) held with the
         grasps `grasp_index` (n,), each grasp turned about its free axis as the check turns it
-        (gripper_frames of the turned part)."""
-        _, turns = self.turned(rotations)
+        (gripper_frames of the turned part). turns: `turned`'s, when the caller has them."""
+        if turns is None:
+            _, turns = self.turned(rotations)
         turn = turns[np.arange(len(rotations)), grasp_index]
         return self.gripper_frames(self._grip_rotations(rotations, grasp_index, turn),
                                    grasp_index)
@@ -330,7 +332,7 @@ class Validator:
         # 1. candidacy, vectorised over targets and grasps (turned on round bodies).
         angles, turns = self.turned(rotations[inner])                   # (n, G)
         best = nearest_grasp(angles, turns)
-        frames = self.approach_frames(rotations[inner], best)           # (n, T, 3, 3)
+        frames = self.approach_frames(rotations[inner], best, turns)    # (n, T, 3, 3)
         approach = self._approachable(frames)
         placeable = self._placeable(rotations[inner], frames, best) & approach
         kept: dict[int, np.ndarray] = {}
