@@ -90,11 +90,11 @@ def _feeder_settled(file: ExperimentFile, successes: int, rows: list[dict]) -> b
     if not rows:
         return False
     low, high = metrics.rate_interval(successes, len(rows), INTERIM_CONFIDENCE)
-    fast, slow = metrics.interval(metrics.throughputs(file.cell, rows), INTERIM_CONFIDENCE)
-    if high < required.success_rate or (slow is not None and slow < required.parts_per_hour):
+    least, most = metrics.interval(metrics.throughputs(file.cell, rows), INTERIM_CONFIDENCE)
+    if high < required.success_rate or (most is not None and most < required.parts_per_hour):
         return True
-    return low >= required.success_rate and fast is not None and (
-        fast >= required.parts_per_hour)
+    return low >= required.success_rate and least is not None and (
+        least >= required.parts_per_hour)
 
 
 def rate_settled(successes: int, n: int, required: float,
