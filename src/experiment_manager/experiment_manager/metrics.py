@@ -198,9 +198,8 @@ def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
 
 
 def throughputs(cell, rows: list[dict]) -> list[float]:
-    """cell_throughput of each feeder run that picked (none for a run directory written
-    before 2026-11-26, which has no table_time)."""
-    return [cell_throughput(cell, r) for r in rows if r['picks'] and 'table_time' in r]
+    """cell_throughput of each feeder run that picked."""
+    return [cell_throughput(cell, r) for r in rows if r['picks']]
 
 
 def cell_throughput(cell, row: dict) -> float:
