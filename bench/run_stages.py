@@ -65,10 +65,9 @@ def main() -> int:
         summary = json.load(f)
     iterations, checks = read_csv(os.path.join(d, 'iterations.csv')), read_csv(
         os.path.join(d, 'checks.csv'))
-    by_id = {e: s for e, s in summary['experiments'].items()}
     paper = PAPER.get(summary['id'], {})
     print(f'run {d} ({summary["id"]})')
-    for exp_id, s in by_id.items():
+    for exp_id, s in summary['experiments'].items():
         mine = [c for c in checks if c['experiment'] == exp_id]
         rows = [r for r in iterations if r['experiment'] == exp_id]
         if s['type'] == 'table_sweep':
