@@ -40,21 +40,29 @@ from paper_case import run_on_cores
 from pick_sim_world.config import PhysicsConfig
 
 DEFAULT = PhysicsConfig()
+# The finer settings solve a tray with a bin's iterations too (100, not the tray's 50).
+FINER = replace(DEFAULT, tray_solver_iterations=DEFAULT.solver_iterations)
 SETTINGS = {
-    'default': DEFAULT,                         # 1/480 s, 100 iterations, warm start 0.85
+    'default': DEFAULT,         # 1/480 s, 100 iterations (50 on a tray), warm start 0.85
     '1/240': replace(DEFAULT, time_step=1 / 240),   # pybullet's step, the default until 11-25
-    'dt/2': replace(DEFAULT, time_step=DEFAULT.time_step / 2),
-    'dt/4': replace(DEFAULT, time_step=DEFAULT.time_step / 4),
-    'dt/8': replace(DEFAULT, time_step=DEFAULT.time_step / 8),
-    '200-it': replace(DEFAULT, solver_iterations=200),
+    'dt/2': replace(FINER, time_step=DEFAULT.time_step / 2),
+    'dt/4': replace(FINER, time_step=DEFAULT.time_step / 4),
+    'dt/8': replace(FINER, time_step=DEFAULT.time_step / 8),
+    '200-it': replace(DEFAULT, solver_iterations=200, tray_solver_iterations=200),
+    # a tray solved with a bin's 100 iterations: the default until 2026-11-26
+    'tray-100-it': FINER,
+    # fewer iterations at the default warm start: what a step costs is mostly the solver's
+    '50-it': replace(DEFAULT, solver_iterations=50, tray_solver_iterations=50),
+    '30-it-warm': replace(DEFAULT, solver_iterations=30, tray_solver_iterations=30),
     'warm-1': replace(DEFAULT, warm_starting_factor=1.0),   # the default of 2026-11-23 to -25
     # the defaults before issue 20's convergence study: 30 iterations, pybullet's warm start
-    '30-it': replace(DEFAULT, solver_iterations=30, warm_starting_factor=0.1),
+    '30-it': replace(DEFAULT, solver_iterations=30, tray_solver_iterations=30,
+                     warm_starting_factor=0.1),
     # the parts' rolling and spinning friction arms until 2026-11-25 (PART below)
     'arms-1mm': DEFAULT,
     # every part stepped to the end of every settle: the default until 2026-11-26
     'no-freeze': replace(DEFAULT, settle_freeze=False),
-    'dt/2-no-freeze': replace(DEFAULT, time_step=DEFAULT.time_step / 2, settle_freeze=False),
+    'dt/2-no-freeze': replace(FINER, time_step=DEFAULT.time_step / 2, settle_freeze=False),
 }
 # the part's changes of a setting (keys of an experiment file's part section)
 PART = {'arms-1mm': {'rolling_friction_mm': 1.0, 'spinning_friction_mm': 1.0}}

@@ -45,6 +45,7 @@ SETTINGS = {
     'dt/4': ({'time_step': PhysicsConfig().time_step / 4}, {}),
     '200-it': ({'solver_iterations': 200}, {}),
     '30-it': ({'solver_iterations': 30}, {}),
+    '50-it': ({'solver_iterations': 50}, {}),
     'warm-0.1': ({'warm_starting_factor': 0.1}, {}),
     'former': (FORMER, {}),
     'former-60-it': ({**FORMER, 'solver_iterations': 60}, {}),

@@ -13,7 +13,7 @@ from pick_common.parts import PartGeometry
 import pybullet as pb
 import trimesh
 
-from .config import GRAVITY, PhysicsConfig
+from .config import GRAVITY, PhysicsConfig, solver_iterations
 
 INSTANCE_GAP = 0.05             # m between the outer walls of neighbouring instances
 TRAY_MASS = 3.0                 # kg; the tray is a dynamic body whose motion is prescribed
@@ -30,12 +30,13 @@ def instance_pitch(spec: ContainerSpec) -> float:
     return containers.outer_size(spec)[0] + INSTANCE_GAP
 
 
-def configure(client: int, physics: PhysicsConfig) -> None:
-    """Empty the simulation and set gravity and the solver settings."""
+def configure(client: int, physics: PhysicsConfig, kind: str) -> None:
+    """Empty the simulation and set gravity and the solver settings for containers of `kind`."""
     pb.resetSimulation(physicsClientId=client)
     pb.setGravity(0.0, 0.0, -GRAVITY, physicsClientId=client)
     pb.setPhysicsEngineParameter(
-        fixedTimeStep=physics.time_step, numSolverIterations=physics.solver_iterations,
+        fixedTimeStep=physics.time_step,
+        numSolverIterations=solver_iterations(physics, kind),
         warmStartingFactor=physics.warm_starting_factor,
         contactBreakingThreshold=physics.contact_breaking_threshold,
         deterministicOverlappingPairs=1, physicsClientId=client)

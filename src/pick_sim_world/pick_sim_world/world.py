@@ -127,7 +127,7 @@ class World:
 
     def _build(self, scene: SceneSpec, part: PartGeometry) -> None:
         c = self._client
-        bodies.configure(c, self._physics)
+        bodies.configure(c, self._physics, scene.container.kind)
         self._scene, self._part = scene, part
         self._instances, self._bodies, self._owner = [], {}, {}
         self._next_id, self._sim_time = 0, 0.0

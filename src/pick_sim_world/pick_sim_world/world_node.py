@@ -150,7 +150,10 @@ class WorldNode(Node):
         physics = PhysicsConfig(
             time_step=setting('physics.time_step', cfg.time_step, 's'),
             solver_iterations=setting('physics.solver_iterations', cfg.solver_iterations,
-                                      'solver iterations per step'),
+                                      'solver iterations per step in a bin'),
+            tray_solver_iterations=setting('physics.tray_solver_iterations',
+                                           cfg.tray_solver_iterations,
+                                           'solver iterations per step on a tray'),
             warm_starting_factor=setting('physics.warm_starting_factor',
                                          cfg.warm_starting_factor,
                                          "share of the last step's contact impulses the "
