@@ -191,17 +191,23 @@ def test_the_solver_runs_the_iterations_of_its_container(container, field):
     assert used['numSolverIterations'] == again['numSolverIterations'] == wanted
 
 
+def _movers_after_settling(world: World, count: int) -> int:
+    """Drop `count` parts into `world` and settle; then step a further second and return how
+    many parts moved more than the settle tolerance in it."""
+    _, report = world.drop(count)
+    assert report.settled
+    before = world.snapshot()
+    world._run('settling', 1.0, None, stop_when_settled=False)    # a full second
+    moved = np.linalg.norm(world.snapshot().poses[:, :3] - before.poses[:, :3], axis=1)
+    return int((moved > world.physics.settle_linear_tolerance).sum())
+
+
 def test_parts_settled_on_a_tray_stay_put():
     """90 TO-220s settled on the tray (seed 0), solved with the tray's iterations: in a further
     second at most 2 move more than the settle tolerance (0 did at 50 iterations, 2 at 100, 6
     at 30 and 9 at 5; with seeds 0 to 2, 0 / 2 / 7 / 20 in all)."""
     with _world(ContainerSpec.tray(), 'to220', seed=0) as world:
-        _, report = world.drop(90)
-        assert report.settled
-        before = world.snapshot()
-        world._run('settling', 1.0, None, stop_when_settled=False)    # a full second
-        moved = np.linalg.norm(world.snapshot().poses[:, :3] - before.poses[:, :3], axis=1)
-    movers = int((moved > PhysicsConfig().settle_linear_tolerance).sum())
+        movers = _movers_after_settling(world, 90)
     assert movers <= 2, f'{movers} of 90 parts moved over 0.5 mm in a further second'
 
 
@@ -217,12 +223,7 @@ def test_a_settled_pile_stays_put():
     part = PartSpec(model='to220', rolling_friction=ARM, spinning_friction=ARM)
     scene = SceneSpec(ContainerSpec(inner_size=(0.075, 0.075, 0.06)), part, 1, 0)
     with World(scene, PhysicsConfig()) as world:
-        _, report = world.drop(150)
-        assert report.settled
-        before = world.snapshot()
-        world._run('settling', 1.0, None, stop_when_settled=False)    # a full second
-        moved = np.linalg.norm(world.snapshot().poses[:, :3] - before.poses[:, :3], axis=1)
-    movers = int((moved > PhysicsConfig().settle_linear_tolerance).sum())
+        movers = _movers_after_settling(world, 150)
     assert movers <= 7, f'{movers} of 150 parts moved over 0.5 mm in a further second'
 
 
