@@ -343,42 +343,32 @@ class World:
                 ids.append(pid)
         if not ids:
             raise InvalidArgument('part_ids', [], 'is empty: name at least one part')
-        touched = self._touch_other_parts(ids)
-        # From a scene at rest, only the parts near the removed ones settle at first: the rest
-        # start frozen, and wake when a moving part comes near (freezing.py).
-        near = self._parts_near(ids) if self._at_rest and self._physics.settle_freeze else None
+        touching = self._parts_touching(ids)
+        # From a scene at rest, only the parts the removed ones touched settle at first: no
+        # other part felt a force change. The rest start frozen, and wake when a moving part
+        # comes near (freezing.py).
+        local = self._at_rest and self._physics.settle_freeze
         for pid in ids:
             pb.removeBody(self._bodies.pop(pid), physicsClientId=self._client)
             self._instances[self._owner.pop(pid)].part_ids.remove(pid)
-        if settle and (touched or not self._at_rest):
-            asleep = [] if near is None else [b for p, b in self._bodies.items() if p not in near]
+        if settle and (touching or not self._at_rest):
+            asleep = [b for p, b in self._bodies.items() if p not in touching] if local else []
             return ids, self._finished(self._settle('settling', max_settle_time, progress,
                                                     asleep=asleep))
-        self._at_rest = self._at_rest and not touched
+        self._at_rest = self._at_rest and not touching
         return ids, self._finished(SettleReport(True, 0.0, 0.0, 0))
 
-    def _parts_near(self, ids: list[int]) -> set[int]:
-        """The parts not in `ids` whose bounding boxes come within a part's length (its
-        enclosing diameter) of the bounding box of a part of `ids`."""
-        c, reach = self._client, 2.0 * self._part.radius
-        part_of = {body: pid for pid, body in self._bodies.items()}
-        near = set()
-        for pid in ids:
-            near.update(part_of[body] for body in bodies.bodies_near(c, self._bodies[pid], reach)
-                        if body in part_of)
-        return near - set(ids)
-
-    def _touch_other_parts(self, ids: list[int]) -> bool:
-        """Whether a part of `ids` touches (is within the contact-breaking threshold of) a part
-        not in `ids`, by the contacts of the last step."""
+    def _parts_touching(self, ids: list[int]) -> set[int]:
+        """The parts not in `ids` that a part of `ids` touches (is within the contact-breaking
+        threshold of), by the contacts of the last step."""
         removed = {self._bodies[pid] for pid in ids}
-        containers_ = {inst.body for inst in self._instances}
+        part_of = {body: pid for pid, body in self._bodies.items() if body not in removed}
+        touching = set()
         for body in removed:
             for contact in pb.getContactPoints(bodyA=body, physicsClientId=self._client):
-                other = contact[2]
-                if other not in removed and other not in containers_:
-                    return True
-        return False
+                if contact[2] in part_of:
+                    touching.add(part_of[contact[2]])
+        return touching
 
     # ----------------------------------------------------------------------------- settle
     def settle(self, max_settle_time: float | None = None,

@@ -1,8 +1,8 @@
 """Freezing rested parts while a settle runs (freezing.py): what it must not change.
 
 A frozen part is static until a moving part comes near; the settle after a pick from a resting
-scene starts with only the parts near the pick awake. Wrong, either would leave parts hovering
-where their support went, or a pile that moves on once its parts are dynamic again.
+scene starts with only the parts the picked one touched awake. Wrong, either would leave parts
+hovering where their support went, or a pile that moves on once its parts are dynamic again.
 """
 
 import numpy as np
@@ -27,10 +27,10 @@ def _masses(world: World) -> set[float]:
 
 @pytest.mark.parametrize('freeze', [True, False], ids=['freeze', 'no-freeze'])
 def test_a_column_falls_as_one_when_its_lowest_part_is_picked(freeze):
-    """Twelve TO-220s stacked flat in a channel 12 mm wide, 54 mm tall: the upper ones are
-    farther from the lowest than a part's length, so they start frozen when it is picked, and
-    only waking part by part up the column brings them down. Every one must come down a
-    part's thickness, and end dynamic again."""
+    """Twelve TO-220s stacked flat in a channel 12 mm wide, 54 mm tall: only the second
+    touches the lowest, so the upper ones start frozen when it is picked (some farther from it
+    than a part's length), and only waking part by part up the column brings them down. Every
+    one must come down a part's thickness, and end dynamic again."""
     channel = ContainerSpec(inner_size=(0.012, 0.031, 0.1))
     scene = SceneSpec(channel, PartSpec(model='to220', rolling_friction=ARM,
                                         spinning_friction=ARM), 1, 0)
@@ -52,7 +52,7 @@ def test_a_column_falls_as_one_when_its_lowest_part_is_picked(freeze):
 
 def test_a_pile_picked_from_stays_put_once_every_part_is_dynamic():
     """150 TO-220s in a 75 x 75 x 60 mm bin, ten parts picked from the top, each settle
-    starting with only the parts near the pick awake: a further second with every part
+    starting with only the parts the pick touched awake: a further second with every part
     dynamic moves at most as many parts as it does after the drop alone
     (test_world.test_a_settled_pile_stays_put: 7)."""
     part = PartSpec(model='to220', rolling_friction=ARM, spinning_friction=ARM)
