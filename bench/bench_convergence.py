@@ -16,7 +16,8 @@ every one with the D 8, W 3 mm gripper, GRIPPER below):
   300 x 300 x 26 mm bin took 250 s per iteration at the default, too long for many seeds);
 - the other parts, to tell a part's effect from a pile's: sweep-pth1 and sweep-pth2 (TO-220s
   and the 8 mm capacitors on the tray at 20, 40 and 60 parts), flat-bin-pth2 (480 capacitors
-  into PTH2's 300 x 300 x 22 mm bin); bins also report the candidates' fraction;
+  into PTH2's 300 x 300 x 22 mm bin), feeder-pth1 and feeder-pth2 (their feeder runs of 100
+  parts at [39, 49] and [53, 63]); bins also report the candidates' fraction;
 and for every workload parts tunnelled, the deepest penetration (mm), the worst tray tracking
 error and the wall time per iteration. An interval is mean +- t(0.975, n-1) s / sqrt(n); a
 setting's mean is marked '*' when it lies outside the finest setting's interval (--finest,
@@ -76,6 +77,17 @@ WORKLOADS = {
                                         'optimal_range': [80, 90], 'max_vibrations': 500}],
                ('vibrations', 'emptied', 'spilled', 'tunnelled', 'max_penetration',
                 'tray_error', 'wall_time')),
+    # the other parts' feeder runs (the reduced test case's optimal ranges, 2026-11-22)
+    'feeder-pth1': ('pth1.yaml', lambda n: [{'id': 'feeder', 'type': 'feeder_emptying',
+                                             'iterations': n, 'parts': 100,
+                                             'optimal_range': [39, 49], 'max_vibrations': 500}],
+                    ('vibrations', 'emptied', 'spilled', 'tunnelled', 'max_penetration',
+                     'tray_error', 'wall_time')),
+    'feeder-pth2': ('pth2.yaml', lambda n: [{'id': 'feeder', 'type': 'feeder_emptying',
+                                             'iterations': n, 'parts': 100,
+                                             'optimal_range': [53, 63], 'max_vibrations': 500}],
+                    ('vibrations', 'emptied', 'spilled', 'tunnelled', 'max_penetration',
+                     'tray_error', 'wall_time')),
     'bins': ('pth1.yaml', lambda n: [{'id': 'bins', 'type': 'bin_static', 'iterations': n,
                                       'parts': 480, 'bins_mm': [[300, 300, 26],
                                                                 [200, 75, 158]]}],

@@ -1,14 +1,16 @@
-"""What does skipping the settle after a pick of a part that touches no other part save, and
-what does it change?
+"""What does settling only what a pick disturbs save, and what does it change?
 
 `World.remove` settles the scene after removing parts, unless the scene was at rest and no
 removed part touched another part (by the last step's contacts, within the contact-breaking
-threshold): lifting such a part out of a resting scene moves nothing. This script runs the
-test case's feeder runs (100 parts, the optimal ranges the reduced test case found) and bin
-emptyings (the test case's counts and best bins) on the cores, once as the world does now and
-once with a settle after every removal (the behaviour before 2026-11-23), with the same seeds:
-wall time, steps, removals that skipped the settle, and the outcomes (vibrations, picks, parts
-spilled). The runs are spread over a process per CPU.
+threshold): lifting such a part out of a resting scene moves nothing. From a scene at rest, the
+settle starts with only the parts the removed ones touched awake, the rest frozen until a
+moving part comes near (freezing.py). This script runs the test case's feeder runs (100
+parts, the optimal ranges the reduced test case found) and bin emptyings (the test case's
+counts and best bins) on the cores in three modes, with the same seeds: a settle after every
+removal with every part awake (the behaviour before 2026-11-23), the parts within a part's
+length of a removed one awake (2026-11-23 to 2026-11-26), and the world's own (the parts
+touched). It prints wall time, steps, removals that skipped the settle, and the outcomes
+(vibrations, picks, parts spilled). The runs are spread over a process per CPU.
 
     tools/ws python bench/bench_pick_settle.py [--runs 4]
 """
@@ -19,15 +21,16 @@ import multiprocessing
 import os
 
 from paper_case import run_on_cores
+from pick_sim_world import bodies
 from pick_sim_world import world as world_module
 
 # Per part: its file, the reduced test case's optimal range (2026-11-22) and best bin, mm.
 PARTS = {'PTH0': ('pth0.yaml', (72, 82), (100, 175, 15)),
          'PTH1': ('pth1.yaml', (39, 49), (300, 300, 26)),
          'PTH2': ('pth2.yaml', (53, 63), (300, 225, 29))}
-MODES = ('settle after every removal (before)', 'skip when nothing touched (now)')
+MODES = ('every removal, every part', 'touched, parts within a length', 'touched, parts touched')
 # The world's own methods, before `measure` wraps them (a pool process runs one case only).
-TOUCH, RUN = world_module.World._touch_other_parts, world_module.World._run
+TOUCHING, RUN = world_module.World._parts_touching, world_module.World._run
 
 
 def experiments(kind: str, part: str, runs: int) -> list[dict]:
@@ -46,13 +49,21 @@ def measure(kind: str, part: str, mode: int, runs: int) -> dict:
     """Run `kind` (feeder | emptying) for `part` in `mode` (an index of MODES)."""
     counts = collections.Counter()
 
-    def touch(self, ids):
-        touched = True if mode == 0 else TOUCH(self, ids)
+    def touching(self, ids):
+        found = TOUCHING(self, ids)
+        if mode == 0:
+            found = set(self._bodies) - set(ids)
+        elif mode == 1 and found:
+            part_of = {body: pid for pid, body in self._bodies.items()}
+            for pid in ids:
+                found.update(part_of[b] for b in bodies.bodies_near(
+                    self._client, self._bodies[pid], 2.0 * self._part.radius) if b in part_of)
+            found -= set(ids)
         counts['removals'] += 1
-        counts['skipped'] += not touched and self._at_rest
-        return touched
+        counts['skipped'] += not found and self._at_rest
+        return found
 
-    world_module.World._touch_other_parts = touch
+    world_module.World._parts_touching = touching
     steps = [0]
 
     def counted(self, *args, **kwargs):
@@ -81,16 +92,18 @@ def main() -> None:
           'whole experiment (an emptying includes one bin_static drop)')
     for kind in ('feeder', 'emptying'):
         for part in PARTS:
-            before, now = by_case[(kind, part, 0)], by_case[(kind, part, 1)]
-            for mode, r in zip(MODES, (before, now), strict=True):
+            results = [by_case[(kind, part, mode)] for mode in range(len(MODES))]
+            for mode, r in zip(MODES, results, strict=True):
                 outcome = '; '.join(
                     f'{x["vibrations"]} vib, {x["picks"]} picks, {x["spilled"]} spilled'
                     for x in r['rows'])
-                print(f'{kind:<8} {part} {mode:<36} wall {r["wall"]:6.1f} s, steps '
+                print(f'{kind:<8} {part} {mode:<30} wall {r["wall"]:6.1f} s, steps '
                       f'{r["steps"]:6d}, removals {r["removals"]:4d} (settle skipped '
                       f'{r["skipped"]:4d}): {outcome}', flush=True)
-            print(f'{kind:<8} {part} wall now / before: {now["wall"] / before["wall"]:.2f}, '
-                  f'steps {now["steps"] / before["steps"]:.2f}')
+            now = results[-1]
+            print(f'{kind:<8} {part} wall now / each mode: ' + ', '.join(
+                f'{now["wall"] / r["wall"]:.2f}' for r in results) + '; steps: ' + ', '.join(
+                f'{now["steps"] / r["steps"]:.2f}' for r in results))
 
 
 if __name__ == '__main__':
