@@ -68,26 +68,25 @@ SETTINGS = {
 # the part's changes of a setting (keys of an experiment file's part section)
 PART = {'arms-1mm': {'rolling_friction_mm': 1.0, 'spinning_friction_mm': 1.0}}
 FINEST = 'dt/4'         # the reference the others are marked against
+
+
+def _feeder(part_file: str, optimal_range: list[int]) -> tuple:
+    """The workload of `part_file`'s feeder_emptying runs of 100 parts at `optimal_range`."""
+    return (part_file, lambda n: [{'id': 'feeder', 'type': 'feeder_emptying', 'iterations': n,
+                                   'parts': 100, 'optimal_range': optimal_range,
+                                   'max_vibrations': 500}],
+            ('vibrations', 'emptied', 'spilled', 'tunnelled', 'max_penetration', 'tray_error',
+             'wall_time'))
+
+
 WORKLOADS = {
     'sweep': ('pth0.yaml', lambda n: [{'id': 'sweep', 'type': 'table_sweep', 'iterations': n,
                                        'counts': {'first': 30, 'last': 90, 'step': 30}}],
               ('valid', 'tunnelled', 'max_penetration', 'wall_time')),
-    'feeder': ('pth0.yaml', lambda n: [{'id': 'feeder', 'type': 'feeder_emptying',
-                                        'iterations': n, 'parts': 100,
-                                        'optimal_range': [80, 90], 'max_vibrations': 500}],
-               ('vibrations', 'emptied', 'spilled', 'tunnelled', 'max_penetration',
-                'tray_error', 'wall_time')),
+    'feeder': _feeder('pth0.yaml', [80, 90]),
     # the other parts' feeder runs (the reduced test case's optimal ranges, 2026-11-22)
-    'feeder-pth1': ('pth1.yaml', lambda n: [{'id': 'feeder', 'type': 'feeder_emptying',
-                                             'iterations': n, 'parts': 100,
-                                             'optimal_range': [39, 49], 'max_vibrations': 500}],
-                    ('vibrations', 'emptied', 'spilled', 'tunnelled', 'max_penetration',
-                     'tray_error', 'wall_time')),
-    'feeder-pth2': ('pth2.yaml', lambda n: [{'id': 'feeder', 'type': 'feeder_emptying',
-                                             'iterations': n, 'parts': 100,
-                                             'optimal_range': [53, 63], 'max_vibrations': 500}],
-                    ('vibrations', 'emptied', 'spilled', 'tunnelled', 'max_penetration',
-                     'tray_error', 'wall_time')),
+    'feeder-pth1': _feeder('pth1.yaml', [39, 49]),
+    'feeder-pth2': _feeder('pth2.yaml', [53, 63]),
     'bins': ('pth1.yaml', lambda n: [{'id': 'bins', 'type': 'bin_static', 'iterations': n,
                                       'parts': 480, 'bins_mm': [[300, 300, 26],
                                                                 [200, 75, 158]]}],
