@@ -14,6 +14,7 @@ import statistics
 import time
 
 from builtin_interfaces.msg import Time
+from pick_common import conversions as common
 from pick_common.containers import ContainerSpec
 from pick_common.specs import SceneSpec
 from pick_sim_world import conversions as conv
@@ -45,7 +46,7 @@ def main() -> None:
             states = world.snapshot()
             totals = {}
             for kind, build in (
-                    ('parts', partial(conv.states_to_msg, states, stamp, 'world', 'w/')),
+                    ('parts', partial(common.states_to_msg, states, stamp, 'world', 'w/')),
                     ('markers', partial(conv.markers_msg, world, states, stamp, 'w/'))):
                 build_ms, msg = median_ms(build, args.repeat)
                 serialize_ms, data = median_ms(partial(serialize_message, msg), args.repeat)
