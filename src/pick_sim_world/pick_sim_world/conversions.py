@@ -6,6 +6,7 @@ No rclpy here: messages are plain Python classes. Times are passed in as builtin
 """
 
 from collections.abc import Sequence
+import copy
 
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Point, Quaternion, Transform, TransformStamped, Vector3
@@ -102,7 +103,8 @@ def markers_msg(world: World, states: PartStates, stamp: Time, prefix: str) -> M
     primitive (CUBE, CYLINDER) or hull (TRIANGLE_LIST). Starts with DELETEALL.
 
     The world publishes this after every operation, so the primitives' poses are computed for
-    all parts at once and the shapes (scale, hull points) are built once per call."""
+    all parts at once, and the parts' markers are copies of one per instance, colour and
+    primitive that share its header, scale, colour and hull points."""
     out = MarkerArray(markers=[Marker(action=Marker.DELETEALL)])
     headers = {}
     marker_id = 0
@@ -135,14 +137,24 @@ def markers_msg(world: World, states: PartStates, stamp: Time, prefix: str) -> M
     positions = np.stack([states.poses[:, :3] + rotate(q, np.asarray(p.position, dtype=float))
                           for p in primitives], axis=1).tolist()
     orientations = np.stack([_quat_mul(q, p.orientation) for p in primitives], axis=1).tolist()
+    # Per instance, colour and primitive, one marker to copy: a copy shares the fields every
+    # part's marker has in common and skips the type checks a Marker built from keywords makes
+    # on each (building 1.8 to 2.2 times faster: bench/bench_conversions.py).
+    templates: dict[tuple[int, bool, int], Marker] = {}
     for pid, inst, inside, part_positions, part_orientations in zip(
             states.ids.tolist(), states.instances.tolist(), states.inside.tolist(), positions,
             orientations, strict=True):
-        header, ns = headers[inst], f'part_{pid}'
-        color = _PART_COLOR if inside else _ESCAPED_COLOR
-        for k, ((kind, scale, points), position, orientation) in enumerate(zip(
-                shapes, part_positions, part_orientations, strict=True)):
-            out.markers.append(Marker(
-                header=header, ns=ns, id=k, type=kind, scale=scale, color=color, points=points,
-                pose=pose_msg(position, orientation)))
+        ns = f'part_{pid}'
+        for k, (position, orientation) in enumerate(zip(part_positions, part_orientations,
+                                                        strict=True)):
+            template = templates.get((inst, inside, k))
+            if template is None:
+                kind, scale, points = shapes[k]
+                template = templates[inst, inside, k] = Marker(
+                    header=headers[inst], id=k, type=kind, scale=scale, points=points,
+                    color=_PART_COLOR if inside else _ESCAPED_COLOR)
+            marker = copy.copy(template)
+            marker.ns = ns
+            marker.pose = pose_msg(position, orientation)
+            out.markers.append(marker)
     return out

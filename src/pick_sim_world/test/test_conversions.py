@@ -17,6 +17,12 @@ def test_each_part_marker_is_its_primitive_placed_by_the_part_pose(model):
     with World(SceneSpec(ContainerSpec.tray(), PartSpec(model=model), 2, seed=4)) as world:
         world.drop(12)
         states = world.snapshot()
+        # Parts in and out of their container in both instances: markers_msg copies one
+        # marker per instance, colour and primitive.
+        states.inside[::3] = False
+        assert set(zip(states.instances.tolist(), states.inside.tolist(),
+                       strict=True)) == {
+            (0, True), (0, False), (1, True), (1, False)}
         msg = conv.markers_msg(world, states, Time(sec=3), 'w/')
         primitives = world.part.primitives
     assert msg.markers[0].action == Marker.DELETEALL
