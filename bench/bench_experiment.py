@@ -5,8 +5,12 @@ one, the peak memory of each worker's processes, and whether the result files of
 identical (they must be).
 
     tools/ws python bench/bench_experiment.py [FILE] [--iterations N] [--workers 1 2]
-        [--paper-case RUN_DIR ...]
+        [--rounds R] [--paper-case RUN_DIR ...]
     (default: the built-in experiment file)
+
+--rounds R runs the three R times in turn and prints the ratio and the throughput of each
+round and their medians (the table sums the rounds): on this shared machine single runs of the
+same code spread by 10 % and more (docs/benchmarks.md, 2026-11-26), more than most levers.
 
 --iterations N caps every experiment of FILE at N iterations (as `run --iterations` does), so
 that a test-case file can be the workload: e.g. `--iterations 2
@@ -23,6 +27,7 @@ import argparse
 import collections
 import os
 import re
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -107,6 +112,24 @@ def graph(path: str, work: str, workers: int) -> tuple[str, float, dict]:
     return re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1), wall, peaks
 
 
+def one_round(file, path: str, work: str, a: int, b: int) -> dict:
+    """The file on the cores, then through the graph with `a` and with `b` workers: wall time
+    per type, spans, peak memory and whether the result files are identical."""
+    start = time.perf_counter()
+    local_dir = os.path.join(work, 'local')
+    with LocalBackend() as backend, ResultsWriter(local_dir, file.text) as writer:
+        Runner(file, [backend], writer).run()
+    local_wall = time.perf_counter() - start
+    dir_a, wall_a, mem_a = graph(path, work, a)
+    dir_b, wall_b, mem_b = graph(path, work, b)
+    identical = all(rows(d, name, ('wall_time',)) == rows(local_dir, name, ('wall_time',))
+                    for d in (dir_a, dir_b) for name in FILES)
+    (g, count), (c, _) = per_type(dir_a), per_type(local_dir)
+    return {'graph': g, 'cores': c, 'count': count, 'identical': identical,
+            'span_a': run_span(dir_a), 'span_b': run_span(dir_b), 'local_wall': local_wall,
+            'wall_a': wall_a, 'wall_b': wall_b, 'mem_a': mem_a, 'mem_b': mem_b}
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('file', nargs='?', default=None)
@@ -116,7 +139,12 @@ def main() -> int:
                         help="run directories of the paper's full test case, made before")
     parser.add_argument('--iterations', type=int, metavar='N',
                         help='cap every experiment of the file at N iterations')
+    parser.add_argument('--rounds', type=int, default=1, metavar='R',
+                        help='run cores, A and B workers R times in turn: runs of the same '
+                             'code on this shared machine spread by 10 %% and more')
     args = parser.parse_args()
+    if args.rounds < 1:
+        parser.error(f'--rounds: {args.rounds} must be at least 1')
     path = os.path.abspath(args.file or default_file())
     try:
         file = config.load(path)
@@ -132,33 +160,49 @@ def main() -> int:
             f.write(text)
         file = config.load(path)
 
-    start = time.perf_counter()
-    local_dir = os.path.join(work, 'local')
-    with LocalBackend() as backend, ResultsWriter(local_dir, file.text) as writer:
-        Runner(file, [backend], writer).run()
-    local_wall = time.perf_counter() - start
     a, b = args.workers
-    dir_a, wall_a, mem_a = graph(path, work, a)
-    dir_b, wall_b, mem_b = graph(path, work, b)
-
-    identical = all(rows(d, name, ('wall_time',)) == rows(local_dir, name, ('wall_time',))
-                    for d in (dir_a, dir_b) for name in FILES)
-    (g, n), (c, _) = per_type(dir_a), per_type(local_dir)
-    print(f'{file.id}: {sum(n.values())} iterations; wall time per iteration, s')
+    rounds = []
+    for r in range(args.rounds):
+        rounds.append(one_round(file, path, os.path.join(work, f'round_{r}'), a, b))
+    # wall time per type summed over the rounds; identical only if every round's files were
+    g: dict[str, float] = collections.defaultdict(float)
+    c: dict[str, float] = collections.defaultdict(float)
+    for x in rounds:
+        for kind, wall in x['graph'].items():
+            g[kind] += wall
+        for kind, wall in x['cores'].items():
+            c[kind] += wall
+    n = rounds[0]['count']
+    identical = all(x['identical'] for x in rounds)
+    print(f'{file.id}: {sum(n.values())} iterations' + (
+        f', {len(rounds)} rounds (cores, {a} worker(s), {b} worker(s) in turn)'
+        if len(rounds) > 1 else '') + '; wall time per iteration, s')
     print(f'{"experiment type":<18} {"n":>4} {f"graph, {a} worker(s)":>20} {"cores":>9} '
           f'{"ratio":>7}')
     for kind in config.TYPES:
         if kind in c:
-            print(f'{kind:<18} {n[kind]:4d} {g[kind] / n[kind]:20.3f} {c[kind] / n[kind]:9.3f} '
+            k = n[kind] * len(rounds)
+            print(f'{kind:<18} {n[kind]:4d} {g[kind] / k:20.3f} {c[kind] / k:9.3f} '
                   f'{g[kind] / c[kind]:7.2f}')
-    print(f'{"all iterations":<18} {sum(n.values()):4d} {sum(g.values()):19.2f}s '
-          f'{sum(c.values()):8.2f}s {sum(g.values()) / sum(c.values()):7.2f}')
-    span_a, span_b = run_span(dir_a), run_span(dir_b)
-    print(f'\nthe run (first iteration to last summary): {a} worker(s) {span_a:.2f} s, '
-          f'{b} worker(s) {span_b:.2f} s: throughput x{span_a / span_b:.2f}')
-    print(f'the whole command: cores {local_wall:.2f} s; graph {a} worker(s) {wall_a:.2f} s, '
-          f'{b} worker(s) {wall_b:.2f} s (starting processes and the report included)')
-    for workers, peaks in ((a, mem_a), (b, mem_b)):
+    print(f'{"all iterations":<18} {sum(n.values()):4d} {sum(g.values()) / len(rounds):19.2f}s '
+          f'{sum(c.values()) / len(rounds):8.2f}s {sum(g.values()) / sum(c.values()):7.2f}')
+    if len(rounds) > 1:
+        ratios = [sum(x['graph'].values()) / sum(x['cores'].values()) for x in rounds]
+        gains = [x['span_a'] / x['span_b'] for x in rounds]
+        print(f'by round: graph / cores {", ".join(f"{v:.2f}" for v in ratios)} (median '
+              f'{statistics.median(ratios):.2f}); throughput of {b} against {a} '
+              f'{", ".join(f"x{v:.2f}" for v in gains)} (median x{statistics.median(gains):.2f})')
+    for x in rounds:
+        print(f'\nthe run (first iteration to last summary): {a} worker(s) {x["span_a"]:.2f} s, '
+              f'{b} worker(s) {x["span_b"]:.2f} s: throughput x{x["span_a"] / x["span_b"]:.2f}')
+        print(f'the whole command: cores {x["local_wall"]:.2f} s; graph {a} worker(s) '
+              f'{x["wall_a"]:.2f} s, {b} worker(s) {x["wall_b"]:.2f} s (starting processes and '
+              'the report included)')
+    for workers, key in ((a, 'mem_a'), (b, 'mem_b')):
+        peaks: dict[tuple[str, str], int] = {}
+        for x in rounds:
+            for node, kb in x[key].items():
+                peaks[node] = max(kb, peaks.get(node, 0))
         per_worker: dict[str, int] = collections.defaultdict(int)
         for (worker, _), kb in peaks.items():
             if worker:
