@@ -78,9 +78,10 @@ class Runner:
         self._rank: dict[tuple, tuple[int, int]] = {}   # key -> (experiment, plan position)
         self._ready: list[tuple[tuple[int, int], Unit]] = []    # a heap by rank
         self._left: dict[str, int] = {}                # planned experiment -> units unwritten
-        # adaptive sampling: experiment -> group -> its units not released yet, in order; and
-        # experiment -> batches released
+        # adaptive sampling: experiment -> group -> its units not released yet, in order;
+        # experiment -> the (group, iteration) of its units released; and -> batches released
         self._unreleased: dict[str, dict[int, list[Unit]]] = {}
+        self._released: dict[str, set[tuple[int, int]]] = {}
         self._looks: dict[str, int] = {}
         self._waiting = list(file.experiments)         # not planned yet
         self._errors: list[BaseException] = []
@@ -153,6 +154,7 @@ class Runner:
                     for u in units:
                         unreleased.setdefault(u.group, []).append(u)
                     self._unreleased[exp.id] = unreleased
+                    self._released[exp.id] = set()
                     self._looks[exp.id] = 0
                     self._next_batch(exp, list(unreleased))
                 else:
@@ -185,16 +187,23 @@ class Runner:
                 self._finish(exp)
                 return
             self._looks[exp.id] += 1
+            self._released[exp.id].update((u.group, u.iteration) for u in units)
             self._queue(exp, units)
             if self._left[exp.id]:
                 return
             groups = self._unsettled(exp)
 
     def _unsettled(self, exp: Experiment) -> list[int]:
-        """The groups of an adaptive experiment that need more iterations and have some."""
-        checks = self.sink.checks(exp.id) if exp.type == GRIPPER_SWEEP else []
-        return [g for g in sampling.unsettled(self.file, exp, self.sink.iterations(exp.id),
-                                              checks)
+        """The groups of an adaptive experiment that need more iterations and have some.
+        It looks at the rows of the batches released so far only: a resumed run may have
+        written rows of later ones (in flight when the run was cut), which the uncut run's look
+        at this point had not seen."""
+        released = self._released[exp.id]
+        rows = [r for r in self.sink.iterations(exp.id)
+                if (r['group'], r['iteration']) in released]
+        checks = ([c for c in self.sink.checks(exp.id) if (c['group'], c['iteration']) in released]
+                  if exp.type == GRIPPER_SWEEP else [])
+        return [g for g in sampling.unsettled(self.file, exp, rows, checks)
                 if self._unreleased[exp.id][g]]
 
     def _finish(self, exp: Experiment) -> None:

@@ -144,8 +144,9 @@ HOPELESS = ('id: stop_early\nseed: 3\npart: {model: radial_capacitor}\n'
 
 
 def run(mode: str, directory: str, writer=ResultsWriter, resume: bool = False,
-        progress=None) -> dict:
-    file = config.parse(HOPELESS + f'sampling: {{mode: {mode}, batch: 2}}\n', SMALL)
+        progress=None, required: float = 0.9) -> dict:
+    file = config.parse(HOPELESS + f'sampling: {{mode: {mode}, batch: 2}}\n'
+                        f'requirements: {{success_rate: {required}}}\n', SMALL)
     with LocalBackend() as backend, writer(directory, file.text, resume) as sink:
         return Runner(file, [backend], sink, progress).run()
 
@@ -190,4 +191,28 @@ def test_an_interrupted_adaptive_run_resumes_to_the_same_batches_and_results(tmp
         run('adaptive', out, StopAtTheThird)
     assert len(read(out)) == 2
     assert run('adaptive', out, resume=True) == whole
+    assert read(out) == read(str(tmp_path / 'whole'))
+
+
+def test_a_resumed_adaptive_run_looks_only_at_the_batches_it_released(tmp_path):
+    """At a 95 % requirement, 0 of 2 runs does not settle the verdict and 0 of 3 does. A run
+    cut after the second batch's first iteration has written 3 rows; resumed, its first look
+    must see the first batch's 2, as the uncut run's did, and not stop at 3."""
+    class Interrupt(Exception):
+        pass
+
+    class StopAtTheFourth(ResultsWriter):
+        def write(self, record):
+            if record.iteration['iteration'] == 3:
+                raise Interrupt
+            super().write(record)
+
+    assert not sampling.rate_settled(0, 2, 0.95) and sampling.rate_settled(0, 3, 0.95)
+    whole = run('adaptive', str(tmp_path / 'whole'), required=0.95)
+    assert whole['experiments']['feeder']['iterations'] == 4
+    out = str(tmp_path / 'cut')
+    with pytest.raises(Interrupt):
+        run('adaptive', out, StopAtTheFourth, required=0.95)
+    assert len(read(out)) == 3
+    assert run('adaptive', out, resume=True, required=0.95) == whole
     assert read(out) == read(str(tmp_path / 'whole'))
