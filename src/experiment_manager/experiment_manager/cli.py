@@ -159,8 +159,10 @@ def _summary_lines(summary: dict) -> list[str]:
                          f'emptied, parts removed mean {r["mean"]:.3g} (min {r["min"]:g}, '
                          f'max {r["max"]:g})')
         elif kind == 'table_sweep':
-            lines.append(f'  {exp_id} (table_sweep): optimum {s.get("n_star")} parts, range '
-                         f'{s.get("optimal_range")}')
+            ci = s.get('n_star_ci95')
+            lines.append(f'  {exp_id} (table_sweep): optimum {s.get("n_star")} parts'
+                         + (f' (95 % interval {ci[0]}-{ci[1]})' if ci else '')
+                         + f', range {s.get("optimal_range")}')
         elif kind == 'gripper_sweep':
             found = s['smallest']
             lines.append(f'  {exp_id} (gripper_sweep): ' + (

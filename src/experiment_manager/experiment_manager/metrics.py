@@ -34,6 +34,7 @@ FAULTS = (PHYSICS_FAULT, TUNNELLED, THROWN, UNSETTLED)
 EXCLUDED = (PHYSICS_FAULT, TUNNELLED, THROWN)
 
 FIT_ORDER = 4
+BOOTSTRAP = 4000        # resamples of a table_sweep's iterations for the interval of n*
 
 
 def stats(values) -> dict:
@@ -128,12 +129,12 @@ def bin_emptying(exp: Experiment, rows: list[dict], picks: list[dict]) -> dict:
             'first_check': _fractions(rows)}
 
 
-def fit(counts: np.ndarray, valid: np.ndarray, order: int, first: int, last: int
-        ) -> tuple[np.ndarray, np.ndarray]:
-    """The polynomial fit of `order` of valid parts against counts, and its maximum over the
-    integers in [first, last]; `valid` (N,) or (N, K): K fits at once (coefficients (order + 1,
-    K), maxima (K,))."""
-    coefficients = np.polyfit(counts, valid, order)
+def fit(counts: np.ndarray, valid: np.ndarray, order: int, first: int, last: int,
+        weights: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The polynomial fit of `order` of valid parts against counts (least squares, each
+    residual times its `weights`), and its maximum over the integers in [first, last]; `valid`
+    (N,) or (N, K): K fits at once (coefficients (order + 1, K), maxima (K,))."""
+    coefficients = np.polyfit(counts, valid, order, w=weights)
     grid = np.arange(first, last + 1)
     values = np.polyval(coefficients, grid if valid.ndim == 1 else grid[:, None])
     return coefficients, grid[np.argmax(values, axis=0)]
@@ -158,16 +159,43 @@ def fit_optimum(counts, valid, first: int, last: int, margin: int) -> dict:
             'optimal_range': [max(1, best - margin), best + margin], 'no_valid': no_valid}
 
 
-def table_sweep(exp: Experiment, rows: list[dict]) -> dict:
-    per_n = []
+def n_star_interval(counts, by_count: list, order: int, first: int, last: int,
+                    confidence: float, rng: np.random.Generator) -> tuple[int, int] | None:
+    """The bootstrap interval of n*: BOOTSTRAP fits of `order`, each to the iterations
+    resampled within each count (`by_count[i]`: the valid parts of `counts[i]`'s iterations),
+    and the quantiles of their maxima over [first, last]; None while a count has fewer than two
+    iterations (one says nothing of its spread). Each fit is the least-squares fit to every
+    iteration, computed on the counts' means weighted by their iterations (the same
+    coefficients, and a hundred times fewer rows)."""
+    if order < 1 or any(len(v) < 2 for v in by_count):
+        return None
+    means = np.stack([np.asarray(v, dtype=float)[rng.integers(0, len(v), (len(v), BOOTSTRAP))]
+                      .mean(axis=0) for v in by_count])
+    _, stars = fit(np.asarray(counts, dtype=float), means, order, first, last,
+                   np.sqrt([len(v) for v in by_count]))
+    tail = (1.0 - confidence) / 2.0
+    return (int(np.quantile(stars, tail, method='lower')),
+            int(np.quantile(stars, 1.0 - tail, method='higher')))
+
+
+def table_sweep(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> dict:
+    """Valid parts per count, the fit and its n* with optimal range, and `n_star_ci95`: n*'s
+    95 % bootstrap interval (n_star_interval, seeded by the file's seed and the rows), when
+    every count has two iterations or more."""
+    per_n, by_count = [], []
     for n in exp.counts:
         mine = [r['valid'] for r in rows if r['group'] == n]
+        by_count.append(mine)
         if mine:
             per_n.append({'n': n, 'valid': stats(mine)})
     out = {'iterations': exp.iterations, 'per_n': per_n, 'margin': exp.margin}
     if rows:
         out.update(fit_optimum([r['group'] for r in rows], [r['valid'] for r in rows],
                                exp.counts[0], exp.counts[-1], exp.margin))
+        found = n_star_interval(exp.counts, by_count, out['order'], exp.counts[0],
+                                exp.counts[-1], 0.95, np.random.default_rng([file.seed, len(rows)]))
+        if found:
+            out['n_star_ci95'] = list(found)
     return out
 
 
@@ -285,7 +313,7 @@ def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: li
     elif exp.type == BIN_EMPTYING:
         out = bin_emptying(exp, rows, picks)
     elif exp.type == TABLE_SWEEP:
-        out = table_sweep(exp, rows)
+        out = table_sweep(file, exp, rows)
     elif exp.type == GRIPPER_SWEEP:
         out = gripper_sweep(exp, rows, checks)
     else:

@@ -252,11 +252,20 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
                       'nothing (the feeder runs use them all the same, and cannot empty the '
                       'table).', '']
         if 'n_star' in s:
+            ci = s.get('n_star_ci95')
             lines += [f'Fit of order {s["order"]}: the most valid parts at n* = {s["n_star"]} '
-                      f'parts on the table; optimal range {s["optimal_range"][0]}-'
-                      f'{s["optimal_range"][1]}' + (
+                      f'parts on the table' + (f' (95 % interval {ci[0]}-{ci[1]}, bootstrap)'
+                                               if ci else '') +
+                      f'; optimal range {s["optimal_range"][0]}-{s["optimal_range"][1]}' + (
                           f' (paper: n* = {paper["n_star"]}, {paper["range"][0]}-'
                           f'{paper["range"][1]}).' if paper else '.')]
+            low, high = s['optimal_range']
+            if ci and (ci[0] < low or ci[1] > high):
+                lines += ['', f'**Note**: the interval of n* reaches beyond the optimal '
+                          f'range: these drops do not pin n* down to it, and others of the same '
+                          f'parts could put it anywhere in {ci[0]}-{ci[1]}. Compare the valid '
+                          f'parts per check across that span (figure 15) before relying on '
+                          f'the range.']
             tested = [p['n'] for p in s['per_n']]
             if tested and s['optimal_range'][1] > max(tested):
                 lines += ['', f'**Warning**: the optimal range runs past the last count tested '

@@ -21,10 +21,10 @@ What settles each decision, looked at after every batch:
 - bin_static, a race: a bin leaves it when the interval of its mean container-free fraction lies
   wholly below the interval of the leading bin's (the highest mean). The race ends with one bin
   left (the best bin) or at the most iterations.
-- table_sweep: the optimum n* of the fit, bootstrapped (iterations resampled within each
-  count, BOOTSTRAP fits, a seed of the file's): settled when the interval of n* lies inside the
-  optimal range n* +- margin, so the feeder runs' range holds the optimum. Every count gets
-  each batch (the fit needs its whole curve).
+- table_sweep: the optimum n* of the fit, bootstrapped (metrics.n_star_interval: iterations
+  resampled within each count, a seed of the file's): settled when the interval of n* lies
+  inside the optimal range n* +- margin, so the feeder runs' range holds the optimum. Every
+  count gets each batch (the fit needs its whole curve).
 - gripper_sweep: the smallest gripper meeting min_valid (metrics.gripper_sweep): settled when,
   in size order, every gripper before the first that meets is known not to meet (its interval
   of valid parts per check lies below min_valid) and that one is known to meet (its interval's
@@ -52,7 +52,6 @@ from .config import (
 from .plan import groups
 
 INTERIM_CONFIDENCE = 0.999
-BOOTSTRAP = 4000        # fits of resampled iterations per look of a table_sweep
 
 
 def unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict],
@@ -122,24 +121,18 @@ def _racing(exp: Experiment, rows: list[dict]) -> list[int]:
 
 def _optimum_settled(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> bool:
     """The bootstrap interval of n* (INTERIM_CONFIDENCE) lies inside n* +- margin."""
-    by_count = [np.array([r['valid'] for r in rows if r['group'] == n], dtype=float)
-                for n in exp.counts]
+    by_count = [[r['valid'] for r in rows if r['group'] == n] for n in exp.counts]
     if any(len(v) < 2 for v in by_count):
         return False
-    counts = np.concatenate([np.full(len(v), n, dtype=float)
-                             for n, v in zip(exp.counts, by_count, strict=True)])
     first, last = exp.counts[0], exp.counts[-1]
-    fitted = metrics.fit_optimum(counts, np.concatenate(by_count), first, last, exp.margin)
+    fitted = metrics.fit_optimum([r['group'] for r in rows], [r['valid'] for r in rows],
+                                 first, last, exp.margin)
     if fitted['order'] < 1:
         return True         # one count: n* is that count
     best = fitted['n_star']
-    # every column a resample of the iterations within each count
-    rng = np.random.default_rng([file.seed, len(rows)])
-    resampled = np.concatenate([v[rng.integers(0, len(v), (len(v), BOOTSTRAP))]
-                                for v in by_count])
-    _, stars = metrics.fit(counts, resampled, fitted['order'], first, last)
-    tail = (1.0 - INTERIM_CONFIDENCE) / 2.0
-    low, high = np.quantile(stars, [tail, 1.0 - tail])
+    low, high = metrics.n_star_interval(exp.counts, by_count, fitted['order'], first, last,
+                                        INTERIM_CONFIDENCE,
+                                        np.random.default_rng([file.seed, len(rows)]))
     return best - exp.margin <= low and high <= best + exp.margin
 
 

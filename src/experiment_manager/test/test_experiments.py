@@ -11,6 +11,7 @@ import time
 
 from experiment_manager import config, metrics
 from experiment_manager.backend import WorkerLost
+from experiment_manager.cli import _summary_lines
 from experiment_manager.local_backend import LocalBackend
 from experiment_manager.plan import iteration_seed, plan, Unit
 from experiment_manager.procedures import faults, Iteration, run_unit, search_order
@@ -68,6 +69,10 @@ def test_every_type_records_its_rows_and_metrics(small):
     assert [x['n'] for x in sweep['per_n']] == [2, 6, 10, 14]
     assert 2 <= sweep['n_star'] <= 14 and sweep['order'] == 3
     assert sweep['optimal_range'] == [max(1, sweep['n_star'] - 2), sweep['n_star'] + 2]
+    low, high = sweep['n_star_ci95']        # two iterations a count: a bootstrap interval
+    assert 2 <= low <= sweep['n_star'] <= high <= 14
+    assert (f'  sweep (table_sweep): optimum {sweep["n_star"]} parts (95 % interval {low}-'
+            f'{high}), range {sweep["optimal_range"]}') in _summary_lines(summary)
     # feeder_emptying: the range came from the sweep; the run stopped by the policy.
     feeder = by_type['feeder_emptying'][0]
     assert s['feeder']['optimal_range'] == sweep['optimal_range']
@@ -496,3 +501,31 @@ def test_the_fit_finds_the_maximum_of_a_known_curve():
     assert metrics.stats([1, 2, 3]) == {'n': 3, 'mean': 2.0, 'min': 1.0, 'max': 3.0,
                                         'std': 1.0}
     assert metrics.stats([])['mean'] is None
+
+
+def test_the_interval_of_n_star_is_the_row_fits_bootstrap_and_narrows_with_the_draws():
+    counts = np.arange(5, 101, 5)
+    rng = np.random.default_rng(3)
+
+    def draws(noise, m):
+        return [20.0 - 0.01 * (n - 60.0) ** 2 + rng.normal(0.0, noise, m) for n in counts]
+
+    by_count = draws(2.0, 6)
+    low, high = metrics.n_star_interval(counts, by_count, 4, 5, 100, 0.95,
+                                        np.random.default_rng(7))
+    # The same resamples fitted row by row (as the summary's fit is) give the same n*s.
+    same = np.random.default_rng(7)
+    rows = np.concatenate([v[same.integers(0, len(v), (len(v), metrics.BOOTSTRAP))]
+                           for v in by_count])
+    _, stars = metrics.fit(np.repeat(counts, 6).astype(float), rows, 4, 5, 100)
+    assert (low, high) == (np.quantile(stars, 0.025, method='lower'),
+                           np.quantile(stars, 0.975, method='higher'))
+    assert low <= 60 <= high
+    many = draws(2.0, 60)
+    tight = metrics.n_star_interval(counts, many, 4, 5, 100, 0.95, np.random.default_rng(7))
+    assert tight[0] <= 60 <= tight[1] and tight[1] - tight[0] < high - low
+    wide = metrics.n_star_interval(counts, many, 4, 5, 100, 0.999, np.random.default_rng(7))
+    assert wide[0] <= tight[0] and tight[1] <= wide[1]
+    # a count with one iteration says nothing of its spread
+    assert metrics.n_star_interval(counts, [v[:1] for v in by_count], 4, 5, 100, 0.95,
+                                   np.random.default_rng(7)) is None

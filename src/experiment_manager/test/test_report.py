@@ -56,6 +56,14 @@ def test_the_report_warns_where_the_optimal_range_runs_past_the_counts_tested(ru
     last = max(p['n'] for p in sweep['per_n'])
     sweep.update(n_star=last - 4, optimal_range=[last - 6, last - 2])
     assert 'Warning' not in report.markdown(s, {}, {})
+    # n*'s interval, and a note when it reaches beyond the range
+    sweep['n_star_ci95'] = [last - 5, last - 3]
+    text = report.markdown(s, {}, {})
+    assert (f'n* = {last - 4} parts on the table (95 % interval {last - 5}-{last - 3}, '
+            'bootstrap); optimal range') in text and '**Note**' not in text
+    sweep['n_star_ci95'] = [last - 10, last]
+    assert f'could put it anywhere in {last - 10}-{last}.' in report.markdown(s, {}, {})
+    del sweep['n_star_ci95']
     sweep.update(n_star=last, optimal_range=[last - 2, last + 2])
     assert (f'**Warning**: the optimal range runs past the last count tested ({last} parts): '
             'beyond it the fit is an extrapolation, and n* sits at that count') in \
