@@ -129,30 +129,35 @@ def bin_emptying(exp: Experiment, rows: list[dict], picks: list[dict]) -> dict:
             'first_check': _fractions(rows)}
 
 
-def fit(counts: np.ndarray, valid: np.ndarray, order: int, first: int, last: int,
-        weights: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """The polynomial fit of `order` of valid parts against counts (least squares, each
-    residual times its `weights`), and its maximum over the integers in [first, last]; `valid`
-    (N,) or (N, K): K fits at once (coefficients (order + 1, K), maxima (K,))."""
-    coefficients = np.polyfit(counts, valid, order, w=weights)
+def fit(counts: np.ndarray, means: np.ndarray, order: int, first: int, last: int
+        ) -> tuple[np.ndarray, np.ndarray]:
+    """The least-squares polynomial of `order` through the counts' mean valid parts, every
+    count weighing the same, and its maximum over the integers in [first, last]; `means` (K,)
+    or (K, B): B fits at once (coefficients (order + 1, B), maxima (B,)). With as many
+    iterations at every count (the fixed counts) this is the fit to every iteration; an
+    adaptive sweep that drops more at some counts than at others fits the same curve."""
+    coefficients = np.polyfit(counts, means, order)
     grid = np.arange(first, last + 1)
-    values = np.polyval(coefficients, grid if valid.ndim == 1 else grid[:, None])
+    values = np.polyval(coefficients, grid if means.ndim == 1 else grid[:, None])
     return coefficients, grid[np.argmax(values, axis=0)]
 
 
 def fit_optimum(counts, valid, first: int, last: int, margin: int) -> dict:
     """The polynomial fit (order 4, lower with fewer distinct counts) of valid parts against
-    parts on the table, n* at its maximum over the integers in [first, last], and the range
-    [max(1, n* - margin), n* + margin]. Coefficients highest power first."""
-    n = np.asarray(counts, dtype=float)
-    order = min(FIT_ORDER, len(np.unique(n)) - 1)
+    parts on the table (`counts`, `valid`: one per iteration; fit), n* at its maximum over the
+    integers in [first, last], and the range [max(1, n* - margin), n* + margin]. Coefficients
+    highest power first."""
+    n, v = np.asarray(counts, dtype=float), np.asarray(valid, dtype=float)
+    tested = np.unique(n)
+    order = min(FIT_ORDER, len(tested) - 1)
     # No valid part at any count: the fit is flat and n* says nothing.
-    no_valid = not np.any(np.asarray(valid) > 0)
+    no_valid = not np.any(v > 0)
     if order < 1:
         best = int(n[0])
-        return {'order': 0, 'coefficients': [float(np.mean(valid))], 'n_star': best,
+        return {'order': 0, 'coefficients': [float(np.mean(v))], 'n_star': best,
                 'optimal_range': [max(1, best - margin), best + margin], 'no_valid': no_valid}
-    coefficients, best = fit(n, np.asarray(valid, dtype=float), order, first, last)
+    means = np.array([v[n == c].mean() for c in tested])
+    coefficients, best = fit(tested, means, order, first, last)
     best = int(best)
     return {'order': order, 'coefficients': coefficients.tolist(), 'n_star': best,
             'fit_max': float(np.polyval(coefficients, best)),
@@ -161,18 +166,15 @@ def fit_optimum(counts, valid, first: int, last: int, margin: int) -> dict:
 
 def n_star_interval(counts, by_count: list, order: int, first: int, last: int,
                     confidence: float, rng: np.random.Generator) -> tuple[int, int] | None:
-    """The bootstrap interval of n*: BOOTSTRAP fits of `order`, each to the iterations
-    resampled within each count (`by_count[i]`: the valid parts of `counts[i]`'s iterations),
-    and the quantiles of their maxima over [first, last]; None while a count has fewer than two
-    iterations (one says nothing of its spread). Each fit is the least-squares fit to every
-    iteration, computed on the counts' means weighted by their iterations (the same
-    coefficients, and a hundred times fewer rows)."""
+    """The bootstrap interval of n*: BOOTSTRAP fits of `order` (fit), each to the counts'
+    means of their iterations resampled (`by_count[i]`: the valid parts of `counts[i]`'s
+    iterations), and the quantiles of their maxima over [first, last]; None while a count has
+    fewer than two iterations (one says nothing of its spread)."""
     if order < 1 or any(len(v) < 2 for v in by_count):
         return None
     means = np.stack([np.asarray(v, dtype=float)[rng.integers(0, len(v), (len(v), BOOTSTRAP))]
                       .mean(axis=0) for v in by_count])
-    _, stars = fit(np.asarray(counts, dtype=float), means, order, first, last,
-                   np.sqrt([len(v) for v in by_count]))
+    _, stars = fit(np.asarray(counts, dtype=float), means, order, first, last)
     tail = (1.0 - confidence) / 2.0
     return (int(np.quantile(stars, tail, method='lower')),
             int(np.quantile(stars, 1.0 - tail, method='higher')))

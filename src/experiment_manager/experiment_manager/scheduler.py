@@ -9,6 +9,7 @@ decision is not settled (sampling.py). A worker that is lost gives its iteration
 queue and may come back (Backend.rejoin).
 """
 
+import collections
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 import heapq
@@ -173,14 +174,16 @@ class Runner:
                 self._left[exp.id] += 1
 
     def _next_batch(self, exp: Experiment, groups: list[int]) -> None:
-        """Release the next batch of an adaptive experiment's `groups`; while a batch was all
-        written already (a resumed run), look at the rows again; finish the experiment when its
-        decision is settled or its iterations are spent (under the lock)."""
+        """Release the next batch of an adaptive experiment's `groups` (a group listed k times:
+        k batches); while a batch was all written already (a resumed run), look at the rows
+        again; finish the experiment when its decision is settled or its iterations are spent
+        (under the lock)."""
         unreleased, batch = self._unreleased[exp.id], self.file.sampling.batch
         while True:
-            units = [u for g in groups for u in unreleased[g][:batch]]
-            for g in groups:
-                del unreleased[g][:batch]
+            wanted = collections.Counter(groups)
+            units = [u for g, k in wanted.items() for u in unreleased[g][:k * batch]]
+            for g, k in wanted.items():
+                del unreleased[g][:k * batch]
             if not units:
                 self._total -= sum(map(len, unreleased.values()))     # not needed
                 unreleased.clear()

@@ -498,6 +498,9 @@ def test_the_fit_finds_the_maximum_of_a_known_curve():
     fit = metrics.fit_optimum(n, valid, 1, 60, 5)
     assert fit['order'] == 4 and fit['n_star'] == 37 and fit['optimal_range'] == [32, 42]
     assert metrics.fit_optimum([4, 4], [1, 3], 4, 4, 5)['optimal_range'] == [1, 9]
+    # Every count weighs the same, however many iterations it had (an adaptive sweep's).
+    uneven = metrics.fit_optimum([1, 1, 1, 1, 2, 3], [0, 0, 0, 4, 3, 1], 1, 3, 1)
+    assert np.allclose(uneven['coefficients'], np.polyfit([1, 2, 3], [1, 3, 1], 2))
     assert metrics.stats([1, 2, 3]) == {'n': 3, 'mean': 2.0, 'min': 1.0, 'max': 3.0,
                                         'std': 1.0}
     assert metrics.stats([])['mean'] is None
@@ -513,7 +516,8 @@ def test_the_interval_of_n_star_is_the_row_fits_bootstrap_and_narrows_with_the_d
     by_count = draws(2.0, 6)
     low, high = metrics.n_star_interval(counts, by_count, 4, 5, 100, 0.95,
                                         np.random.default_rng(7))
-    # The same resamples fitted row by row (as the summary's fit is) give the same n*s.
+    # The same resamples fitted row by row give the same n*s: with as many iterations at
+    # every count, the fit to the counts' means is the fit to every iteration.
     same = np.random.default_rng(7)
     rows = np.concatenate([v[same.integers(0, len(v), (len(v), metrics.BOOTSTRAP))]
                            for v in by_count])

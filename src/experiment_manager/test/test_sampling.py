@@ -114,6 +114,36 @@ def test_a_sweep_is_settled_when_the_optimum_s_interval_lies_inside_its_range():
     assert sampling.unsettled(file, exp, rows(0.3, 1)) == list(exp.counts)    # one each
 
 
+def test_a_sweep_places_its_next_drops_where_they_narrow_n_star_most():
+    """Looks as the scheduler makes them, on rows drawn from a known curve (n* = 50): the
+    placed batches settle n* with fewer parts dropped than a batch at every count, never drop
+    more at a look, and never ask for a count that has no iterations left."""
+    file = small(mode='adaptive', batch=5)
+    exp = replace(file.experiment('sweep'), counts=tuple(range(10, 101, 10)), margin=5,
+                  iterations=40)
+    drawn = {c: 20 - (c - 50) ** 2 / 100 + np.random.default_rng(c).normal(0, 3, 40)
+             for c in exp.counts}
+
+    def sweep(everywhere: bool) -> tuple[int, int]:
+        taken = dict.fromkeys(exp.counts, 5)
+        while True:
+            rows = [row(c, i, valid=drawn[c][i]) for c in exp.counts for i in range(taken[c])]
+            wanted = sampling.unsettled(file, exp, rows)
+            if not wanted:
+                return metrics.table_sweep(file, exp, rows)['n_star'], sum(
+                    c * k for c, k in taken.items())
+            if everywhere:
+                wanted = [c for c in exp.counts if taken[c] < 40]
+            assert all(taken[c] < 40 for c in wanted)
+            assert sum(wanted) * 5 <= 5 * sum(exp.counts)
+            for c in wanted:
+                taken[c] = min(40, taken[c] + 5)
+
+    placed, uniform = sweep(everywhere=False), sweep(everywhere=True)
+    assert abs(placed[0] - 50) <= 2 and abs(uniform[0] - 50) <= 2
+    assert placed[1] < uniform[1]
+
+
 def test_a_gripper_sweep_is_settled_by_the_smallest_gripper_s_decision():
     file = small()
     exp = replace(file.experiment('grippers'), min_valid=2.0)   # 8 variants, 0 the smallest
