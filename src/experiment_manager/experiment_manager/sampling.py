@@ -140,16 +140,16 @@ def _optimum_settled(file: ExperimentFile, exp: Experiment, rows: list[dict]) ->
 
 def _sweep_batches(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> list[int]:
     """Where a sweep's next look puts its iterations: as many parts' worth of drops as a batch
-    at every count, given a batch at a time to the count where a batch
-    shrinks the variance of the fit's slope at n* most per part dropped (a greedy sequential
-    c-optimal design: n* is where that slope crosses zero, so its spread is the slope's over
-    the curvature). The fit weighs every count's mean the same (metrics.fit), so the slope's
-    variance is the sum over counts of influence^2 x variance / iterations, and more drops at
-    a count narrow n* without moving the curve the fixed counts fit. Each count's variance of
-    valid parts is smoothed by a quadratic in n (a count seen five times can show no spread by
-    chance). A count listed k times gets k batches. Every count has had the first batch, so
-    the whole curve is known. Falls back to a batch at every count when the fit cannot say
-    (no spread at all, too few counts, or a count seen fewer than twice)."""
+    at every count, given a batch at a time to the count where a batch shrinks the variance of
+    the fit's slope at n* most per part dropped (a greedy sequential c-optimal design: n* is
+    where that slope crosses zero, so its spread is the slope's over the curvature). The fit
+    weighs every count's mean the same (metrics.fit), so the slope's variance is the sum over
+    counts of influence^2 x variance / iterations, and more drops at a count narrow n* without
+    moving the curve the fixed counts fit. Each count's variance of valid parts is smoothed by
+    a quadratic in n (a count seen five times can show no spread by chance). A count listed k
+    times gets k batches. Every count has had the first batch, so the whole curve is known.
+    Falls back to a batch at every count when the fit cannot say (no spread at all, too few
+    counts, or a count seen fewer than twice)."""
     batch = file.sampling.batch
     counts = np.array(exp.counts, dtype=float)
     by_count = [np.array([r['valid'] for r in rows if r['group'] == n], dtype=float)
