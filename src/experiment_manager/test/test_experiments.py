@@ -519,8 +519,9 @@ def test_the_interval_of_n_star_is_the_row_fits_bootstrap_and_narrows_with_the_d
     # The same resamples fitted row by row give the same n*s: with as many iterations at
     # every count, the fit to the counts' means is the fit to every iteration.
     same = np.random.default_rng(7)
+    widened = [v.mean() + (v - v.mean()) * np.sqrt(6 / 5) for v in by_count]
     rows = np.concatenate([v[same.integers(0, len(v), (len(v), metrics.BOOTSTRAP))]
-                           for v in by_count])
+                           for v in widened])
     _, stars = metrics.fit(np.repeat(counts, 6).astype(float), rows, 4, 5, 100)
     assert (low, high) == (np.quantile(stars, 0.025, method='lower'),
                            np.quantile(stars, 0.975, method='higher'))
@@ -533,3 +534,13 @@ def test_the_interval_of_n_star_is_the_row_fits_bootstrap_and_narrows_with_the_d
     # a count with one iteration says nothing of its spread
     assert metrics.n_star_interval(counts, [v[:1] for v in by_count], 4, 5, 100, 0.95,
                                    np.random.default_rng(7)) is None
+
+
+def test_the_bootstrap_gives_a_mean_of_few_iterations_its_whole_variance():
+    """Two iterations, 0 and 1: their mean's variance is s^2 / m = 0.5 / 2; resampling the two
+    as they are gives half of it."""
+    means = metrics.resampled_means([[0.0, 1.0], [2.0, 2.0]], np.random.default_rng(1))
+    assert means.shape == (2, metrics.BOOTSTRAP)
+    assert means[0].var() == pytest.approx(0.25, rel=0.05)
+    assert means[0].mean() == pytest.approx(0.5, abs=0.02)
+    assert (means[1] == 2.0).all()
