@@ -165,8 +165,8 @@ def fit_optimum(counts, valid, first: int, last: int, margin: int) -> dict:
 
 
 def resampled_means(by_count: list, rng: np.random.Generator) -> np.ndarray:
-    """(counts, BOOTSTRAP) bootstrap means of each count's iterations (`by_count[i]`, m of
-    them), resampled about their mean with their deviations widened by sqrt(m / (m - 1)):
+    """(counts, BOOTSTRAP) bootstrap means of each count's iterations (`by_count[i]`, m >= 2
+    of them), resampled about their mean with their deviations widened by sqrt(m / (m - 1)):
     resampling m values as they are gives their mean (m - 1) / m of its variance (Davison and
     Hinkley 1997, section 3.3), a fifth too little at an adaptive sweep's first look of 5."""
     out = []

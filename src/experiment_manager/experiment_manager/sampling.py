@@ -26,7 +26,7 @@ What settles each decision, looked at after every batch:
   inside the optimal range n* +- margin, so the feeder runs' range holds the optimum. Every
   count gets the first batch (the fit needs its whole curve); each later look places as many
   parts' worth of drops as a batch at every count would, where they narrow n* most
-  (_sweep_batches), so a sweep never takes more looks than a batch at every count would.
+  (_sweep_batches), so a sweep takes about as many looks as with a batch at every count.
 - gripper_sweep: the smallest gripper meeting min_valid (metrics.gripper_sweep): settled when,
   in size order, every gripper before the first that meets is known not to meet (its interval
   of valid parts per check lies below min_valid) and that one is known to meet (its interval's
