@@ -13,11 +13,9 @@ the last check (the parts a landing layer keeps awake).
 import argparse
 import time
 
-import numpy as np
 from paper_case import variant
 from pick_common.containers import ContainerSpec
 from pick_common.specs import SceneSpec
-from pick_common.states import quaternion_angles
 from pick_sim_world import freezing
 from pick_sim_world import world as world_module
 
@@ -51,9 +49,7 @@ def main() -> None:
 
     def check(self, bodies, poses, elapsed):
         if streaming[0] and elapsed > 0.0:
-            last = np.array([self._last.get(b, p) for b, p in zip(bodies, poses, strict=True)])
-            moved = (np.linalg.norm(poses[:, :3] - last[:, :3], axis=1) > self._linear) | \
-                (quaternion_angles(poses[:, 3:], last[:, 3:]) > self._angular)
+            moved, _ = self.movers(bodies, poses)
             checks.append((len(bodies), len(self.frozen), int(moved.sum())))
         CHECK(self, bodies, poses, elapsed)
 

@@ -103,20 +103,26 @@ class Freezer:
         """The indices into `bodies` of those not frozen."""
         return [i for i, b in enumerate(bodies) if b not in self.frozen]
 
-    def check(self, bodies: Sequence[int], poses: np.ndarray, elapsed: float) -> None:
-        """At a rest check, `elapsed` s after the last (poses (N, 7) of `bodies`, world frame):
-        wake the frozen parts within reach of a part that moved more than the tolerance since
-        the last check (its reach: how far it moved), then freeze the parts that stayed near
-        their anchor pose for a window."""
-        if not len(bodies):
-            return
-        c = self._client
+    def movers(self, bodies: Sequence[int], poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Which of `bodies` (poses (N, 7), world frame) moved or turned more than the
+        tolerance since the last check (a part new to the checks: none), and how far each
+        moved (m)."""
         last = np.array([self._last.get(b, p) for b, p in zip(bodies, poses, strict=True)])
         shift = np.linalg.norm(poses[:, :3] - last[:, :3], axis=1)
         turn = quaternion_angles(poses[:, 3:], last[:, 3:])
+        return (shift > self._linear) | (turn > self._angular), shift
+
+    def check(self, bodies: Sequence[int], poses: np.ndarray, elapsed: float) -> None:
+        """At a rest check, `elapsed` s after the last (poses (N, 7) of `bodies`, world frame):
+        wake the frozen parts within reach of a part that moved more than the tolerance since
+        the last check (movers; its reach: how far it moved), then freeze the parts that
+        stayed near their anchor pose for a window."""
+        if not len(bodies):
+            return
+        c = self._client
         if self.frozen:
             woken = set()
-            movers = (shift > self._linear) | (turn > self._angular)   # new parts: 0
+            movers, shift = self.movers(bodies, poses)
             for i in np.flatnonzero(movers):
                 woken.update(b for b in bodies_near(c, bodies[i], shift[i]) if b in self.frozen)
             self.thaw(woken)
