@@ -20,6 +20,7 @@ import os
 from experiment_manager import config, metrics, sampling
 from experiment_manager.results import read_csv
 import numpy as np
+from pick_common.errors import InvalidArgument
 
 
 def replay(file, exp, by_count: dict, everywhere: bool) -> tuple:
@@ -47,9 +48,14 @@ def main() -> None:
     parser.add_argument('--orders', type=int, default=20)
     parser.add_argument('--batch', type=int, default=5)
     args = parser.parse_args()
-    file = config.load(os.path.join(args.run_dir, 'experiment.yaml'))
+    try:
+        file = config.load(os.path.join(args.run_dir, 'experiment.yaml'))
+    except InvalidArgument as exc:
+        raise SystemExit(f'{args.run_dir}: not a run directory ({exc})') from None
     file = replace(file, sampling=replace(file.sampling, mode=config.ADAPTIVE, batch=args.batch))
-    exp = next(e for e in file.experiments if e.type == config.TABLE_SWEEP)
+    exp = next((e for e in file.experiments if e.type == config.TABLE_SWEEP), None)
+    if exp is None:
+        raise SystemExit(f'{args.run_dir}: its file has no table_sweep experiment')
     rows = [r for r in read_csv(os.path.join(args.run_dir, 'iterations.csv'))
             if r['experiment'] == exp.id]
     recorded = {n: sorted((r for r in rows if r['group'] == n), key=lambda r: r['iteration'])
