@@ -167,7 +167,8 @@ def _sampling(summary: dict) -> list[str]:
             'Adaptive: each experiment ran in batches of iterations per group (bin, count) '
             'until its decision was settled at 99.9 % confidence, at most the iterations of '
             'its file; the figures and verdicts above come from the iterations that ran, at '
-            '95 %.', ''] + table(
+            '95 %. Batches: the looks that released iterations (a later look of a sweep gives '
+            'the counts that narrow n* most a batch or more each, and others none).', ''] + table(
         ['experiment', 'iterations run', 'at most', 'batches', 'ended'],
         [[f'`{exp_id}`', a['iterations_run'], a['most'], a['batches'],
           'settled' if a['settled'] else 'at the most iterations, not settled']
