@@ -69,7 +69,7 @@ def unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict],
     if exp.type == BIN_STATIC:
         return _racing(exp, kept)
     if exp.type == TABLE_SWEEP:
-        return [] if _optimum_settled(file, exp, kept) else _sweep_batches(file, exp, kept)
+        return _sweep_unsettled(file, exp, kept)
     if exp.type == GRIPPER_SWEEP:
         kept_keys = {(r['group'], r['iteration']) for r in kept}
         return [] if _smallest_settled(exp, [c for c in checks if (c['group'], c['iteration'])
@@ -121,24 +121,30 @@ def _racing(exp: Experiment, rows: list[dict]) -> list[int]:
     return racing if len(racing) > 1 else []
 
 
-def _optimum_settled(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> bool:
-    """The bootstrap interval of n* (INTERIM_CONFIDENCE) lies inside n* +- margin."""
-    by_count = [[r['valid'] for r in rows if r['group'] == n] for n in exp.counts]
-    if any(len(v) < 2 for v in by_count):
-        return False
+def _sweep_unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> list[int]:
+    """[] when the sweep's n* is settled (its bootstrap interval at INTERIM_CONFIDENCE lies
+    inside n* +- margin), else where the next look's drops go (_sweep_batches). The counts'
+    rows and the fit are made once for both."""
+    by_count = [np.array([r['valid'] for r in rows if r['group'] == n], dtype=float)
+                for n in exp.counts]
+    if any(len(v) < 2 for v in by_count):      # also every row left out: nothing to fit
+        return _sweep_batches(file, exp, by_count, None)
     first, last = exp.counts[0], exp.counts[-1]
     fitted = metrics.fit_optimum([r['group'] for r in rows], [r['valid'] for r in rows],
                                  first, last, exp.margin)
     if fitted['order'] < 1:
-        return True         # one count: n* is that count
+        return []           # one count: n* is that count
     best = fitted['n_star']
     low, high = metrics.n_star_interval(exp.counts, by_count, fitted['order'], first, last,
                                         INTERIM_CONFIDENCE,
                                         np.random.default_rng([file.seed, len(rows)]))
-    return best - exp.margin <= low and high <= best + exp.margin
+    if best - exp.margin <= low and high <= best + exp.margin:
+        return []
+    return _sweep_batches(file, exp, by_count, fitted)
 
 
-def _sweep_batches(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> list[int]:
+def _sweep_batches(file: ExperimentFile, exp: Experiment, by_count: list[np.ndarray],
+                   fitted: dict | None) -> list[int]:
     """Where a sweep's next look puts its iterations: as many parts' worth of drops as a batch
     at every count, given a batch at a time to the count where a batch shrinks the variance of
     the fit's slope at n* most per part dropped (a greedy sequential c-optimal design: n* is
@@ -148,22 +154,18 @@ def _sweep_batches(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> l
     moving the curve the fixed counts fit. Each count's variance of valid parts is smoothed by
     a quadratic in n (a count seen five times can show no spread by chance). A count listed k
     times gets k batches. Every count has had the first batch, so the whole curve is known.
-    Falls back to a batch at every count when the fit cannot say (no spread at all, too few
-    counts, or a count seen fewer than twice)."""
+    Falls back to a batch at every count when the fit cannot say (no fit, no spread at all,
+    or too few counts). `by_count`: each count's valid parts; `fitted`: metrics.fit_optimum's
+    fit of them, None while a count has fewer than two iterations."""
     batch = file.sampling.batch
     counts = np.array(exp.counts, dtype=float)
-    by_count = [np.array([r['valid'] for r in rows if r['group'] == n], dtype=float)
-                for n in exp.counts]
     taken = np.array([len(v) for v in by_count], dtype=float)
     left = exp.iterations - taken
     # not settled: never [], even with no iterations left (the scheduler then stops)
     everywhere = [n for n, k in zip(exp.counts, left, strict=True) if k > 0] or list(exp.counts)
-    first, last = exp.counts[0], exp.counts[-1]
-    fitted = metrics.fit_optimum([r['group'] for r in rows], [r['valid'] for r in rows],
-                                 first, last, exp.margin)
-    order = fitted['order']
-    if order < 1 or len(counts) < 3 or taken.min() < 2:
+    if fitted is None or fitted['order'] < 1 or len(counts) < 3:
         return everywhere
+    first, last, order = exp.counts[0], exp.counts[-1], fitted['order']
     spread = np.array([v.var(ddof=1) for v in by_count])
     if not spread.any():
         return everywhere

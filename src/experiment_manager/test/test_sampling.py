@@ -112,6 +112,9 @@ def test_a_sweep_is_settled_when_the_optimum_s_interval_lies_inside_its_range():
     assert sampling.unsettled(file, exp, rows(0.3, 10)) == []
     assert sampling.unsettled(file, exp, rows(8.0, 3)) == list(exp.counts)
     assert sampling.unsettled(file, exp, rows(0.3, 1)) == list(exp.counts)    # one each
+    # every iteration left out (a physics fault): nothing to fit, a batch at every count
+    faulted = [{**r, 'fault': metrics.PHYSICS_FAULT} for r in rows(0.3, 1)]
+    assert sampling.unsettled(file, exp, faulted) == list(exp.counts)
 
 
 def test_a_sweep_places_its_next_drops_where_they_narrow_n_star_most():
