@@ -31,10 +31,10 @@ def replay(file, exp, by_count: dict, everywhere: bool) -> tuple:
     looks = 1
     while True:
         rows = [r for n, v in by_count.items() for r in v[:taken[n]]]
-        wanted = [n for n in sampling.unsettled(file, exp, rows) if taken[n] < len(by_count[n])]
+        asked = sampling.unsettled(file, exp, rows)
+        wanted = [n for n in asked if taken[n] < len(by_count[n])]
         if not wanted:
-            settled = not sampling.unsettled(file, exp, rows)
-            return settled, looks, rows
+            return not asked, looks, rows
         if everywhere:
             wanted = [n for n in by_count if taken[n] < len(by_count[n])]
         for n, k in collections.Counter(wanted).items():
