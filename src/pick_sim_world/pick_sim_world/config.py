@@ -35,8 +35,9 @@ class PhysicsConfig:
     time_step: s. 1/480: at pybullet's 1/240, 480 TO-220s dropped into a 300 x 300 x 26 mm bin
     lean steeper (2.6 % of them tilted past every grasp's tolerance against 1.3 to 1.7 % at
     1/480, 1/960 and 1/1920), and the bin's container-free fraction lies 2 points below the
-    finer steps' (0.908 against 0.926 / 0.930 / 0.927, 12 seeds; bench_lean.py); the tray's
-    answers agree at every step (bench_convergence.py). solver_iterations: per step, in a bin.
+    finer steps' (0.908 against 0.926 / 0.930 / 0.927, 12 seeds; bench_lean.py); on a tray at
+    1/240 s feeder runs need a quarter more vibrations than at 1/960 s (docs/physics.md, "The
+    tray at 1/240 s"). solver_iterations: per step, in a bin.
     tray_solver_iterations: per step, on a tray. 100 keep a bin's deep pile at rest: with 50,
     150 TO-220s settled in a 75 x 75 x 60 mm bin crept (5 seeds: 170 moves > 0.5 mm over three
     further seconds against 24 at 100; bench_creep.py). Parts on a tray lie about one deep, and
