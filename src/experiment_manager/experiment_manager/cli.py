@@ -42,7 +42,7 @@ from tqdm import tqdm
 from . import config, interrupt
 from .claim import claim, NamespaceInUse
 from .supervisor import Graph, report_dead, spin_until, start_graph
-from .wording import gripper_label
+from .wording import gripper_label, sampling_end
 
 MAX_WORKERS = 64
 START_TIMEOUT = 60.0    # s for the manager's action server to appear
@@ -179,7 +179,7 @@ def _summary_lines(summary: dict) -> list[str]:
         if 'sampling' in s:
             a = s['sampling']
             lines[-1] += (f' [adaptive: {a["iterations_run"]} of {a["most"]} iterations, '
-                          + ('settled]' if a['settled'] else 'not settled]'))
+                          f'{sampling_end(s)}]')
     return lines
 
 

@@ -33,7 +33,7 @@ from .verdicts import (
     UNDECIDED,
     verdicts,
 )
-from .wording import count, dims, fmt, gripper_label, of_type, pct, table, varying
+from .wording import count, dims, fmt, gripper_label, of_type, pct, sampling_end, table, varying
 
 FIGSIZE = (6.4, 4.0)   # inches
 # the HTML class (colour) of a bold verdict
@@ -159,7 +159,7 @@ def _physics_health(summary: dict) -> list[str]:
 def _sampling(summary: dict) -> list[str]:
     """With adaptive sampling: how many iterations each experiment took, and whether its
     decision was settled or its iterations ran out."""
-    adaptive = [(exp_id, s['sampling']) for exp_id, s in summary['experiments'].items()
+    adaptive = [(exp_id, s, s['sampling']) for exp_id, s in summary['experiments'].items()
                 if 'sampling' in s]
     if not adaptive:
         return []
@@ -171,8 +171,8 @@ def _sampling(summary: dict) -> list[str]:
             'the counts that narrow n* most a batch or more each, and others none).', ''] + table(
         ['experiment', 'iterations run', 'at most', 'batches', 'ended'],
         [[f'`{exp_id}`', a['iterations_run'], a['most'], a['batches'],
-          'settled' if a['settled'] else 'at the most iterations, not settled']
-         for exp_id, a in adaptive])
+          'settled' if a['settled'] else f'at the most iterations, {sampling_end(s)}']
+         for exp_id, s, a in adaptive])
 
 
 def _sizes(given: dict | None, lead: str) -> str:

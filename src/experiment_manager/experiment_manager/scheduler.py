@@ -19,7 +19,7 @@ from typing import Protocol
 
 from . import metrics, sampling
 from .backend import Backend, WorkerLost
-from .config import Experiment, ExperimentFile, GRIPPER_SWEEP
+from .config import BIN_STATIC, Experiment, ExperimentFile, GRIPPER_SWEEP
 from .estimate import Costs
 from .plan import count_iterations, experiment_iterations, plan, Unit
 from .procedures import run_unit
@@ -217,11 +217,13 @@ class Runner:
         self._summary[exp.id] = metrics.summarise(
             self.file, exp, rows, self.sink.picks(exp.id), self._summary, checks)
         if self.file.sampling.adaptive:
+            left = sampling.unsettled(self.file, exp, rows, checks)
             self._summary[exp.id]['sampling'] = {
                 'mode': self.file.sampling.mode, 'batch': self.file.sampling.batch,
                 'batches': self._looks[exp.id], 'iterations_run': len(rows),
-                'most': experiment_iterations(exp),
-                'settled': not sampling.unsettled(self.file, exp, rows, checks)}
+                'most': experiment_iterations(exp), 'settled': not left}
+            if left and exp.type == BIN_STATIC:     # the bins that could not be told apart
+                self._summary[exp.id]['sampling']['tied_bins'] = left
         self.sink.write_summary(metrics.file_summary(self.file, self._ordered_summary()))
         self._release()
 

@@ -15,6 +15,20 @@ def dims(values) -> str:
     return ' x '.join(fmt(x) for x in values)
 
 
+def sampling_end(experiment: dict) -> str:
+    """How an adaptive experiment's sampling ended, from its summary: 'settled', or 'not
+    settled', for bins with the ones whose intervals still reached the leader's."""
+    a = experiment['sampling']
+    if a['settled']:
+        return 'settled'
+    if not a.get('tied_bins'):
+        return 'not settled'
+    sizes = {b['index']: dims(b['size_mm']) for b in experiment['bins']}
+    tied = [sizes[g] for g in a['tied_bins']]
+    listed = ', '.join(tied[:-1]) + ' and ' + tied[-1]
+    return f'not settled: bins {listed} mm could not be told apart at 99.9 %'
+
+
 def count(n: int, noun: str) -> str:
     """'1 part', '35 parts': the report's sentences say a count as it is read."""
     return f'{n} {noun}' + ('' if n == 1 else 's')

@@ -249,3 +249,20 @@ def test_a_resumed_adaptive_run_looks_only_at_the_batches_it_released(tmp_path):
     assert len(read(out)) == 3
     assert run('adaptive', out, resume=True, required=0.95) == whole
     assert read(out) == read(str(tmp_path / 'whole'))
+
+
+def test_an_adaptive_race_that_runs_out_names_the_bins_it_could_not_tell_apart(tmp_path):
+    """Two drops per bin cannot part two bins at 99.9 %: the race ends at the most iterations
+    with both still in it, and the summary, the terminal and the report say which."""
+    text = open(SMALL).read()
+    bins = next(line for line in text.splitlines() if '{id: bins' in line)
+    file = config.parse(text.split('experiments:\n')[0] + f'experiments:\n{bins}\n'
+                        'sampling: {mode: adaptive, batch: 2}\n', SMALL)
+    assert [e.id for e in file.experiments] == ['bins']
+    with LocalBackend() as backend, ResultsWriter(str(tmp_path), file.text) as sink:
+        summary = Runner(file, [backend], sink).run()
+    s = summary['experiments']['bins']
+    assert s['sampling']['settled'] is False and s['sampling']['tied_bins'] == [0, 1]
+    said = 'not settled: bins 100 x 100 x 20 and 120 x 80 x 20 mm could not be told apart'
+    assert said in _summary_lines(summary)[0]
+    assert f'at the most iterations, {said}' in report.markdown(summary, {}, {})
