@@ -109,7 +109,10 @@ def rate_settled(successes: int, n: int, required: float,
 
 def _racing(exp: Experiment, rows: list[dict]) -> list[int]:
     """The bins still in the race: every bin whose interval of the mean container-free
-    fraction reaches the leader's; all of them while any has fewer than two iterations."""
+    fraction reaches the leader's; all of them while any has fewer than two iterations; none
+    when there is one bin (it is the best)."""
+    if len(groups(exp)) == 1:
+        return []
     fractions = {g: [r['container_free'] / r['checked'] for r in rows
                      if r['group'] == g and r['checked']] for g in groups(exp)}
     intervals = {g: metrics.interval(v, INTERIM_CONFIDENCE) for g, v in fractions.items()}

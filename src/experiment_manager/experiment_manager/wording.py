@@ -25,7 +25,7 @@ def sampling_end(experiment: dict) -> str:
         return 'not settled'
     sizes = {b['index']: dims(b['size_mm']) for b in experiment['bins']}
     tied = [sizes[g] for g in a['tied_bins']]
-    listed = ', '.join(tied[:-1]) + ' and ' + tied[-1]
+    listed = ' and '.join(filter(None, (', '.join(tied[:-1]), tied[-1])))
     return f'not settled: bins {listed} mm could not be told apart at 99.9 %'
 
 

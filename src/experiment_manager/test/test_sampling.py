@@ -98,6 +98,8 @@ def test_bins_leave_the_race_when_they_are_clearly_behind_the_leader():
     assert sampling.unsettled(file, exp, rows([90, 89, 60, 30], 6)) == [0, 1]
     assert sampling.unsettled(file, exp, rows([90, 50, 60, 30], 6)) == []   # one left: best
     assert sampling.unsettled(file, exp, rows([90, 50, 60, 30], 1)) == [0, 1, 2, 3]
+    one = replace(exp, bins=exp.bins[:1])        # nothing to race: the one bin is the best
+    assert sampling.unsettled(file, one, rows([90], 1)) == []
 
 
 def test_a_sweep_is_settled_when_the_optimum_s_interval_lies_inside_its_range():
