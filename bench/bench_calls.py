@@ -15,15 +15,14 @@ import os
 import statistics
 import subprocess
 import sys
-import tempfile
 import threading
 import time
 
 from experiment_manager import config
 from experiment_manager.config import BIN_STATIC
 from experiment_manager.graph_backend import GraphBackend
-from experiment_manager.launcher import NodeProcess, WORKER_NODES
 from experiment_manager.plan import plan
+from paper_case import one_worker
 import rclpy
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import MultiThreadedExecutor
@@ -74,23 +73,13 @@ def main() -> int:
     if args.probe:      # one scene, in a process of its own (a fresh rclpy)
         print(probe(args.probe[0], int(args.probe[1])), flush=True)
         os._exit(0)     # the executor thread is a daemon; nothing to close cleanly
-    os.environ.setdefault('ROS_DOMAIN_ID', str(150 + os.getpid() % 50))
-    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    logs = tempfile.mkdtemp(prefix='bench_calls_')
     print('median round trip, ms      get_parts check_parts remove_parts')
     for markers in ('true', 'false'):
-        ns = f'/calls_{os.getpid()}_{markers}'
-        procs = [NodeProcess(pkg, exe, ['-r', f'__ns:={ns}/worker_0', *(
-                     ['-p', f'publish_markers:={markers}'] if exe == 'world' else [])],
-                             f'{logs}/{exe}_{markers}.log') for pkg, exe in WORKER_NODES]
-        try:
+        with one_worker(f'calls_{markers}', ['-p', f'publish_markers:={markers}']) as ns:
             for parts in args.parts:
                 out = subprocess.run([sys.executable, __file__, '--probe', ns, str(parts)],
                                      check=True, capture_output=True, text=True, timeout=600)
                 print(f'{parts:4d} parts, markers {markers:<5} {out.stdout.strip()}', flush=True)
-        finally:
-            for p in procs:
-                p.stop()
     return 0
 
 

@@ -18,17 +18,16 @@ import argparse
 import collections
 import os
 import sys
-import tempfile
 import threading
 import time
 
 from experiment_manager import config
 from experiment_manager.graph_backend import GraphBackend
-from experiment_manager.launcher import NodeProcess, WORKER_NODES
 from experiment_manager.local_backend import LocalBackend
 from experiment_manager.plan import plan
 from experiment_manager.procedures import run_unit
 from feeder_controller.policy import PICK
+from paper_case import one_worker
 import rclpy
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import MultiThreadedExecutor
@@ -65,13 +64,7 @@ class Timed:
 
 def through_graph(file: config.ExperimentFile, units: list) -> tuple[Timed, list, float]:
     """The units through a worker of this process's own, on a private domain."""
-    os.environ.setdefault('ROS_DOMAIN_ID', str(150 + os.getpid() % 50))
-    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    ns = f'/graph_calls_{os.getpid()}'
-    logs = tempfile.mkdtemp(prefix='bench_graph_calls_')
-    procs = [NodeProcess(pkg, exe, ['-r', f'__ns:={ns}/worker_0'], f'{logs}/{exe}.log')
-             for pkg, exe in WORKER_NODES]
-    try:
+    with one_worker('graph_calls') as ns:
         rclpy.init()
         node = Node('graph_calls', namespace=ns)
         executor = MultiThreadedExecutor(num_threads=4)    # as the manager's
@@ -84,9 +77,6 @@ def through_graph(file: config.ExperimentFile, units: list) -> tuple[Timed, list
         start = time.perf_counter()
         records = [run_unit(file, u, timed) for u in units]
         return timed, records, time.perf_counter() - start
-    finally:
-        for p in procs:
-            p.stop()
 
 
 def main() -> int:

@@ -13,16 +13,15 @@ import collections
 import os
 import subprocess
 import sys
-import tempfile
 import threading
 import time
 
 from experiment_manager import config
 from experiment_manager.graph_backend import GraphBackend
-from experiment_manager.launcher import NodeProcess, WORKER_NODES
 from experiment_manager.plan import plan
 from experiment_manager.procedures import run_unit
 from experiment_manager.topic_recorder import QOS, RECORDED, TopicRecorder
+from paper_case import one_worker
 import rclpy
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import MultiThreadedExecutor
@@ -83,20 +82,11 @@ def main() -> int:
         print(f'recording subscriptions: {sys.argv[2]:<14} iteration {total:7.1f} s  '
               f'({calls} s)', flush=True)
         os._exit(0)   # the executor threads are daemons; nothing to close cleanly
-    os.environ.setdefault('ROS_DOMAIN_ID', str(150 + os.getpid() % 50))
-    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    ns = f'/probe_{os.getpid()}'
-    logs = tempfile.mkdtemp(prefix='probe_logs_')
-    procs = [NodeProcess(pkg, exe, ['-r', f'__ns:={ns}/worker_0'], f'{logs}/{exe}.log')
-             for pkg, exe in WORKER_NODES]
-    try:
+    with one_worker('probe') as ns:
         print('one feeder_emptying iteration (60 parts, range 51-61, 300 vibrations)',
               flush=True)
         for mode in MODES:
             subprocess.run([sys.executable, __file__, ns, mode], check=True)
-    finally:
-        for p in procs:
-            p.stop()
     return 0
 
 

@@ -2,12 +2,15 @@
 working time of a full run from its run directories, for the benchmarks (run them as
 `tools/ws python bench/NAME.py`: this directory is on the path)."""
 
+from collections.abc import Iterator, Sequence
+import contextlib
 import os
 import re
 import tempfile
 import time
 
 from experiment_manager import config
+from experiment_manager.launcher import NodeProcess, WORKER_NODES
 from experiment_manager.local_backend import LocalBackend
 from experiment_manager.recording import CompleteRecords
 from experiment_manager.results import read_csv, ResultsWriter
@@ -46,6 +49,26 @@ def run_on_cores(part_file: str, experiments: list[dict], physics: PhysicsConfig
             Runner(file, [backend], writer).run()
         wall = time.perf_counter() - start
         return read_csv(os.path.join(out, 'iterations.csv')), wall
+
+
+@contextlib.contextmanager
+def one_worker(label: str, world_args: Sequence[str] = ()) -> Iterator[str]:
+    """A worker's nodes (world, validity, feeder_controller) as processes on a private domain
+    of this process (ROS_DOMAIN_ID unless set, this host only), under `worker_0` of the
+    namespace yielded (`/<label>_<pid>`); `world_args` are the world's extra ROS arguments.
+    Stopped when the block ends."""
+    os.environ.setdefault('ROS_DOMAIN_ID', str(150 + os.getpid() % 50))
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    ns = f'/{label}_{os.getpid()}'
+    logs = tempfile.mkdtemp(prefix=f'{label}_logs_')
+    procs = [NodeProcess(pkg, exe, ['-r', f'__ns:={ns}/worker_0',
+                                    *(world_args if exe == 'world' else ())],
+                         f'{logs}/{exe}.log') for pkg, exe in WORKER_NODES]
+    try:
+        yield ns
+    finally:
+        for p in procs:
+            p.stop()
 
 
 def recorded_spans(run_dir: str) -> list[float]:
