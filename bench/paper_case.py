@@ -1,6 +1,7 @@
-"""The paper's test case files, a variant of one run on the cores in this process, and the
-working time of a full run from its run directories, for the benchmarks (run them as
-`tools/ws python bench/NAME.py`: this directory is on the path)."""
+"""The paper's test case files, a variant of one run on the cores in this process, a worker's
+nodes to call through the graph, and the working time of a full run from its run directories,
+for the benchmarks (run them as `tools/ws python bench/NAME.py`: this directory is on the
+path)."""
 
 from collections.abc import Iterator, Sequence
 import contextlib
