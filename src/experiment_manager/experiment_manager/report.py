@@ -171,7 +171,7 @@ def _sampling(summary: dict) -> list[str]:
             'the counts that narrow n* most a batch or more each, and others none).', ''] + table(
         ['experiment', 'iterations run', 'at most', 'batches', 'ended'],
         [[f'`{exp_id}`', a['iterations_run'], a['most'], a['batches'],
-          'settled' if a['settled'] else f'at the most iterations, {sampling_end(s)}']
+          ('' if a['settled'] else 'at the most iterations, ') + sampling_end(s)]
          for exp_id, s, a in adaptive])
 
 
