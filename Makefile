@@ -36,7 +36,12 @@ $(DEPS_STAMP): requirements.txt constraints.txt tools/fix_cmake_paths.py
 
 deps: $(DEPS_STAMP)
 
+# The Python packages are installed afresh: colcon copies modules into install/ and never
+# removes one that was moved or deleted in src/, which would then still import.
+PY_PACKAGES := $(notdir $(patsubst %/setup.py,%,$(wildcard src/*/setup.py)))
+
 $(BUILD_STAMP): $(DEPS_STAMP) $(SOURCES) colcon.meta
+	rm -rf $(addprefix install/,$(PY_PACKAGES)) $(addprefix build/,$(PY_PACKAGES))
 	$(WS) colcon build --base-paths . $(VENDORED) \
 	    --event-handlers console_cohesion- summary+ status- \
 	    --cmake-args -DBUILD_TESTING=OFF -Wno-dev
@@ -57,9 +62,9 @@ test-loaded: $(BUILD_STAMP)
 	$(PYTHON) tools/loaded.py --rounds 3 -- $(MAKE) test
 
 bench: $(BUILD_STAMP)
-	$(WS) python bench/bench_world.py
-	$(WS) python bench/bench_validity.py
-	$(WS) python bench/bench_vibration.py
+	$(WS) python bench/world/bench_world.py
+	$(WS) python bench/validity/bench_validity.py
+	$(WS) python bench/world/bench_vibration.py
 
 lock: $(DEPS_STAMP)
 	$(VENV)/bin/python -m pip freeze --exclude-editable | sort > constraints.txt.new

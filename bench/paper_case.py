@@ -10,12 +10,12 @@ import re
 import tempfile
 import time
 
-from experiment_manager import config
-from experiment_manager.launcher import NodeProcess, WORKER_NODES
-from experiment_manager.local_backend import LocalBackend
-from experiment_manager.recording import CompleteRecords
-from experiment_manager.results import read_csv, ResultsWriter
-from experiment_manager.scheduler import Runner
+from experiment_manager import experiment_file
+from experiment_manager.analysis.results import read_csv, ResultsWriter
+from experiment_manager.commands.launcher import NodeProcess, WORKER_NODES
+from experiment_manager.graph.recording import CompleteRecords
+from experiment_manager.running.local_backend import LocalBackend
+from experiment_manager.running.scheduler import Runner
 from mcap.exceptions import McapError
 from mcap.reader import make_reader
 from mcap.records import Message
@@ -27,7 +27,7 @@ TEST_CASE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src'
 
 
 def variant(part_file: str, experiments: list[dict], part: dict | None = None,
-            **sections) -> config.ExperimentFile:
+            **sections) -> experiment_file.ExperimentFile:
     """TEST_CASE/`part_file` with its experiments replaced by `experiments`, its top-level
     `sections` (e.g. vibration, gripper) by the ones given, and the keys of its part section
     in `part` changed, parsed."""
@@ -36,7 +36,7 @@ def variant(part_file: str, experiments: list[dict], part: dict | None = None,
         data = yaml.safe_load(f)
     data.update(sections, experiments=experiments)
     data['part'].update(part or {})
-    return config.parse(yaml.safe_dump(data), path)
+    return experiment_file.parse(yaml.safe_dump(data), path)
 
 
 def run_on_cores(part_file: str, experiments: list[dict], physics: PhysicsConfig | None = None,

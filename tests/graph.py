@@ -9,10 +9,10 @@ import os
 import tempfile
 import time
 
-from experiment_manager import launcher
+from experiment_manager.commands import launcher
 from pick_common.node_runner import handshake
+from pick_common.rclpy_adapter import LockedActionClient
 import rclpy
-from rclpy.action import ActionClient
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -87,7 +87,7 @@ class Client:
         """Wait until every client (service or action) sees its server and the server answers
         a probe (node_runner.handshake), as the experiment manager does."""
         def ready() -> bool:
-            return all(c.server_is_ready() if isinstance(c, ActionClient)
+            return all(c.server_is_ready() if isinstance(c, LockedActionClient)
                        else c.service_is_ready() for c in clients)
         if not self.wait(ready, timeout, nodes):
             return False

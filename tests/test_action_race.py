@@ -7,7 +7,7 @@ LockedActionClient can go), the manager's LockedActionClient does not."""
 import threading
 import time
 
-from experiment_manager.graph_backend import LockedActionClient
+from pick_common.rclpy_adapter import LockedActionClient
 from pick_msgs.action import DropParts
 import pytest
 import rclpy

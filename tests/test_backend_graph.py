@@ -2,8 +2,8 @@
 
 import threading
 
-from experiment_manager import config
-from experiment_manager.graph_backend import GraphBackend, WorkerGone
+from experiment_manager import experiment_file
+from experiment_manager.graph.graph_backend import GraphBackend, WorkerGone
 from graph import NodeProcess, SMALL, stop_all, unique_namespace
 import pytest
 import rclpy
@@ -33,7 +33,7 @@ def backend(private_ros_domain):
     spinner.start()
     graph = GraphBackend(node, NS, ReentrantCallbackGroup(), call_timeout=120.0,
                          server_timeout=60.0, canceled=lambda: False, rejoin_timeout=60.0)
-    graph.start(config.load(SMALL))
+    graph.start(experiment_file.load(SMALL))
     try:
         yield graph, procs
     finally:
@@ -49,7 +49,7 @@ def test_a_world_started_again_between_two_calls_ends_the_iteration(backend):
     a world without the iteration's parts. It must end the iteration (WorkerGone: it runs
     again), not go on with an empty scene."""
     graph, procs = backend
-    bin_spec = config.load(SMALL).experiment('bins').bins[0]
+    bin_spec = experiment_file.load(SMALL).experiment('bins').bins[0]
     graph.reset(bin_spec, seed=5)
     states, _ = graph.drop(10, 'container')
     assert len(states.ids) == 10

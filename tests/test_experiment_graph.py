@@ -16,21 +16,22 @@ import subprocess
 import time
 
 from ament_index_python.packages import get_package_share_directory
-from experiment_manager import config, interrupt, supervisor
-from experiment_manager.launcher import executable, WORKER_NODES
-from experiment_manager.local_backend import LocalBackend
-from experiment_manager.results import FILES, read_text_rows, ResultsWriter
-from experiment_manager.scheduler import Runner
-from experiment_manager.verdicts import verdicts
+from experiment_manager import experiment_file
+from experiment_manager.analysis.results import FILES, read_text_rows, ResultsWriter
+from experiment_manager.analysis.verdicts import verdicts
+from experiment_manager.commands import interrupt, supervisor
+from experiment_manager.commands.launcher import executable, WORKER_NODES
+from experiment_manager.running.local_backend import LocalBackend
+from experiment_manager.running.scheduler import Runner
 from graph import SMALL, unique_namespace
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
+from pick_common.rclpy_adapter import LockedActionClient
 from pick_msgs.action import RunExperiment
 from pick_msgs.msg import ValidityReport, Verdict
 from pick_sim_world.bodies import instance_seed
 import pytest
 import rclpy
-from rclpy.action import ActionClient
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock
@@ -67,7 +68,7 @@ def graph_run(tmp_path_factory, private_ros_domain):
 def core_run(tmp_path_factory) -> str:
     """The small file run on the cores in this process: the results the graph must give."""
     directory = str(tmp_path_factory.mktemp('cores'))
-    file = config.load(SMALL)
+    file = experiment_file.load(SMALL)
     with LocalBackend() as backend, ResultsWriter(directory, file.text) as writer:
         Runner(file, [backend], writer).run()
     return directory
@@ -423,7 +424,7 @@ def test_a_second_goal_or_run_is_refused_and_a_killed_last_worker_ends_the_run(
     try:
         assert client.wait(first_iteration_done(out), 120.0), 'no iteration finished'
 
-        manager = ActionClient(client.node, RunExperiment, f'{ns}/run_experiment')
+        manager = LockedActionClient(client.node, RunExperiment, f'{ns}/run_experiment')
         assert client.wait_for_servers(manager)
         handle = client.result(manager.send_goal_async(RunExperiment.Goal(
             experiment_file=str(path), output_dir=str(tmp_path / 'other'))))
@@ -591,7 +592,7 @@ def test_the_manager_finds_the_workers_under_its_namespace(tmp_path, client, sta
                          '-p', f'output_dirs:=["{tmp_path}"]')
     path = tmp_path / 'tiny.yaml'
     path.write_text(TINY)
-    action = ActionClient(client.node, RunExperiment, f'{ns}/run_experiment')
+    action = LockedActionClient(client.node, RunExperiment, f'{ns}/run_experiment')
     assert client.wait_for_servers(action, nodes=(manager,))
     def manager_nodes() -> list[str]:
         return sorted(n for n, s in client.node.get_node_names_and_namespaces() if s == ns)

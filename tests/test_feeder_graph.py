@@ -6,11 +6,11 @@ import time
 from geometry_msgs.msg import Vector3
 from graph import NodeProcess, stop_all, unique_namespace
 from pick_common.node_runner import LATCHED
+from pick_common.rclpy_adapter import LockedActionClient
 from pick_msgs.action import FeedCycle, RemoveParts
 from pick_msgs.msg import FeederState, Vibration
 from pick_msgs.srv import GetParts
 import pytest
-from rclpy.action import ActionClient
 
 pytestmark = pytest.mark.graph
 NS = unique_namespace('cell_f')
@@ -29,8 +29,8 @@ def nodes(private_ros_domain):
 class Feeder:
     def __init__(self, client, nodes) -> None:
         self.c = client
-        self.cycle_client = ActionClient(client.node, FeedCycle, f'{NS}/feed_cycle')
-        self.remove_client = ActionClient(client.node, RemoveParts, f'{NS}/remove_parts')
+        self.cycle_client = LockedActionClient(client.node, FeedCycle, f'{NS}/feed_cycle')
+        self.remove_client = LockedActionClient(client.node, RemoveParts, f'{NS}/remove_parts')
         self.parts_client = client.node.create_client(GetParts, f'{NS}/get_parts')
         self.states = []
         client.node.create_subscription(FeederState, f'{NS}/feeder/state', self.states.append,
@@ -113,7 +113,7 @@ def test_a_world_that_dies_mid_cycle_gets_an_error_answer_not_a_hang(client, res
     world = NodeProcess('pick_sim_world', 'world', args)
     feeder = NodeProcess('feeder_controller', 'feeder_controller', ['-r', f'__ns:={ns}'])
     try:
-        cycle = ActionClient(client.node, FeedCycle, f'{ns}/feed_cycle')
+        cycle = LockedActionClient(client.node, FeedCycle, f'{ns}/feed_cycle')
         assert client.wait_for_servers(cycle, nodes=(world, feeder))
         # A big feed: the world is still dropping when it is killed.
         handle = client.result(cycle.send_goal_async(FeedCycle.Goal(

@@ -16,11 +16,11 @@ from fuzz import documents, requests, TRIED
 from geometry_msgs.msg import Vector3
 from graph import Client, NodeProcess, stop_all, unique_namespace
 from hypothesis import given, HealthCheck, settings
+from pick_common.rclpy_adapter import LockedActionClient
 from pick_msgs.action import DropParts, FeedCycle, RemoveParts, RunExperiment, Vibrate
 from pick_msgs.msg import ContainerGeometry, PartModel, Vibration
 from pick_msgs.srv import CheckParts, GetParts, ResetScene
 import pytest
-from rclpy.action import ActionClient
 import trimesh
 import yaml
 
@@ -94,7 +94,7 @@ class Endpoints:
         self.services = {'get_parts': node.create_client(GetParts, f'{NS}/w/get_parts'),
                          'reset_scene': node.create_client(ResetScene, f'{NS}/w/reset_scene'),
                          'check_parts': node.create_client(CheckParts, f'{NS}/w/check_parts')}
-        self.actions = {name: ActionClient(node, t, f'{NS}/{name}') for name, t in (
+        self.actions = {name: LockedActionClient(node, t, f'{NS}/{name}') for name, t in (
             ('w/drop_parts', DropParts), ('w/vibrate', Vibrate), ('w/remove_parts', RemoveParts),
             ('w/feed_cycle', FeedCycle), ('run_experiment', RunExperiment))}
         assert client.wait_for_servers(*self.services.values(), *self.actions.values(),

@@ -8,8 +8,8 @@ import ast
 import glob
 import os
 
-from experiment_manager.experiment_manager_node import ExperimentManagerNode
-from experiment_manager.launcher import WORKER_NODES
+from experiment_manager.commands.launcher import WORKER_NODES
+from experiment_manager.graph.experiment_manager_node import ExperimentManagerNode
 import rclpy
 from rclpy.node import Node
 

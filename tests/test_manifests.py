@@ -20,6 +20,8 @@ IMPORT_KEYS = {
     'numpy': 'python3-numpy',
     'scipy': 'python3-scipy',
     'yaml': 'python3-yaml',
+    'pydantic': 'python3-pydantic',
+    'pydantic_core': 'python3-pydantic',     # pydantic's own core, installed with it
     'matplotlib': 'python3-matplotlib',
     'tqdm': 'python3-tqdm',
     'pytest': 'python3-pytest',

@@ -16,16 +16,16 @@ import os
 import shutil
 import subprocess
 
-from experiment_manager import config
-from experiment_manager.launcher import WORKER_NODES
-from experiment_manager.local_backend import LocalBackend
-from experiment_manager.results import FILES, read_text_rows, ResultsWriter
-from experiment_manager.scheduler import Runner
+from experiment_manager import experiment_file
+from experiment_manager.analysis.results import FILES, read_text_rows, ResultsWriter
+from experiment_manager.commands.launcher import WORKER_NODES
+from experiment_manager.running.local_backend import LocalBackend
+from experiment_manager.running.scheduler import Runner
 from graph import NodeProcess, unique_namespace
 from mcap.reader import make_reader
+from pick_common.rclpy_adapter import LockedActionClient
 from pick_msgs.action import RunExperiment
 import pytest
-from rclpy.action import ActionClient
 
 pytestmark = pytest.mark.graph
 
@@ -109,7 +109,7 @@ def test_a_worker_on_a_second_host_gives_the_results_of_one_host(tmp_path, secon
     nodes = (manager, *here, *there)
     path = tmp_path / 'two_hosts.yaml'
     path.write_text(FILE)
-    action = ActionClient(client.node, RunExperiment, f'{ns}/run_experiment')
+    action = LockedActionClient(client.node, RunExperiment, f'{ns}/run_experiment')
     assert client.wait_for_servers(action, nodes=nodes)
     # The manager waits for the workers it is given (server_timeout): this test process does
     # not look for the remote worker itself. After another test had opened contexts in this
@@ -124,7 +124,7 @@ def test_a_worker_on_a_second_host_gives_the_results_of_one_host(tmp_path, secon
     assert 'on 2 worker(s): worker_0, worker_1' in manager.output()
 
     cores = str(tmp_path / 'cores')
-    file = config.load(str(path))
+    file = experiment_file.load(str(path))
     with LocalBackend() as backend, ResultsWriter(cores, file.text) as writer:
         Runner(file, [backend], writer).run()
     for name in FILES:

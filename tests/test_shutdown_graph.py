@@ -7,10 +7,10 @@ import subprocess
 import sys
 
 from graph import NodeProcess, unique_namespace
+from pick_common.rclpy_adapter import LockedActionClient
 from pick_msgs.action import DropParts, FeedCycle
 from pick_msgs.srv import CheckParts
 import pytest
-from rclpy.action import ActionClient
 
 pytestmark = pytest.mark.graph
 ROUNDS = 4                      # starts and stops per node and signal
@@ -47,7 +47,7 @@ def test_the_world_stops_cleanly_while_it_drops_parts(client, signum):
         ns = unique_namespace(f'stop_world_{signum}_{k}')
         world = NodeProcess('pick_sim_world', 'world', ['-r', f'__ns:={ns}', *WORLD])
         try:
-            drop = ActionClient(client.node, DropParts, f'{ns}/drop_parts')
+            drop = LockedActionClient(client.node, DropParts, f'{ns}/drop_parts')
             assert client.wait_for_servers(drop, nodes=(world,))
             # 300 parts stream in layers for seconds of wall time: stopped mid-operation.
             _in_flight(client, drop.send_goal_async(DropParts.Goal(count=300)))
@@ -63,7 +63,7 @@ def test_the_feeder_controller_stops_cleanly_while_a_cycle_runs(client, signum):
         ns = unique_namespace(f'stop_feeder_{signum}_{k}')
         world = NodeProcess('pick_sim_world', 'world', ['-r', f'__ns:={ns}', *WORLD])
         feeder = NodeProcess('feeder_controller', 'feeder_controller', ['-r', f'__ns:={ns}'])
-        cycle = ActionClient(client.node, FeedCycle, f'{ns}/feed_cycle')
+        cycle = LockedActionClient(client.node, FeedCycle, f'{ns}/feed_cycle')
         try:
             assert client.wait_for_servers(cycle, nodes=(world, feeder))
             # A big feed: the cycle waits on the world's drop when the signal comes.

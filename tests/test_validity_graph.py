@@ -7,14 +7,13 @@ import math
 from graph import NodeProcess, stop_all, unique_namespace
 from pick_common.conversions import container_from_msg, part_spec_from_msg, parts_to_arrays
 from pick_common.node_runner import LATCHED
-from pick_common.parts import build_part
+from pick_common.rclpy_adapter import LockedActionClient
 from pick_msgs.action import DropParts
 from pick_msgs.msg import Scene, ValidityReport
 from pick_msgs.srv import CheckParts, GetParts
-from pick_validity.config import CAPACITOR_GRASPS, CheckConfig, Gripper, PlaceSpec
+from pick_validity.config import Setup
 from pick_validity.validity import Validator
 import pytest
-from rclpy.action import ActionClient
 
 pytestmark = pytest.mark.graph
 NS = unique_namespace('cell_v')
@@ -37,7 +36,7 @@ def settled(nodes):
     from graph import Client
     client = Client()
     try:
-        drop = ActionClient(client.node, DropParts, f'{NS}/drop_parts')
+        drop = LockedActionClient(client.node, DropParts, f'{NS}/drop_parts')
         assert client.wait_for_servers(drop, nodes=nodes)
         handle = client.result(drop.send_goal_async(DropParts.Goal(count=120)))
         result = client.result(handle.get_result_async(), 120.0).result
@@ -74,8 +73,7 @@ def test_service_agrees_with_the_core_on_a_settled_bin(client, check, settled, n
     response = check(_request(scene, parts, check_neighbours=neighbours))
     assert response.error_code == OK, response.error_msg
     ids, _, poses = parts_to_arrays(parts)
-    core = Validator(build_part(part_spec_from_msg(scene.part_model)), Gripper(),
-                     CAPACITOR_GRASPS, PlaceSpec(), CheckConfig()).check(
+    core = Validator(Setup(part_spec_from_msg(scene.part_model))).check(
         container_from_msg(scene.instances[0].container), ids, poses,
         neighbour_check=neighbours)
     got = [(r.part_id, r.stage_reached, r.grasp_index, tuple(r.valid_tilts))

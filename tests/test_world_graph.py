@@ -9,11 +9,11 @@ from geometry_msgs.msg import Vector3
 from graph import NodeProcess, stop_all, unique_namespace
 import numpy as np
 from pick_common.node_runner import LATCHED
+from pick_common.rclpy_adapter import LockedActionClient
 from pick_msgs.action import DropParts, RemoveParts, Vibrate
 from pick_msgs.msg import ContainerGeometry, PartArray, Scene, Vibration
 from pick_msgs.srv import GetParts, ResetScene
 import pytest
-from rclpy.action import ActionClient
 from visualization_msgs.msg import Marker, MarkerArray
 
 pytestmark = pytest.mark.graph
@@ -39,7 +39,7 @@ class Cell:
         node = client.node
         self.get_parts_srv = node.create_client(GetParts, f'{NS}/get_parts')
         self.reset_srv = node.create_client(ResetScene, f'{NS}/reset_scene')
-        self.actions = {t: ActionClient(node, t, f'{NS}/{name}') for t, name in (
+        self.actions = {t: LockedActionClient(node, t, f'{NS}/{name}') for t, name in (
             (DropParts, 'drop_parts'), (Vibrate, 'vibrate'), (RemoveParts, 'remove_parts'))}
         assert client.wait_for_servers(self.get_parts_srv, self.reset_srv,
                                        *self.actions.values(), nodes=(world,)), \

@@ -26,9 +26,9 @@ setup(
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
-            'experiment_manager = experiment_manager.experiment_manager_node:main',
-            'run = experiment_manager.cli:main',
-            'replay = experiment_manager.replay:main',
+            'experiment_manager = experiment_manager.graph.experiment_manager_node:main',
+            'run = experiment_manager.commands.run:main',
+            'replay = experiment_manager.commands.replay:main',
         ],
     },
 )

@@ -9,7 +9,7 @@ ros2 action send_goal --feedback /run_experiment pick_msgs/action/RunExperiment 
 (the `run` executable does the same without ros2 launch: it starts these processes itself).
 """
 
-from experiment_manager.launcher import MANAGER, READS_MESHES, WORKER_NODES
+from experiment_manager.commands.launcher import MANAGER, READS_MESHES, WORKER_NODES
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration

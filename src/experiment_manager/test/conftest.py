@@ -2,10 +2,10 @@
 
 import os
 
-from experiment_manager import config
-from experiment_manager.local_backend import LocalBackend
-from experiment_manager.results import ResultsWriter
-from experiment_manager.scheduler import Runner
+from experiment_manager import experiment_file
+from experiment_manager.analysis.results import ResultsWriter
+from experiment_manager.running.local_backend import LocalBackend
+from experiment_manager.running.scheduler import Runner
 import pytest
 
 SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
@@ -13,7 +13,7 @@ SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
 
 def run_small(directory: str, resume: bool = False) -> dict:
     """Run the small file on the cores (LocalBackend) into `directory`; returns the summary."""
-    file = config.load(SMALL)
+    file = experiment_file.load(SMALL)
     with LocalBackend() as backend, ResultsWriter(directory, file.text, resume) as writer:
         return Runner(file, [backend], writer).run()
 

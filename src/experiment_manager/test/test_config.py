@@ -6,7 +6,7 @@ import os
 import re
 
 from ament_index_python.packages import get_package_share_directory
-from experiment_manager import config
+from experiment_manager import experiment_file
 from pick_common.errors import InvalidArgument
 from pick_common.specs import MOVES
 import pytest
@@ -21,8 +21,9 @@ SWEEP = MINIMAL + '  - {id: g, type: gripper_sweep, iterations: 1, parts: 10, '
 
 
 def test_the_default_file_parses_into_si_units():
-    f = config.load(DEFAULT)
-    assert f.id == 'capacitor_demo' and [e.type for e in f.experiments] == list(config.TYPES)
+    f = experiment_file.load(DEFAULT)
+    assert f.id == 'capacitor_demo'
+    assert [e.type for e in f.experiments] == list(experiment_file.TYPES)
     assert f.gripper.body_diameter == pytest.approx(0.020)
     assert f.check.tolerance == pytest.approx(math.radians(45))
     assert f.tray.inner_size == pytest.approx((0.195, 0.150, 0.027))
@@ -38,14 +39,14 @@ def test_the_default_file_parses_into_si_units():
 def test_the_default_file_s_containers_hold_a_refill_interval_s_parts():
     # Otherwise its bin and table could never come out feasible (issue 23: it once loaded 150
     # parts into a cell that needed 480).
-    f = config.load(DEFAULT)
+    f = experiment_file.load(DEFAULT)
     loads = {e.id: e.parts for e in f.experiments
              if e.type in ('bin_emptying', 'feeder_emptying')}
     assert len(loads) == 2 and min(loads.values()) >= f.requirements.capacity, loads
 
 
 def test_omitted_keys_take_the_documented_defaults():
-    f = config.parse(MINIMAL)
+    f = experiment_file.parse(MINIMAL)
     assert f.seed == 0 and f.search_order == 'top_first' and len(f.grasps) == 5
     assert f.experiments[0].bins[0].inner_size == pytest.approx((0.1, 0.1, 0.02))
     assert f.experiments[0].bins[0].wall_thickness == pytest.approx(0.003)
@@ -137,12 +138,12 @@ BAD = [
 @pytest.mark.parametrize('text, message', BAD)
 def test_a_bad_file_is_refused_with_field_value_and_rule(text, message):
     with pytest.raises(InvalidArgument) as info:
-        config.parse(text)
+        experiment_file.parse(text)
     assert re.search(message, str(info.value)), str(info.value)
 
 
 def test_a_gripper_sweep_is_every_combination_of_its_grid_and_grasp_sets():
-    f = config.parse('gripper: {body_diameter_mm: 10, jaw_height_mm: 12}\n' + MINIMAL + (
+    f = experiment_file.parse('gripper: {body_diameter_mm: 10, jaw_height_mm: 12}\n' + MINIMAL + (
         '  - {id: g, type: gripper_sweep, iterations: 3, parts: 10, min_valid: 2, '
         'grippers: {body_diameter_mm: [8, 12], jaw_depth_mm: [3, 4, 5]}, '
         'grasp_sets: {sides: [side_py, side_px], up: [upright]}}\n'
@@ -166,10 +167,10 @@ def test_a_gripper_sweep_is_every_combination_of_its_grid_and_grasp_sets():
 def test_a_file_that_cannot_be_read_is_named(tmp_path):
     with pytest.raises(InvalidArgument, match=r"experiment_file: '.*missing\.yaml' cannot be "
                        'read: No such file'):
-        config.load(str(tmp_path / 'missing.yaml'))
+        experiment_file.load(str(tmp_path / 'missing.yaml'))
     (tmp_path / 'binary.yaml').write_bytes(b'\xff\xfe\x00')
     with pytest.raises(InvalidArgument, match='is not UTF-8 text'):
-        config.load(str(tmp_path / 'binary.yaml'))
+        experiment_file.load(str(tmp_path / 'binary.yaml'))
 
 
 def test_a_mesh_path_is_relative_to_the_file(tmp_path):
@@ -179,23 +180,23 @@ def test_a_mesh_path_is_relative_to_the_file(tmp_path):
     path.write_text('part:\n  model: mesh\n  mesh: clip.stl\n  mass_g: 0.2\n  grasps:\n'
                     '    - {up_axis: [0, 0, 1], closing_axis: [1, 0, 0], jaw_opening_mm: 8}\n'
                     + MINIMAL)
-    f = config.load(str(path))
+    f = experiment_file.load(str(path))
     assert f.part.mesh_path == str(tmp_path / 'clip.stl')
 
 
 def test_a_reduced_copy_caps_iterations_and_keeps_the_rest(tmp_path):
-    f = config.load(DEFAULT)
-    small = config.parse(config.reduced(f, 1))
+    f = experiment_file.load(DEFAULT)
+    small = experiment_file.parse(experiment_file.reduced(f, 1))
     assert [e.iterations for e in small.experiments] == [1, 1, 1, 1, 1]
     assert small.experiment('sweep').counts == f.experiment('sweep').counts
     assert (small.part, small.gripper, small.grasps) == (f.part, f.gripper, f.grasps)
     with pytest.raises(InvalidArgument, match=r'max_iterations: 0 must be within \[1, '):
-        config.reduced(f, 0)
+        experiment_file.reduced(f, 0)
 
 
 def test_feeder_moves_are_named_or_set_field_by_field():
     text = open(DEFAULT).read()
-    f = config.parse(text.replace('moves: [spread]', 'moves: [flip, {move: backward, '
+    f = experiment_file.parse(text.replace('moves: [spread]', 'moves: [flip, {move: backward, '
                                   'duration_s: 0.2}, {amplitude_mm: [0, 1, 2]}]'))
     flip, back, own = f.moves
     assert flip == MOVES['flip'] and back.duration == 0.2
@@ -206,29 +207,30 @@ def test_feeder_moves_are_named_or_set_field_by_field():
                          ('[{amplitude_mm: [0, 0, -1]}]',
                           r'moves\[0\] \(vibration.amplitude\[2\]\): -0.001 must be >= 0')):
         with pytest.raises(InvalidArgument, match=error):
-            config.parse(text.replace('moves: [spread]', f'moves: {moves}'))
+            experiment_file.parse(text.replace('moves: [spread]', f'moves: {moves}'))
 
 
 def test_the_cell_s_times_default_and_are_checked():
     text = open(DEFAULT).read()
-    assert config.parse(MINIMAL).cell == config.Cell(pick_time=4.0, image_time=0.0)
-    f = config.parse(text.replace('pick_s: 4', 'pick_s: 2.5').replace('image_s: 0',
+    assert experiment_file.parse(MINIMAL).cell == experiment_file.Cell(pick_time=4.0,
+                                                                       image_time=0.0)
+    f = experiment_file.parse(text.replace('pick_s: 4', 'pick_s: 2.5').replace('image_s: 0',
                                                                     'image_s: 0.3'))
-    assert f.cell == config.Cell(pick_time=2.5, image_time=0.3)
+    assert f.cell == experiment_file.Cell(pick_time=2.5, image_time=0.3)
     for old, new, error in (('pick_s: 4', 'pick_s: 0', r'cell.pick_s: 0 must be > 0'),
                             ('image_s: 0', 'image_s: -1', r'cell.image_s: -1 must be >= 0'),
                             ('pick_s: 4', 'pick_time: 4',
                              r'cell.pick_time: 4 is not a known key here \(did you mean '
                              r'pick_s\?\)')):
         with pytest.raises(InvalidArgument, match=error):
-            config.parse(text.replace(old, new))
+            experiment_file.parse(text.replace(old, new))
 
 
 def test_the_installed_share_holds_the_paper_test_case():
     # A user of an installed workspace runs the test case by its share path.
     share = os.path.join(get_package_share_directory('experiment_manager'), 'config')
     for name in ('pth0.yaml', 'pth1.yaml', 'pth2.yaml', 'grippers_pth0.yaml'):
-        assert config.load(os.path.join(share, 'test_case', name)).experiments
+        assert experiment_file.load(os.path.join(share, 'test_case', name)).experiments
 
 
 def test_every_error_of_a_file_comes_at_once():
@@ -240,8 +242,8 @@ experiments:
   - {id: b, type: bin_static, iterations: 0, parts: 10, bins_mm: [[100, 100, 20]]}
   - {id: s, type: table_sweep, iterations: 1, margn: 5}
 """
-    with pytest.raises(config.InvalidFile) as info:
-        config.parse(text)
+    with pytest.raises(experiment_file.InvalidFile) as info:
+        experiment_file.parse(text)
     assert [e.field for e in info.value.errors] == [
         'seed', 'gripper.jaw_depht_mm', 'experiments[0].iterations', 'experiments[1].margn']
     message = str(info.value)
@@ -253,13 +255,13 @@ experiments:
 def test_an_empty_experiment_list_is_refused():
     for text in ('id: t\nexperiments:\n', 'id: t\nexperiments: []\n'):
         with pytest.raises(InvalidArgument, match=r'^experiments: .* must be a list of 1\.\.'):
-            config.parse(text)
+            experiment_file.parse(text)
 
 
 def test_a_misspelt_required_key_is_named_as_the_typo_it_is():
     text = MINIMAL.replace('iterations: 1', 'iteration: 1')
     with pytest.raises(InvalidArgument) as info:
-        config.parse(text)
+        experiment_file.parse(text)
     assert str(info.value) == ('experiments[0].iteration: 1 is not a known key here '
                                '(did you mean iterations? it is required)')
-    assert not isinstance(info.value, config.InvalidFile)     # one error, told once
+    assert not isinstance(info.value, experiment_file.InvalidFile)     # one error, told once

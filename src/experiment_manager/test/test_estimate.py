@@ -3,9 +3,9 @@ finished iterations cost per part, not counted."""
 
 import os
 
-from experiment_manager import config
-from experiment_manager.estimate import Costs, mean_units, TYPE_WEIGHT
-from experiment_manager.plan import count_iterations, experiment_iterations
+from experiment_manager import experiment_file
+from experiment_manager.experiment_file.plan import count_iterations, experiment_iterations
+from experiment_manager.running.estimate import Costs, mean_units, TYPE_WEIGHT
 import pytest
 
 SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
@@ -13,7 +13,7 @@ SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
 
 @pytest.fixture(scope='module')
 def small():
-    file = config.load(SMALL)
+    file = experiment_file.load(SMALL)
     return {e.id: e for e in file.experiments}, file
 
 

@@ -9,21 +9,22 @@ import re
 import threading
 import time
 
-from experiment_manager import config, metrics
-from experiment_manager.backend import WorkerLost
-from experiment_manager.cli import _summary_lines
-from experiment_manager.local_backend import LocalBackend
-from experiment_manager.plan import iteration_seed, plan, Unit
-from experiment_manager.procedures import faults, Iteration, run_unit, search_order
-from experiment_manager.results import read_text_rows, ResultsWriter
-from experiment_manager.rows import FILES, POSE
-from experiment_manager.scheduler import Runner
+from experiment_manager import experiment_file
+from experiment_manager.analysis import metrics
+from experiment_manager.analysis.results import read_text_rows, ResultsWriter
+from experiment_manager.analysis.rows import FILES, POSE
+from experiment_manager.commands.run import _summary_lines
+from experiment_manager.experiment_file.plan import iteration_seed, plan, Unit
+from experiment_manager.running.backend import WorkerLost
+from experiment_manager.running.local_backend import LocalBackend
+from experiment_manager.running.procedures import faults, Iteration, run_unit, search_order
+from experiment_manager.running.scheduler import Runner
 from feeder_controller.policy import NAMES
 import numpy as np
 from pick_common.errors import InvalidArgument
 from pick_common.states import PartStates
-from pick_sim_world.world import speed_limit
-from pick_validity.validity import STAGE_VALID
+from pick_sim_world.stepping import speed_limit
+from pick_validity.results import STAGE_VALID
 import pybullet as pb
 import pytest
 from scipy import stats as scipy_stats
@@ -38,8 +39,8 @@ def read(directory: str, name: str) -> list[dict]:
 def test_every_type_records_its_rows_and_metrics(small):
     directory, summary = small
     rows = read(directory, 'iterations')
-    by_type = {t: [r for r in rows if r['type'] == t] for t in config.TYPES}
-    assert [len(by_type[t]) for t in config.TYPES] == [4, 1, 8, 1, 2]
+    by_type = {t: [r for r in rows if r['type'] == t] for t in experiment_file.TYPES}
+    assert [len(by_type[t]) for t in experiment_file.TYPES] == [4, 1, 8, 1, 2]
     for r in rows:
         n = [int(r[k]) for k in ('checked', 'candidates', 'placeable', 'container_free')]
         assert n == sorted(n, reverse=True), r      # each stage passes a subset of the last
@@ -81,7 +82,7 @@ def test_every_type_records_its_rows_and_metrics(small):
     assert 0 < float(feeder['tray_error']) < 0.05    # the tray moved as commanded
     # The table's time: each vibration lasts its move's duration and then settles, the first
     # feed streams its parts in; no other type has one.
-    file = config.load(SMALL)
+    file = experiment_file.load(SMALL)
     shaking = int(feeder['vibrations']) * sum(m.duration for m in file.moves)
     assert shaking < float(feeder['table_time']) < shaking + 10.0 * (int(feeder['vibrations'])
                                                                       + int(feeder['feeds']))
@@ -95,7 +96,7 @@ def test_every_type_records_its_rows_and_metrics(small):
 
 def test_a_gripper_sweep_checks_every_gripper_on_the_same_scenes(small):
     directory, summary = small
-    exp = config.load(SMALL).experiment('grippers')
+    exp = experiment_file.load(SMALL).experiment('grippers')
     checks = [c for c in read(directory, 'checks') if c['experiment'] == 'grippers']
     assert [(int(c['iteration']), int(c['check'])) for c in checks] == [
         (i, k) for i in range(2) for k in range(len(exp.variants))]
@@ -131,7 +132,7 @@ def test_a_gripper_sweep_checks_every_gripper_on_the_same_scenes(small):
 
 
 def test_the_smallest_gripper_meeting_the_yield_is_chosen_by_size_then_order():
-    file = config.parse(open(SMALL).read())
+    file = experiment_file.parse(open(SMALL).read())
     exp = file.experiment('grippers')      # D 8 / 20 x W 3 / 6 x {all, upright}
     # Per scene (iteration), the valid parts of each variant; 8 scenes.
     per_variant = {0: [9] * 8, 1: [0, 1] * 4, 2: [4] * 8, 3: [16] * 8, 4: [25] * 8,
@@ -168,7 +169,7 @@ def test_the_smallest_gripper_meeting_the_yield_is_chosen_by_size_then_order():
 
 def test_runs_are_deterministic_and_independent_of_order(small, tmp_path):
     directory, _ = small
-    file = config.load(SMALL)
+    file = experiment_file.load(SMALL)
     summary: dict = {}
     units = []
     for exp in file.experiments:   # planned as the run plans them, then run backwards
@@ -188,7 +189,7 @@ def test_runs_are_deterministic_and_independent_of_order(small, tmp_path):
 
 def test_an_interrupted_run_resumes_to_the_same_results(small, run_file, tmp_path):
     directory, summary = small
-    file = config.load(SMALL)
+    file = experiment_file.load(SMALL)
 
     class Interrupt(Exception):
         pass
@@ -276,7 +277,7 @@ def run_on(workers: list, directory: str, started: list | None = None
            ) -> tuple[Runner, dict, list]:
     """Run the small file on `workers`; `started` collects the experiment of each iteration
     in the order the workers took them."""
-    file = config.load(SMALL)
+    file = experiment_file.load(SMALL)
     try:
         with Writer(directory, file.text) as writer:
             runner = Runner(file, workers, writer, lambda p: started is not None and ': ' in
@@ -368,7 +369,7 @@ def test_a_physics_fault_is_marked_left_out_of_the_figures_and_the_run_goes_on(s
 def test_parts_fallen_far_from_the_container_are_not_sent_to_the_check():
     """Found by the reduced test case: an escaped part had fallen to z = -80 m, beyond what
     check_parts accepts (10 m); the run failed."""
-    file = config.load(SMALL)
+    file = experiment_file.load(SMALL)
     exp = file.experiment('emptying')
     container = file.experiment('bins').bins[0]
     u = Unit(exp, 0, 0, 5, container, 20)
@@ -404,7 +405,7 @@ def test_the_health_of_an_iteration_counts_spilled_tunnelled_and_thrown_parts_ap
     floor tunnels, one launched at 4 m/s (what a solver blow-up does: 3.6 m/s was seen) is
     thrown, not spilled, although it flies out; the tunnelled iteration is left out of the
     figures, the spill is counted."""
-    file = config.load(SMALL)
+    file = experiment_file.load(SMALL)
     exp = file.experiment('feeder')
     u = Unit(exp, 0, 0, 5, file.tray, exp.parts)
     with LocalBackend() as backend:

@@ -3,7 +3,7 @@ import signal
 import threading
 import time
 
-from experiment_manager import interrupt
+from experiment_manager.commands import interrupt
 import pytest
 
 

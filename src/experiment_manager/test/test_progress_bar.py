@@ -3,7 +3,7 @@
 import io
 from types import SimpleNamespace
 
-from experiment_manager.cli import ProgressBar
+from experiment_manager.commands.run import ProgressBar
 
 
 class Terminal(io.StringIO):

@@ -4,7 +4,8 @@ the schema text in the file alone (it never imports our message classes)."""
 import struct
 
 from builtin_interfaces.msg import Time
-from experiment_manager.recording import (
+from experiment_manager.commands.replay import replay_qos, STREAM
+from experiment_manager.graph.recording import (
     msg_definition,
     OFFERED_QOS,
     qos_profiles,
@@ -13,7 +14,6 @@ from experiment_manager.recording import (
     recover,
     SEPARATOR,
 )
-from experiment_manager.replay import replay_qos, STREAM
 from geometry_msgs.msg import Vector3
 from mcap.exceptions import EndOfFile, McapError
 from mcap.reader import make_reader

@@ -7,9 +7,10 @@ import os
 import re
 import shutil
 
-from experiment_manager import config, pictures, report, verdicts
-from experiment_manager.metrics import iterations_to_decide, rate_interval
-from experiment_manager.verdicts import FEASIBLE, NOT_ANALYSED, NOT_FEASIBLE, UNDECIDED
+from experiment_manager import experiment_file
+from experiment_manager.analysis import pictures, report, verdicts
+from experiment_manager.analysis.metrics import iterations_to_decide, rate_interval
+from experiment_manager.analysis.verdicts import FEASIBLE, NOT_ANALYSED, NOT_FEASIBLE, UNDECIDED
 import pytest
 
 
@@ -291,8 +292,8 @@ def test_against_the_paper_says_which_findings_hold_and_why_figures_differ(run_d
 
 
 def test_pictures_re_simulate_the_recorded_iteration(run_dir):
-
-    captions = pictures.write(config.load(os.path.join(run_dir, 'experiment.yaml')), run_dir)
+    file = experiment_file.load(os.path.join(run_dir, 'experiment.yaml'))
+    captions = pictures.write(file, run_dir)
     assert set(captions) == {'bin.png', 'tray.png'}
     for name, caption in captions.items():
         assert 'poses identical to the recorded ones' in caption, caption

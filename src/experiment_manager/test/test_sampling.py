@@ -5,12 +5,14 @@ from dataclasses import replace
 import json
 import os
 
-from experiment_manager import config, metrics, report, sampling
-from experiment_manager.cli import _summary_lines
-from experiment_manager.local_backend import LocalBackend
-from experiment_manager.results import read_text_rows, ResultsWriter
-from experiment_manager.scheduler import Runner
-from experiment_manager.verdicts import NOT_FEASIBLE, verdicts
+from experiment_manager import experiment_file
+from experiment_manager.analysis import metrics, report
+from experiment_manager.analysis.results import read_text_rows, ResultsWriter
+from experiment_manager.analysis.verdicts import NOT_FEASIBLE, verdicts
+from experiment_manager.commands.run import _summary_lines
+from experiment_manager.running import sampling
+from experiment_manager.running.local_backend import LocalBackend
+from experiment_manager.running.scheduler import Runner
 import numpy as np
 from pick_common.errors import InvalidArgument
 import pytest
@@ -18,11 +20,11 @@ import pytest
 SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
 
 
-def small(**sampling_section) -> config.ExperimentFile:
+def small(**sampling_section) -> experiment_file.ExperimentFile:
     text = open(SMALL).read()
     if sampling_section:
         text += f'sampling: {json.dumps(sampling_section)}\n'
-    return config.parse(text, SMALL)
+    return experiment_file.parse(text, SMALL)
 
 
 def row(group: int, i: int, **values) -> dict:
@@ -30,13 +32,13 @@ def row(group: int, i: int, **values) -> dict:
 
 
 def test_the_sampling_section_is_read_and_checked():
-    assert small().sampling == config.Sampling('fixed', 5)
+    assert small().sampling == experiment_file.Sampling('fixed', 5)
     assert small(mode='adaptive', batch=3).sampling.adaptive
     with pytest.raises(InvalidArgument, match=r"sampling.mode.*'every'"):
         small(mode='every')
     with pytest.raises(InvalidArgument, match=r'sampling.batch'):
         small(mode='adaptive', batch=0)
-    copy = config.parse(config.reduced(small(), None, adaptive=True), SMALL)
+    copy = experiment_file.parse(experiment_file.reduced(small(), None, adaptive=True), SMALL)
     assert copy.sampling.adaptive and copy.experiments == small().experiments
 
 
@@ -180,7 +182,7 @@ HOPELESS = ('id: stop_early\nseed: 3\npart: {model: radial_capacitor}\n'
 
 def run(mode: str, directory: str, writer=ResultsWriter, resume: bool = False,
         progress=None, required: float = 0.9) -> dict:
-    file = config.parse(HOPELESS + f'sampling: {{mode: {mode}, batch: 2}}\n'
+    file = experiment_file.parse(HOPELESS + f'sampling: {{mode: {mode}, batch: 2}}\n'
                         f'requirements: {{success_rate: {required}}}\n', SMALL)
     with LocalBackend() as backend, writer(directory, file.text, resume) as sink:
         return Runner(file, [backend], sink, progress).run()
@@ -258,7 +260,7 @@ def test_an_adaptive_race_that_runs_out_names_the_bins_it_could_not_tell_apart(t
     with both still in it, and the summary, the terminal and the report say which."""
     text = open(SMALL).read()
     bins = next(line for line in text.splitlines() if '{id: bins' in line)
-    file = config.parse(text.split('experiments:\n')[0] + f'experiments:\n{bins}\n'
+    file = experiment_file.parse(text.split('experiments:\n')[0] + f'experiments:\n{bins}\n'
                         'sampling: {mode: adaptive, batch: 2}\n', SMALL)
     assert [e.id for e in file.experiments] == ['bins']
     with LocalBackend() as backend, ResultsWriter(str(tmp_path), file.text) as sink:

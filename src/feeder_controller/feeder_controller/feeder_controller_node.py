@@ -18,11 +18,12 @@ from pick_common.node_runner import (
     ServerWatch,
     serving,
 )
+from pick_common.rclpy_adapter import LockedActionClient
 from pick_common.specs import MAX_MOVES
 from pick_msgs.action import DropParts, FeedCycle, Vibrate
 from pick_msgs.msg import FeederState as FeederStateMsg
 from pick_msgs.msg import Vibration
-from rclpy.action import ActionClient, ActionServer
+from rclpy.action import ActionServer
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -69,8 +70,8 @@ class FeederControllerNode(Node):
         self._lock = threading.Lock()
         group = ReentrantCallbackGroup()
         self._state_pub = self.create_publisher(FeederStateMsg, 'feeder/state', LATCHED)
-        self._drop = ActionClient(self, DropParts, 'drop_parts', callback_group=group)
-        self._vibrate = ActionClient(self, Vibrate, 'vibrate', callback_group=group)
+        self._drop = LockedActionClient(self, DropParts, 'drop_parts', callback_group=group)
+        self._vibrate = LockedActionClient(self, Vibrate, 'vibrate', callback_group=group)
         ActionServer(self, FeedCycle, 'feed_cycle', execute_callback=self._feed_cycle,
                      callback_group=group, result_timeout=RESULT_KEEP)
         # the call to the world in flight and the watch on the server that took it
@@ -89,7 +90,7 @@ class FeederControllerNode(Node):
     def _publish_state(self) -> None:
         self._state_pub.publish(self._state_msg())
 
-    async def _world(self, client: ActionClient, goal, name: str):
+    async def _world(self, client: LockedActionClient, goal, name: str):
         """Send a goal to the world's action `name` and await its result. Raises CodedError
         with the world's own error code, or INTERNAL when it is not there or leaves."""
         if not client.wait_for_server(timeout_sec=SERVER_WAIT):
@@ -104,7 +105,7 @@ class FeederControllerNode(Node):
             raise CodedError(result.error_code, f'world {name}: {result.error_msg}')
         return result
 
-    def _watched(self, future: Future, client: ActionClient, name: str) -> Future:
+    def _watched(self, future: Future, client: LockedActionClient, name: str) -> Future:
         """`future`, failed by _watch with CodedError if the world's server that took it leaves
         the graph before it completes (a world that died never answers)."""
         self._in_flight = (future, ServerWatch(self, serving(self, [client])), name)

@@ -23,7 +23,6 @@ import rclpy
 from rclpy.action import ActionClient
 from rclpy.exceptions import InvalidHandle, ParameterException
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
-from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -31,10 +30,7 @@ from rclpy.task import Future
 
 from .conversions import error_code, ERROR_INTERNAL
 from .errors import CodedError, Limit, PickError
-
-# `_rclpy` (rclpy's binding) is not public API: rcl's failures (a context shut down under a
-# call, a node rcl refuses) raise its RCLError, which rclpy Jazzy exports nowhere else, and the
-# runner must tell them from other errors.
+from .rclpy_adapter import LockedActionClient, RCLError
 
 # s an action server keeps a finished goal's result (rclpy's default: 900). Every status
 # message lists each goal kept, and every client decodes every status message: with the default,
@@ -49,9 +45,14 @@ LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL,
 
 
 def endpoint_name(client) -> str:
-    """The name a service or action client was made with, as given (unresolved). Not public
-    API for an action: rclpy Jazzy's ActionClient keeps it only as `_action_name`."""
-    return client._action_name if isinstance(client, ActionClient) else client.srv_name
+    """The name a service or action client was made with, as given (unresolved). An action
+    client must be a LockedActionClient: rclpy's own keeps its name private."""
+    if isinstance(client, LockedActionClient):
+        return client.name
+    if isinstance(client, ActionClient):
+        raise TypeError('an action client of the workspace is a '
+                        'pick_common.rclpy_adapter.LockedActionClient (it has a public name)')
+    return client.srv_name
 
 
 def server_ids(node: Node, client) -> frozenset[bytes]:
@@ -220,7 +221,7 @@ def _destroy_quietly(node: Node | None) -> None:
         return
     try:
         node.destroy_node()
-    except (_rclpy.RCLError, InvalidHandle):
+    except (RCLError, InvalidHandle):
         pass
 
 
@@ -251,7 +252,7 @@ def run(name: str, make_node: Callable[[], Node],
         node = make_node()
         executor = make_executor() if make_executor else SingleThreadedExecutor()
         executor.add_node(node)
-    except (PickError, ParameterException, _rclpy.RCLError, InvalidHandle) as exc:
+    except (PickError, ParameterException, RCLError, InvalidHandle) as exc:
         if not rclpy.ok():
             # A signal shut the context down while the node was starting, and the start then
             # failed on something the shutdown took: the world's first scene ('publisher's
@@ -265,7 +266,7 @@ def run(name: str, make_node: Callable[[], Node],
         if isinstance(exc, InvalidHandle):
             raise
         # RCLError: rcl refused the node, e.g. ROS_SECURITY_* it cannot honour.
-        what = 'could not start' if isinstance(exc, _rclpy.RCLError) else 'bad configuration'
+        what = 'could not start' if isinstance(exc, RCLError) else 'bad configuration'
         print(f'{name}: {what}: {exc}', file=sys.stderr)
         sys.exit(2)
     try:
@@ -277,7 +278,7 @@ def run(name: str, make_node: Callable[[], Node],
             executor.spin_once(timeout_sec=SPIN_WAKE)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
-    except (_rclpy.RCLError, InvalidHandle):
+    except (RCLError, InvalidHandle):
         # A signal shut the context down while the executor was taking or finishing work:
         # the handles it used are gone ('feedback publisher is invalid'). That is the
         # shutdown itself; with the context still up it is a failure.

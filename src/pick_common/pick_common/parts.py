@@ -55,6 +55,12 @@ class PartSpec:
     scale: float = 1.0
 
 
+
+def geometry_key(spec: PartSpec) -> tuple:
+    """What a part's collision geometry depends on (not its mass or friction), hashable."""
+    return spec.model, tuple(sorted(spec.dimensions.items())), spec.mesh_path, spec.scale
+
+
 @dataclass(frozen=True, eq=False)
 class Primitive:
     """One collision shape of a part, in the part frame.

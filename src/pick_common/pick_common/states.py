@@ -53,7 +53,7 @@ class SettleReport:
     their container's inner volume; of them, tunnelled_ids are in or under the floor or inside
     a wall (a physics fault: solid bodies passed through each other), and the rest spilled over
     a wall. thrown_ids: parts that moved faster than gravity and the tray can move them
-    (world.speed_limit): a physics fault (the solver gave them energy), wherever they ended.
+    (stepping.speed_limit): a physics fault (the solver gave them energy), wherever they ended.
     max_penetration: the deepest overlap of two bodies at the end, m. max_speed: the fastest
     any part's centre moved during the operation while above its container's floor, m/s.
     tray: for a vibration, the motion the trays delivered (TrayMotion), else None.

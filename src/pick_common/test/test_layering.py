@@ -21,7 +21,7 @@ def _loaded(module: str) -> set[str]:
 @pytest.mark.parametrize('module', [
     'pick_validity.validity_node',
     'feeder_controller.feeder_controller_node',
-    'experiment_manager.experiment_manager_node',
+    'experiment_manager.graph.experiment_manager_node',
 ])
 def test_nodes_other_than_the_world_do_not_import_pybullet(module):
     assert 'pybullet' not in _loaded(module)

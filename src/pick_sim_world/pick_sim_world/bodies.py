@@ -4,6 +4,7 @@
 Every function takes the PyBullet client it works on; the World owns the client.
 """
 
+from collections.abc import Sequence
 import os
 
 import numpy as np
@@ -128,3 +129,14 @@ def max_penetration(client: int) -> float:
     """The deepest overlap of any two bodies in contact now, m (0 when none overlap)."""
     contacts = pb.getContactPoints(physicsClientId=client)
     return max(0.0, -min((c[8] for c in contacts), default=0.0))
+
+
+def touching(client: int, bodies: Sequence[int]) -> set[int]:
+    """The bodies that a body of `bodies` touches (is within the contact-breaking threshold
+    of), by the contacts of the last step; `bodies` themselves among them only where two of
+    them touch."""
+    found = set()
+    for body in bodies:
+        found.update(contact[2] for contact in pb.getContactPoints(bodyA=body,
+                                                                   physicsClientId=client))
+    return found

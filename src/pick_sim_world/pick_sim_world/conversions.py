@@ -139,7 +139,7 @@ def markers_msg(world: World, states: PartStates, stamp: Time, prefix: str) -> M
     orientations = np.stack([_quat_mul(q, p.orientation) for p in primitives], axis=1).tolist()
     # Per instance, colour and primitive, one marker to copy: a copy shares the fields every
     # part's marker has in common and skips the type checks a Marker built from keywords makes
-    # on each (building 1.8 to 2.2 times faster: bench/bench_conversions.py).
+    # on each (building 1.8 to 2.2 times faster: bench/graph/bench_conversions.py).
     templates: dict[tuple[int, bool, int], Marker] = {}
     for pid, inst, inside, part_positions, part_orientations in zip(
             states.ids.tolist(), states.instances.tolist(), states.inside.tolist(), positions,

@@ -42,21 +42,10 @@ import pybullet as pb
 
 from . import bodies, camera, spawning, stepping
 from .camera import Overlay
-from .config import check_physics, GRAVITY, PhysicsConfig
+from .config import check_physics, PhysicsConfig
 from .freezing import Freezer
 from .stepping import ProgressCallback
 from .tray import TrayDrive, vibration_amplitude, vibration_substeps
-
-
-def speed_limit(container: containers.ContainerSpec, part: PartGeometry,
-                tray_speed: float = 0.0) -> float:
-    """The fastest gravity and the tray can move a part's centre, m/s: a free fall from the
-    highest a part can be and still count as in its container (twice the walls' height,
-    containers.inside) plus a part's bounding diameter (where a drop's next layer spawns) to
-    the floor's underside, plus twice the tray's peak speed (a bounce off a moving wall). A
-    part faster than this got its energy from the solver (world README, "Thrown parts")."""
-    height = 2.0 * container.inner_size[2] + 2.0 * part.radius + container.floor_thickness
-    return math.sqrt(2.0 * GRAVITY * height) + 2.0 * tray_speed
 
 
 @dataclass
@@ -359,22 +348,25 @@ class World:
         return ids, self._finished(SettleReport(True, 0.0, 0.0, 0))
 
     def _parts_touching(self, ids: list[int]) -> set[int]:
-        """The parts not in `ids` that a part of `ids` touches (is within the contact-breaking
-        threshold of), by the contacts of the last step."""
-        removed = {self._bodies[pid] for pid in ids}
-        part_of = {body: pid for pid, body in self._bodies.items() if body not in removed}
-        touching = set()
-        for body in removed:
-            for contact in pb.getContactPoints(bodyA=body, physicsClientId=self._client):
-                if contact[2] in part_of:
-                    touching.add(part_of[contact[2]])
-        return touching
+        """The parts not in `ids` that a part of `ids` touches (bodies.touching)."""
+        part_of = {body: pid for pid, body in self._bodies.items() if pid not in ids}
+        touched = bodies.touching(self._client, [self._bodies[pid] for pid in ids])
+        return {part_of[b] for b in touched if b in part_of}
 
     # ----------------------------------------------------------------------------- settle
     def settle(self, max_settle_time: float | None = None,
                progress: ProgressCallback | None = None) -> SettleReport:
         """Step until every part rests or the time cap is hit."""
         return self._finished(self._settle('settling', max_settle_time, progress))
+
+    def advance(self, duration: float, progress: ProgressCallback | None = None
+                ) -> SettleReport:
+        """Step every part for `duration` s of simulated time (0 < duration <= 600), whether
+        the parts rest or not: how a settled pile creeps, or a scene watched over time. No
+        part is frozen. The report's `settled` says whether the parts rested at its end."""
+        duration = check_number('duration', duration, low=0.0, high=600.0, low_open=True)
+        return self._finished(self._run('settling', duration, progress,
+                                        stop_when_settled=False))
 
     def _settle(self, phase: str, max_settle_time: float | None,
                 progress: ProgressCallback | None, freezer: Freezer | None = None,
@@ -421,7 +413,7 @@ class World:
             gone = containers.tunnelled(self._scene.container, self._centres(state))
             last.tunnelled_ids = [int(i) for i in state.ids[gone]]
         last.max_penetration = bodies.max_penetration(self._client)
-        limit = speed_limit(self._scene.container, self._part, self._tray_speed)
+        limit = stepping.speed_limit(self._scene.container, self._part, self._tray_speed)
         last.max_speed = max(self._peaks.values(), default=0.0)
         last.thrown_ids = sorted(pid for pid, v in self._peaks.items() if v > limit)
         self._peaks, self._tray_speed = {}, 0.0

@@ -13,8 +13,9 @@ from pick_common.specs import FIXED, RANDOM, SceneSpec, Vibration
 from pick_common.states import quaternion_angles, rotate
 from pick_sim_world import spawning
 from pick_sim_world.config import PhysicsConfig
+from pick_sim_world.stepping import speed_limit
 from pick_sim_world.tray import vibration_amplitude
-from pick_sim_world.world import speed_limit, World
+from pick_sim_world.world import World
 import pybullet as pb
 import pytest
 import trimesh
@@ -194,10 +195,23 @@ def _movers_after_settling(world: World, count: int) -> int:
     many parts moved more than the settle tolerance in it."""
     _, report = world.drop(count)
     assert report.settled
-    before = world.snapshot()
-    world._run('settling', 1.0, None, stop_when_settled=False)    # a full second
+    before, start = world.snapshot(), world.sim_time
+    world.advance(1.0)                  # a full second, at rest or not
+    assert world.sim_time == pytest.approx(start + 1.0, abs=world.physics.time_step)
     moved = np.linalg.norm(world.snapshot().poses[:, :3] - before.poses[:, :3], axis=1)
     return int((moved > world.physics.settle_linear_tolerance).sum())
+
+
+def test_advance_steps_the_time_asked_and_refuses_a_bad_duration():
+    with _world() as world:
+        world.drop(5)
+        start = world.sim_time
+        report = world.advance(0.25)
+        assert world.sim_time == pytest.approx(start + 0.25, abs=world.physics.time_step)
+        assert report.escaped_ids == []
+        for bad in (0.0, -1.0, math.nan, 601.0):
+            with pytest.raises(InvalidArgument, match='duration'):
+                world.advance(bad)
 
 
 def test_parts_settled_on_a_tray_stay_put():

@@ -1,5 +1,6 @@
 """Frozen definitions of the gripper, the grasp poses, the placement and the check settings,
-and their validation in one place (shared by the node, the services and the tests).
+and their validation in one place (shared by the node, the services and the tests); `Setup`
+packs them with the part spec: the one input a check is built from.
 
 Units: metres and radians. Axes are in the part frame.
 """
@@ -9,6 +10,7 @@ import math
 
 import numpy as np
 from pick_common.errors import check_vector, InvalidArgument, Limit
+from pick_common.parts import geometry_key, PartSpec
 
 MAX_GRASPS = 32
 MAX_TILTS = 361
@@ -112,6 +114,25 @@ CAPACITOR_GRASPS = (
     GraspPose('side_ny', (0.0, -1.0, 0.0), (1.0, 0.0, 0.0), 0.011),
     GraspPose('upright', (0.0, 0.0, 1.0), (1.0, 0.0, 0.0), 0.011),
 )
+
+
+@dataclass(frozen=True)
+class Setup:
+    """Everything a check runs with besides the scene, packed once where it is read (the
+    experiment file, the node's parameters, a check_parts request): the part's spec (the
+    validator builds its geometry), the gripper, its grasp poses, how the part is placed and
+    the check's settings. Checked when a Validator is built from it."""
+
+    part: PartSpec = PartSpec()
+    gripper: Gripper = Gripper()
+    grasps: tuple[GraspPose, ...] = CAPACITOR_GRASPS
+    place: PlaceSpec = PlaceSpec()
+    config: CheckConfig = CheckConfig()
+
+    def key(self) -> tuple:
+        """What a validator built from this setup depends on, hashable: the part's geometry
+        (not its mass or friction) and the rest as they are."""
+        return geometry_key(self.part), self.gripper, self.grasps, self.place, self.config
 
 
 @dataclass(frozen=True)

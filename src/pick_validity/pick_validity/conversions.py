@@ -2,14 +2,12 @@
 validity core. Container, part-model and part conversions are pick_common's, reused."""
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Point, Vector3
 import numpy as np
 from pick_common import conversions as common
 from pick_common.containers import ContainerSpec
-from pick_common.parts import PartSpec
 from pick_msgs.msg import CheckSettings, PartValidity, ValidityReport
 from pick_msgs.msg import GraspPose as GraspPoseMsg
 from pick_msgs.msg import Gripper as GripperMsg
@@ -17,39 +15,30 @@ from pick_msgs.msg import PlaceSpec as PlaceSpecMsg
 from pick_msgs.srv import CheckParts
 from std_msgs.msg import Header
 
-from .config import CheckConfig, GraspPose, Gripper, PlaceSpec
-from .validity import PartResult, Report, Validator
+from .config import CheckConfig, GraspPose, Gripper, PlaceSpec, Setup
+from .results import PartResult, Report
+from .validity import Validator
 
 
-@dataclass(frozen=True)
-class Setup:
-    """The gripper, grasp poses, placement and settings a check runs with."""
-
-    gripper: Gripper
-    grasps: tuple[GraspPose, ...]
-    place: PlaceSpec
-    config: CheckConfig
-
-
-def request_to_core(request: CheckParts.Request, mesh_dirs: Sequence[str]
-                    ) -> tuple[ContainerSpec, PartSpec, list[int], object, list[int] | None]:
-    """Container, part spec, ids, poses (N, 7) and targets (None for all) of a request; a
-    mesh file must lie in one of `mesh_dirs`."""
+def request_to_core(request: CheckParts.Request
+                    ) -> tuple[ContainerSpec, list[int], object, list[int] | None]:
+    """Container, ids, poses (N, 7) and targets (None for all) of a request (its setup:
+    `setup_from_request`)."""
     ids, _, poses = common.parts_to_arrays(request.parts)
     targets = [int(t) for t in request.target_ids] or None
-    return (common.container_from_msg(request.container),
-            common.part_spec_from_msg(request.part_model, mesh_dirs), ids.tolist(),
-            poses,
-            targets)
+    return common.container_from_msg(request.container), ids.tolist(), poses, targets
 
 
 def _xyz(v) -> tuple[float, float, float]:
     return float(v.x), float(v.y), float(v.z)
 
 
-def setup_from_request(request: CheckParts.Request, defaults: Setup) -> Setup:
-    """The request's gripper, grasps, placement and settings; each left empty (all 0 or an
-    empty list) takes the node's default. Checked by the core."""
+def setup_from_request(request: CheckParts.Request, defaults: Setup,
+                       mesh_dirs: Sequence[str]) -> Setup:
+    """The request's part model, gripper, grasps, placement and settings; each but the part
+    left empty (all 0 or an empty list) takes the node's default. A mesh file must lie in one
+    of `mesh_dirs`. Checked by the core."""
+    part = common.part_spec_from_msg(request.part_model, mesh_dirs)
     g = request.gripper
     gripper = defaults.gripper
     if any((g.body_diameter, g.body_length, g.jaw_height, g.jaw_depth)):
@@ -65,12 +54,13 @@ def setup_from_request(request: CheckParts.Request, defaults: Setup) -> Setup:
     if s.tilt_step != 0.0:
         config = CheckConfig(s.tolerance, s.tilt_min, s.tilt_max, s.tilt_step,
                              s.approach_cone, s.rim_tolerance)
-    return Setup(gripper, grasps, place, config)
+    return Setup(part, gripper, grasps, place, config)
 
 
 def setup_to_request(setup: Setup, request: CheckParts.Request) -> CheckParts.Request:
-    """Fill a request's gripper, grasps, placement and settings from a Setup."""
+    """Fill a request's part model, gripper, grasps, placement and settings from a Setup."""
     g, p, c = setup.gripper, setup.place, setup.config
+    request.part_model = common.part_spec_to_msg(setup.part)
     request.gripper = GripperMsg(body_diameter=g.body_diameter, body_length=g.body_length,
                                  jaw_height=g.jaw_height, jaw_depth=g.jaw_depth,
                                  finger_clearance=g.finger_clearance)
@@ -94,11 +84,6 @@ def _grasp_msg(name, up, closing, opening, point) -> GraspPoseMsg:
                         jaw_opening=float(opening),
                         grasp_point=Point(x=float(point[0]), y=float(point[1]),
                                           z=float(point[2])))
-
-
-def geometry_key(spec: PartSpec) -> tuple:
-    """What a part's collision geometry depends on (not its mass or friction)."""
-    return spec.model, tuple(sorted(spec.dimensions.items())), spec.mesh_path, spec.scale
 
 
 def report_to_msg(report: Report, validator: Validator, stamp: Time, frame_id: str,

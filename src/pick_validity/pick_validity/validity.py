@@ -20,43 +20,26 @@ its up axis nearest world +Z before the stages (`Validator.free_axes`); a capaci
 its side is then approached from above whatever its roll. So the part-in-gripper pose, and
 with it placeability, depends on how the part lies: the same grasp of a part tilted one way
 can be placed and tilted the other way not.
-Container and neighbour stages decide what exact bounds can decide and ask FCL the rest;
-`naive_check` asks FCL everything, with no broadphase and no caching, and must give identical
-results.
+Container and neighbour stages decide what exact bounds can decide and ask FCL the rest
+(`pairs`); `naive.naive_check` asks FCL everything, with no broadphase and no caching, and must
+give identical results. What a check answers lives in `results`.
 
 Poses are (N, 7) float64, xyz m + xyzw unit quaternion, in the container frame (origin at the
 centre of the inner floor, +Z up).
 """
 
+
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
-import itertools
 import math
 import time
 
-import fcl
 import numpy as np
 from pick_common import containers
 from pick_common.containers import ContainerSpec
-from pick_common.errors import InvalidArgument, UnknownPart
-from pick_common.parts import PartGeometry
-from scipy.spatial import cKDTree
-from scipy.spatial.transform import Rotation
+from pick_common.parts import build_part, PartGeometry
 
-from .config import (
-    check_grasps,
-    check_gripper,
-    check_place,
-    CheckConfig,
-    Grasp,
-    GraspPose,
-    Gripper,
-    PlaceSpec,
-    tilts,
-)
+from .config import check_grasps, check_gripper, check_place, Grasp, Setup, tilts
 from .geometry import (
-    bounds,
-    collide,
     contains,
     CYLINDER,
     grasped_extent,
@@ -66,116 +49,21 @@ from .geometry import (
     place,
     quaternions_to_matrices,
     rotations_about_x,
-    Shape,
     support,
 )
-
-# The stage a check stopped at (the one that failed), or VALID; values as in PartValidity.msg.
-STAGE_NONE, STAGE_CANDIDACY, STAGE_PLACEABILITY, STAGE_CONTAINER, STAGE_NEIGHBOUR, \
-    STAGE_VALID, STAGE_OUTSIDE = range(7)
-# The stages a part in the container passed, in order (OUTSIDE is not among them: its part
-# was not checked).
-ORDER = (STAGE_CANDIDACY, STAGE_PLACEABILITY, STAGE_CONTAINER, STAGE_NEIGHBOUR, STAGE_VALID)
-CENTRE_TOLERANCE = 0.001      # m beyond the inner walls and floor a part's centre may lie
-TIE = 1e-6                    # rad: grasps whose up axes are this near in angle tie (acos near 0
-#                               is only good to about 1e-8 rad)
-QUATERNION_TOLERANCE = 1e-3   # |norm - 1| accepted (and normalised); larger is refused
-MAX_PARTS = 20000
-MAX_POSITION = 10.0           # m from the instance frame; a container is at most 2 m wide
-
-
-@dataclass
-class PartResult:
-    """One part's check. gripper_pose: (7,) xyz + xyzw in the container frame at the valid tilt
-    nearest 0, None unless valid. Angles in rad, jaw_opening in m."""
-
-    part_id: int
-    stage: int
-    reason: str
-    grasp_index: int = -1
-    candidacy_angle: float = math.nan
-    gripper_pose: np.ndarray | None = None
-    jaw_opening: float = 0.0
-    valid_tilts: tuple[float, ...] = ()
-
-    @property
-    def valid(self) -> bool:
-        return self.stage == STAGE_VALID
-
-    def key(self) -> tuple:
-        """What two checks must agree on."""
-        return self.part_id, self.stage, self.grasp_index, self.valid_tilts
-
-
-@dataclass
-class Report:
-    """The results of one check, in the order of the targets, with counts per stage (a part
-    outside the container counts as checked and in none of the stages)."""
-
-    results: list[PartResult]
-    neighbour_check: bool
-    queries: int = 0            # FCL narrowphase queries issued
-    wall_time: float = 0.0      # s
-    counts: dict[str, int] = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        passed = [ORDER.index(r.stage) if r.stage in ORDER else -1 for r in self.results]
-        self.counts = {
-            'checked': len(passed),
-            'outside': sum(r.stage == STAGE_OUTSIDE for r in self.results),
-            'candidates': sum(p > 0 for p in passed),
-            'placeable': sum(p > 1 for p in passed),
-            'container_free': sum(p > 2 for p in passed),
-            'valid': sum(p == 4 for p in passed)}
-
-
-def check_poses(ids: Sequence[int], poses: np.ndarray) -> np.ndarray:
-    """Refuse NaN/inf and non-unit quaternions (beyond float noise, which is normalised) and
-    duplicate ids; return the poses with unit quaternions. A NaN must never reach FCL: it
-    reports no collision for a NaN transform."""
-    poses = np.asarray(poses, dtype=np.float64)
-    if poses.ndim != 2 or poses.shape[1] != 7 or len(poses) != len(ids):
-        raise InvalidArgument('parts', poses.shape, f'must be ({len(ids)}, 7) poses')
-    if not len(ids):
-        raise InvalidArgument('parts', [], 'is empty: send every part of the container')
-    if len(ids) > MAX_PARTS:
-        raise InvalidArgument('parts', len(ids), f'holds more than {MAX_PARTS} parts')
-    bad = np.flatnonzero(~np.isfinite(poses).all(axis=1))
-    if len(bad):
-        i = int(bad[0])
-        raise InvalidArgument(f'parts[{i}] (id {ids[i]}).pose', poses[i].tolist(),
-                              'must be finite (no NaN or inf)')
-    bad = np.flatnonzero((np.abs(poses[:, :3]) > MAX_POSITION).any(axis=1))
-    if len(bad):     # found by fuzzing: 1e154 overflowed in the neighbour search
-        i = int(bad[0])
-        raise InvalidArgument(f'parts[{i}] (id {ids[i]}).pose.position', poses[i, :3].tolist(),
-                              f'must be within {MAX_POSITION:g} m of the instance frame')
-    norms = np.linalg.norm(poses[:, 3:], axis=1)
-    bad = np.flatnonzero(np.abs(norms - 1.0) > QUATERNION_TOLERANCE)
-    if len(bad):
-        i = int(bad[0])
-        raise InvalidArgument(f'parts[{i}] (id {ids[i]}).pose.orientation', poses[i, 3:].tolist(),
-                              f'has norm {norms[i]:.6g}; must be a unit quaternion (within '
-                              f'{QUATERNION_TOLERANCE:g}, which is normalised)')
-    if len(set(ids)) != len(ids):
-        seen = set()
-        dup = next(i for i in ids if i in seen or seen.add(i))
-        raise InvalidArgument('parts', dup, 'id appears twice')
-    out = poses.copy()
-    out[:, 3:] /= norms[:, None]
-    return out
-
-
-def _targets(ids: Sequence[int], targets: Iterable[int] | None) -> list[int]:
-    index = {pid: i for i, pid in enumerate(ids)}
-    if targets is None:
-        return list(range(len(ids)))
-    rows = []
-    for pid in targets:
-        if pid not in index:
-            raise UnknownPart(f'target_ids: {pid} is not among the parts sent')
-        rows.append(index[pid])
-    return rows
+from .pairs import Pairs
+from .results import (
+    CENTRE_TOLERANCE,
+    check_poses,
+    PartResult,
+    Report,
+    STAGE_CANDIDACY,
+    STAGE_OUTSIDE,
+    STAGE_PLACEABILITY,
+    STAGE_VALID,
+    target_rows,
+    TIE,
+)
 
 
 def _deg(rad: float) -> str:
@@ -189,20 +77,22 @@ class Validator:
     are computed here, never per part.
     """
 
-    def __init__(self, part: PartGeometry, gripper: Gripper, grasps: Sequence[GraspPose],
-                 place_spec: PlaceSpec, config: CheckConfig | None = None) -> None:
-        self.config = config or CheckConfig()
-        self.part = part
-        self.gripper = check_gripper(gripper)
-        self.grasps = check_grasps(list(grasps))
-        self.place_axis, self.seat_offset = check_place(place_spec)
+    def __init__(self, setup: Setup, part: PartGeometry | None = None) -> None:
+        """`part`: the geometry of setup.part when the caller has built it already (the
+        world's); built here otherwise. Raises InvalidArgument for a bad setup."""
+        self.setup = setup
+        self.config = setup.config
+        self.part = part if part is not None else build_part(setup.part)
+        self.gripper = check_gripper(setup.gripper)
+        self.grasps = check_grasps(list(setup.grasps))
+        self.place_axis, self.seat_offset = check_place(setup.place)
         self.tilts = tilts(self.config)
         self._rotations = rotations_about_x(self.tilts)
-        self.part_shapes = part_shapes(part)
+        self.part_shapes = part_shapes(self.part)
         self.finger_depths = tuple(self._finger_depth(g) for g in self.grasps)
         self.gripper_shapes = [gripper_shapes(self.gripper, g.jaw_opening, depth)
                                for g, depth in zip(self.grasps, self.finger_depths, strict=True)]
-        self._gripper_objects = [[s.fcl_object() for s in shapes]
+        self.gripper_objects = [[s.fcl_object() for s in shapes]
                                  for shapes in self.gripper_shapes]
         # per grasp: the axis (part frame) of the round body its jaws close across, about which
         # it may turn; zero for a grasp that is fixed to the part
@@ -313,7 +203,7 @@ class Validator:
         containers.check_container(container)
         ids = [int(i) for i in ids]
         poses = check_poses(ids, poses)
-        rows = _targets(ids, targets)
+        rows = target_rows(ids, targets)
         rotations = quaternions_to_matrices(poses[:, 3:])
         positions = poses[:, :3]
         results: dict[int, PartResult] = {}
@@ -365,7 +255,7 @@ class Validator:
             world_frames[row] = frames[n]
 
         # 3. container, 4. neighbours: vectorised over every (part, tilt) pair left.
-        pairs = _Pairs(self, kept, results, world_frames, rotations, positions)
+        pairs = Pairs(self, kept, results, world_frames, rotations, positions)
         queries += pairs.container(container)
         if neighbour_check:
             queries += pairs.neighbours(ids, rotations, positions)
@@ -409,269 +299,3 @@ def _outside_reason(container: ContainerSpec, centre: np.ndarray, rim: float) ->
     else:
         where = f'more than {1000 * rim:g} mm (check.rim_tolerance) above its {1000 * z:g} mm rim'
     return f'not in the container: its centre ({mm}) mm lies {where}; not checked'
-
-
-class _Pairs:
-    """Every (part, tilt) pair still open after placeability, with the gripper's shapes placed
-    in the container frame, their exact bounds, and the masks of `kept` to update."""
-
-    def __init__(self, v: Validator, kept: dict[int, np.ndarray],
-                 results: dict[int, PartResult], frames: dict[int, np.ndarray],
-                 rotations: np.ndarray, positions: np.ndarray) -> None:
-        self.v, self.kept, self.results = v, kept, results
-        rows, ks = [], []
-        for row, mask in kept.items():
-            k = np.flatnonzero(mask)
-            rows.append(np.full(len(k), row))
-            ks.append(k)
-        self.row = np.concatenate(rows) if rows else np.zeros(0, dtype=int)
-        self.k = np.concatenate(ks) if ks else np.zeros(0, dtype=int)
-        self.g = np.array([results[r].grasp_index for r in self.row], dtype=int)
-        count, shapes = len(self.row), 2
-        self.rot = np.empty((count, shapes, 3, 3))
-        self.center = np.empty((count, shapes, 3))
-        self.lo = np.empty((count, shapes, 3))
-        self.hi = np.empty((count, shapes, 3))
-        self.grasp_point = np.empty((count, 3))
-        for g in np.unique(self.g):
-            sel = np.flatnonzero(self.g == g)
-            r = rotations[self.row[sel]]
-            frame = np.stack([frames[row][k] for row, k in zip(self.row[sel], self.k[sel],
-                                                                strict=True)])
-            origin = positions[self.row[sel]] + r @ v.grasps[g].point
-            self.grasp_point[sel] = origin
-            for s, shape in enumerate(v.gripper_shapes[g]):
-                rot, center = place(shape, frame, origin)
-                self.rot[sel, s], self.center[sel, s] = rot, center
-                self.lo[sel, s], self.hi[sel, s] = bounds(shape, rot, center)
-        self.hit = np.zeros(count, dtype=bool)
-
-    def _object(self, q: int, s: int) -> fcl.CollisionObject:
-        obj = self.v._gripper_objects[self.g[q]][s]
-        obj.setTransform(fcl.Transform(self.rot[q, s], self.center[q, s]))
-        return obj
-
-    def _close(self, stage: int, why: str) -> None:
-        """Apply hits to the masks; parts with no tilt left stop at `stage`."""
-        for q in np.flatnonzero(self.hit):
-            self.kept[self.row[q]][self.k[q]] = False
-        for row, mask in self.kept.items():
-            result = self.results[row]
-            if result.stage == STAGE_CANDIDACY and not mask.any():
-                result.stage = stage
-                result.reason = why.format(name=self.v.grasps[result.grasp_index].name,
-                                           n=int((self.row == row).sum()))
-        keep = ~self.hit
-        for name in ('row', 'k', 'g', 'rot', 'center', 'lo', 'hi', 'grasp_point', 'hit'):
-            setattr(self, name, getattr(self, name)[keep])
-
-    def container(self, container: ContainerSpec) -> int:
-        """Stage 3. A convex shape and an axis-aligned wall box: apart when their bounds are;
-        certainly touching when the shape's bounds lie within the box's on two axes (its
-        projection on the third overlaps, so some point of it is inside). FCL decides the
-        rest. Returns the FCL queries issued."""
-        queries = 0
-        for half, center in containers.wall_boxes(container):
-            wc, wh = np.array(center), np.array(half)
-            wall = fcl.CollisionObject(fcl.Box(*(2 * wh)), fcl.Transform(np.eye(3), wc))
-            for s in range(self.lo.shape[1]):
-                lo, hi = self.lo[:, s], self.hi[:, s]
-                apart = ((lo > wc + wh) | (hi < wc - wh)).any(axis=1)
-                inside = ((lo >= wc - wh) & (hi <= wc + wh)).sum(axis=1) >= 2
-                self.hit |= ~apart & inside
-                for q in np.flatnonzero(~apart & ~inside & ~self.hit):
-                    queries += 1
-                    self.hit[q] = collide(self._object(q, s), wall)
-        self._close(STAGE_CONTAINER, 'grasp {name!r}: the gripper hits the container at each '
-                    'of the {n} placeable tilts')
-        return queries
-
-    def neighbours(self, ids: Sequence[int], rotations: np.ndarray,
-                   positions: np.ndarray) -> int:
-        """Stage 4. Broadphase: a k-d tree over the parts' bounding spheres, queried at once
-        with the bounding sphere of every gripper shape at every pair; then exact bounds; FCL
-        decides the pairs that overlap, and a pair stops at its first hit."""
-        v = self.v
-        if not len(self.row):
-            return 0
-        placed = [place(s, rotations, positions) for s in v.part_shapes]
-        part_bounds = [bounds(s, r, c) for s, (r, c) in zip(v.part_shapes, placed, strict=True)]
-        tree = cKDTree(positions + np.einsum('nij,j->ni', rotations, v.part.center))
-        count, shapes = self.lo.shape[:2]
-        radii = np.array([[_radius(s) for s in v.gripper_shapes[g]] for g in self.g])
-        near = tree.query_ball_point(self.center.reshape(-1, 3),
-                                     radii.reshape(-1) + v.part.radius)
-        lengths = np.fromiter(map(len, near), dtype=int, count=len(near))
-        jj = np.fromiter(itertools.chain.from_iterable(near), dtype=int, count=lengths.sum())
-        qs = np.repeat(np.arange(count * shapes), lengths)
-        qq, ss = np.divmod(qs, shapes)
-        other_part = jj != self.row[qq]
-        qq, ss, jj = qq[other_part], ss[other_part], jj[other_part]
-        todo = []
-        for p, (plo, phi) in enumerate(part_bounds):
-            hit = ~((plo[jj] > self.hi[qq, ss]) | (phi[jj] < self.lo[qq, ss])).any(axis=1)
-            todo.append(np.column_stack([qq[hit], ss[hit], jj[hit], np.full(hit.sum(), p)]))
-        todo = np.concatenate(todo)
-        todo = todo[np.lexsort(todo.T[::-1])]          # by pair, shape, neighbour, primitive
-        starts = np.searchsorted(todo[:, 0], np.arange(count + 1)).tolist()
-        todo = todo.tolist()
-        objects: dict[tuple[int, int], fcl.CollisionObject] = {}
-        hits: dict[int, set[int]] = {}
-        queries = 0
-        for q in range(count):
-            shape_set = -1
-            for _, s, j, p in todo[starts[q]:starts[q + 1]]:
-                other = objects.get((j, p))
-                if other is None:
-                    other = objects[j, p] = fcl.CollisionObject(
-                        v.part_shapes[p].geometry,
-                        fcl.Transform(placed[p][0][j], placed[p][1][j]))
-                if shape_set != s:
-                    gripper = self._object(q, s)
-                    shape_set = s
-                queries += 1
-                if collide(gripper, other):
-                    self.hit[q] = True
-                    hits.setdefault(int(self.row[q]), set()).add(ids[j])
-                    break
-        self._close(STAGE_NEIGHBOUR, 'grasp {name!r}: the gripper hits other parts at each of '
-                    'the {n} remaining tilts')
-        for row, found in hits.items():
-            result = self.results[row]
-            if result.stage == STAGE_NEIGHBOUR:
-                result.reason += f' (parts {sorted(found)})'
-        return queries
-
-
-def _radius(shape: Shape) -> float:
-    """Radius of a sphere about the shape's center that encloses it, m."""
-    if shape.kind == 'hull':
-        return float(np.linalg.norm(shape.vertices, axis=1).max())
-    if shape.kind == 'box':
-        return float(np.linalg.norm(shape.half))
-    return float(math.hypot(shape.half[0], shape.half[1]))
-
-
-def naive_check(validator: Validator, container: ContainerSpec, ids: Sequence[int],
-                poses: np.ndarray, targets: Iterable[int] | None = None,
-                neighbour_check: bool = True) -> Report:
-    """The reference: every part, every tilt, every other part, FCL for every decision (the
-    placing surface a half-space in the part frame), no broadphase, no bounds, no caching;
-    the gripper's frame built per tilt from its definition. Same results as
-    `Validator.check`, far slower."""
-    start = time.perf_counter()
-    v = validator
-    ids = [int(i) for i in ids]
-    poses = check_poses(ids, poses)
-    rows = _targets(ids, targets)
-    rotations = quaternions_to_matrices(poses[:, 3:])
-    positions = poses[:, :3]
-    walls = [fcl.CollisionObject(fcl.Box(*(2 * np.array(h))), fcl.Transform(np.eye(3),
-                                                                          np.array(c)))
-             for h, c in containers.wall_boxes(container)]
-    surface = fcl.CollisionObject(fcl.Halfspace(-v.place_axis, -v.seat_offset),
-                                  fcl.Transform())
-    queries = 0
-    results = []
-    for row in rows:
-        rotation, position = rotations[row], positions[row]
-        centre = position + rotation @ v.part.center
-        if not containers.inside(container, centre, CENTRE_TOLERANCE,
-                                 v.config.rim_tolerance)[0]:
-            results.append(PartResult(ids[row], STAGE_OUTSIDE, 'outside'))
-            continue
-        # each grasp as the gripper takes it: on a round body, turned about its axis by the
-        # angle from the up axis to world +Z, both seen across the axis
-        turns, turned = [], []
-        for g, a in zip(v.grasps, v.free_axes, strict=True):
-            w = rotation.T @ np.array([0.0, 0.0, 1.0])
-            u_across, w_across = g.up - (g.up @ a) * a, w - (w @ a) * a
-            turn = math.atan2(float(a @ np.cross(u_across, w_across)),
-                              float(u_across @ w_across)) if a.any() else 0.0
-            turns.append(turn)
-            turned.append(rotation @ Rotation.from_rotvec(turn * a).as_matrix())
-        angles = [math.acos(max(-1.0, min(1.0, float((r @ g.up)[2]))))
-                  for g, r in zip(v.grasps, turned, strict=True)]
-        g = min((k for k in range(len(angles)) if angles[k] <= min(angles) + TIE),
-                key=lambda k: (abs(turns[k]), k))
-        grasp, gripped = v.grasps[g], turned[g]
-        result = PartResult(ids[row], STAGE_CANDIDACY, '', g, angles[g],
-                            jaw_opening=grasp.jaw_opening)
-        results.append(result)
-        if angles[g] > v.config.tolerance:
-            result.grasp_index = -1
-            continue
-        shapes = gripper_shapes(v.gripper, grasp.jaw_opening, v.finger_depths[g])
-        objects = [s.fcl_object() for s in shapes]
-        closing = gripped @ grasp.closing
-        # the vertical made perpendicular to the closing axis, turned by each tilt about it
-        axis = np.array([0.0, 0.0, 1.0]) - closing[2] * closing
-        if np.linalg.norm(axis) < 1e-9:
-            axis = gripped @ grasp.up
-        axis /= np.linalg.norm(axis)
-        side = np.cross(axis, closing)
-        frames = []
-        for tilt in v.tilts:
-            up = math.cos(tilt) * axis - math.sin(tilt) * side
-            frames.append(np.column_stack([closing, np.cross(up, closing), up]))
-        approach = [k for k, f in enumerate(frames)
-                    if f[2, 2] >= math.cos(v.config.approach_cone) - 1e-12]
-        if not approach:
-            continue
-        kept = []
-        for k in approach:
-            relative = rotation.T @ frames[k]
-            clear = True
-            for s, obj in zip(shapes, objects, strict=True):
-                obj.setTransform(fcl.Transform(relative @ s.rotation,
-                                               grasp.point + relative @ s.center))
-                queries += 1
-                clear &= not collide(obj, surface)
-            if clear:
-                kept.append(k)
-        if not kept:
-            result.stage = STAGE_PLACEABILITY
-            continue
-
-        def placed(k, s, frames=frames, position=position, rotation=rotation, grasp=grasp):
-            origin = position + rotation @ grasp.point
-            return fcl.Transform(frames[k] @ s.rotation, origin + frames[k] @ s.center)
-
-        free = []
-        for k in kept:
-            hit = False
-            for s, obj in zip(shapes, objects, strict=True):
-                obj.setTransform(placed(k, s))
-                for wall in walls:
-                    queries += 1
-                    hit |= collide(obj, wall)
-            if not hit:
-                free.append(k)
-        if not free:
-            result.stage = STAGE_CONTAINER
-            continue
-        if neighbour_check:
-            clear_tilts = []
-            for k in free:
-                hit = False
-                for s, obj in zip(shapes, objects, strict=True):
-                    obj.setTransform(placed(k, s))
-                    for j in range(len(ids)):
-                        if j == row:
-                            continue
-                        for shape in v.part_shapes:
-                            other = shape.fcl_object()
-                            other.setTransform(fcl.Transform(rotations[j] @ shape.rotation,
-                                                             positions[j] + rotations[j]
-                                                             @ shape.center))
-                            queries += 1
-                            hit |= collide(obj, other)
-                if not hit:
-                    clear_tilts.append(k)
-            free = clear_tilts
-            if not free:
-                result.stage = STAGE_NEIGHBOUR
-                continue
-        result.stage = STAGE_VALID
-        result.valid_tilts = tuple(float(v.tilts[k]) for k in free)
-    return Report(results, neighbour_check, queries, time.perf_counter() - start)

@@ -5,15 +5,22 @@ own vision system); topic `results` (the last report, latched, for review). The 
 grasp poses, the placement and the check settings are parameters.
 """
 
-from pick_common.conversions import part_spec_from_msg
 from pick_common.node_runner import answer_error, declare, declare_mesh_dirs, LATCHED, run
-from pick_common.parts import build_part
-from pick_msgs.msg import PartModel, ValidityReport
+from pick_common.parts import PartSpec
+from pick_msgs.msg import ValidityReport
 from pick_msgs.srv import CheckParts
 from rclpy.node import Node
 
 from . import conversions as conv
-from .config import CAPACITOR_GRASPS, CheckConfig, GraspPose, Gripper, LIMITS, PlaceSpec
+from .config import (
+    CAPACITOR_GRASPS,
+    CheckConfig,
+    GraspPose,
+    Gripper,
+    LIMITS,
+    PlaceSpec,
+    Setup,
+)
 from .validity import Validator
 
 # Validators (part model x gripper, grasps, placing, settings) kept: a gripper_sweep cycles
@@ -27,11 +34,10 @@ class ValidityNode(Node):
 
     def __init__(self) -> None:
         super().__init__('validity')
-        self._defaults = conv.Setup(*self._declare_parameters())
+        self._defaults = Setup(PartSpec(), *self._declare_parameters())
         self._cache: dict[tuple, Validator] = {}
         # Fail at start, not at the first request, on a bad gripper, grasp or setting.
-        self._validator_for(part_spec_from_msg(
-            PartModel(name='radial_capacitor')), self._defaults)
+        self._validator_for(self._defaults)
         self._results = self.create_publisher(ValidityReport, 'results', LATCHED)
         self.create_service(CheckParts, 'check_parts', self._check_parts)
         grasps = self._defaults.grasps
@@ -92,14 +98,13 @@ class ValidityNode(Node):
         self._mesh_dirs = declare_mesh_dirs(self)
         return gripper, tuple(grasps), place, config
 
-    def _validator_for(self, spec, setup: conv.Setup) -> Validator:
-        """The validator of a part model and setup, built once (placeability tables are the
-        costly part) and kept for the next CACHE_SIZE different ones."""
-        key = (conv.geometry_key(spec), setup)
+    def _validator_for(self, setup: Setup) -> Validator:
+        """The validator of a setup, built once (placeability tables are the costly part) and
+        kept for the next CACHE_SIZE different ones."""
+        key = setup.key()
         validator = self._cache.get(key)
         if validator is None:
-            validator = Validator(build_part(spec), setup.gripper, setup.grasps, setup.place,
-                                  setup.config)
+            validator = Validator(setup)
             if len(self._cache) >= CACHE_SIZE:
                 self._cache.pop(next(iter(self._cache)))
             self._cache[key] = validator
@@ -108,10 +113,9 @@ class ValidityNode(Node):
     def _check_parts(self, request: CheckParts.Request,
                      response: CheckParts.Response) -> CheckParts.Response:
         try:
-            container, spec, ids, poses, targets = conv.request_to_core(request,
-                                                                        self._mesh_dirs)
+            container, ids, poses, targets = conv.request_to_core(request)
             validator = self._validator_for(
-                spec, conv.setup_from_request(request, self._defaults))
+                conv.setup_from_request(request, self._defaults, self._mesh_dirs))
             report = validator.check(container, ids, poses, targets, request.check_neighbours)
         except Exception as exc:  # core errors get their code, bugs INTERNAL (answer_error)
             answer_error(response, exc, self.get_logger(), 'check_parts')

@@ -9,17 +9,17 @@ from pick_common.errors import InvalidArgument, UnknownPart
 from pick_common.parts import build_part, PartSpec
 from pick_common.specs import SceneSpec
 from pick_sim_world.world import World
-from pick_validity.config import CheckConfig, GraspPose, Gripper, PlaceSpec
-from pick_validity.validity import (
-    naive_check,
+from pick_validity.config import CheckConfig, GraspPose, Gripper, PlaceSpec, Setup
+from pick_validity.naive import naive_check
+from pick_validity.results import (
     STAGE_CANDIDACY,
     STAGE_CONTAINER,
     STAGE_NEIGHBOUR,
     STAGE_OUTSIDE,
     STAGE_PLACEABILITY,
     STAGE_VALID,
-    Validator,
 )
+from pick_validity.validity import Validator
 import pytest
 from scipy.spatial.transform import Rotation
 
@@ -34,7 +34,7 @@ RADIUS = 0.0025   # body radius of the capacitor, m
 
 
 def _validator(grasps=(SIDE,), **config) -> Validator:
-    return Validator(CAPACITOR, Gripper(), grasps, PlaceSpec(), CheckConfig(**config))
+    return Validator(Setup(grasps=tuple(grasps), config=CheckConfig(**config)))
 
 
 def _lying(x: float, y: float, roll_deg: float = 0.0) -> np.ndarray:
@@ -107,7 +107,7 @@ def test_placeability_depends_on_how_the_part_lies():
     assert 'cannot be placed' in result.reason
     assert _tilts(v, _tilted(30)) == (STAGE_VALID, tuple(range(-45, 15, 5)))
     # A huge jaw never clears the seat, however the part lies.
-    wide = Validator(CAPACITOR, Gripper(jaw_depth=0.05), [SIDE], PlaceSpec())
+    wide = Validator(Setup(gripper=Gripper(jaw_depth=0.05), grasps=(SIDE,)))
     assert _tilts(wide, _tilted(20))[0] == STAGE_PLACEABILITY
 
 
@@ -116,12 +116,12 @@ def test_the_gripper_stays_within_the_approach_cone():
     # the lying part's closing axis rises 40 deg: the gripper's axis leans at least 40 deg
     # from the vertical, and tilt a makes it acos(cos 40 cos a): within the 45 deg cone for
     # |a| <= 22.6 deg.
-    v = Validator(CAPACITOR, THIN, [OFF_AXIS], FAR)
+    v = Validator(Setup(gripper=THIN, grasps=(OFF_AXIS,), place=FAR))
     assert not v.free_axes.any()
     assert _tilts(v, _tilted(0))[1] == tuple(range(-45, 50, 5))
     assert _tilts(v, _tilted(0, roll_deg=40))[1] == tuple(range(-20, 25, 5))
-    narrow = Validator(CAPACITOR, THIN, [OFF_AXIS], FAR,
-                       CheckConfig(approach_cone=math.radians(30)))
+    narrow = Validator(Setup(gripper=THIN, grasps=(OFF_AXIS,), place=FAR,
+                             config=CheckConfig(approach_cone=math.radians(30))))
     result = narrow.check(DEEP, [1], [_tilted(0, roll_deg=40)], neighbour_check=False)
     assert result.results[0].stage == STAGE_CANDIDACY
     assert 'no wrist tilt approaches within 30.0 deg' in result.results[0].reason
@@ -135,7 +135,7 @@ def test_jaws_across_a_round_body_grip_it_at_any_roll(roll):
     # A capacitor lying alone on the floor: a cell's camera cannot see its roll, and its jaws
     # close across the round body whatever it is. Found 2026-11-26: with the grasp fixed to
     # the part, rolls beyond 6 deg of a side grasp tilted the jaws into the floor
-    # (bench/bench_roll.py). The turned grasp is the side grasp nearest in roll.
+    # (bench/validity/bench_roll.py). The turned grasp is the side grasp nearest in roll.
     sides = [GraspPose(f'side{k}', (math.cos(k * math.pi / 2), math.sin(k * math.pi / 2), 0.0),
                        (-math.sin(k * math.pi / 2), math.cos(k * math.pi / 2), 0.0), 0.011)
              for k in range(4)]
@@ -161,7 +161,7 @@ def test_the_fingertips_reach_down_the_grasped_part():
     # fingertips, and nothing else, go through the floor at every tilt.
     sunk = _lying(0, 0)
     sunk[2] -= 0.0005
-    touching = Validator(CAPACITOR, Gripper(finger_clearance=0.0), [SIDE], PlaceSpec())
+    touching = Validator(Setup(gripper=Gripper(finger_clearance=0.0), grasps=(SIDE,)))
     result = touching.check(BIN, [1], [sunk], neighbour_check=False).results[0]
     assert result.stage == STAGE_CONTAINER, result.reason
     # With the default 1 mm they stop 1.5 mm below the axis, which lies 2.0 mm above the
@@ -170,7 +170,7 @@ def test_the_fingertips_reach_down_the_grasped_part():
     # 15 deg. (The default 20 mm body hits the seat below 20 deg: a far seat keeps
     # placeability out of this.)
     sunk[2] -= 0.0001
-    clear = Validator(CAPACITOR, THIN, [SIDE], FAR)
+    clear = Validator(Setup(gripper=THIN, grasps=(SIDE,), place=FAR))
     assert _tilts(clear, sunk) == (STAGE_VALID, (-10, -5, 0, 5, 10))
 
 
@@ -252,7 +252,8 @@ def test_fast_check_equals_the_naive_loop_on_settled_scenes(container, model, co
     # The default gripper stops most parts at placeability or the container; a thin one
     # lets more through to the later stages.
     for gripper in (Gripper(), THIN):
-        v = Validator(part, gripper, grasps, PlaceSpec(seat_offset=0.003))
+        v = Validator(Setup(PartSpec(model=model), gripper=gripper, grasps=tuple(grasps),
+                            place=PlaceSpec(seat_offset=0.003)), part)
         for neighbours in (False, True):
             fast = v.check(container, state.ids, state.poses, neighbour_check=neighbours)
             naive = naive_check(v, container, state.ids, state.poses,
@@ -276,8 +277,8 @@ def test_mesh_parts_are_checked_with_their_hulls(tmp_path):
         world.drop(40)
         state = world.snapshot()
         part = world.part
-    v = Validator(part, Gripper(), [GraspPose('flat', (0, 0, 1), (1, 0, 0), 0.01)],
-                  PlaceSpec(seat_offset=0.001))
+    v = Validator(Setup(spec, grasps=(GraspPose('flat', (0, 0, 1), (1, 0, 0), 0.01),),
+                        place=PlaceSpec(seat_offset=0.001)), part)
     fast = v.check(ContainerSpec.tray(), state.ids, state.poses)
     naive = naive_check(v, ContainerSpec.tray(), state.ids, state.poses)
     assert [r.key() for r in fast.results] == [r.key() for r in naive.results]
@@ -347,8 +348,8 @@ def test_bad_check_settings_are_refused(config, rule):
 
 def test_bad_gripper_and_placement_are_refused():
     with pytest.raises(InvalidArgument, match='gripper.body_diameter: -0.02 must be > 0'):
-        Validator(CAPACITOR, Gripper(body_diameter=-0.02), [SIDE], PlaceSpec())
+        Validator(Setup(gripper=Gripper(body_diameter=-0.02), grasps=(SIDE,)))
     with pytest.raises(InvalidArgument, match='gripper.finger_clearance: nan must be finite'):
-        Validator(CAPACITOR, Gripper(finger_clearance=math.nan), [SIDE], PlaceSpec())
+        Validator(Setup(gripper=Gripper(finger_clearance=math.nan), grasps=(SIDE,)))
     with pytest.raises(InvalidArgument, match='place.place_axis: .* is a zero vector'):
-        Validator(CAPACITOR, Gripper(), [SIDE], PlaceSpec(place_axis=(0, 0, 0)))
+        Validator(Setup(gripper=Gripper(), grasps=(SIDE,), place=PlaceSpec(place_axis=(0, 0, 0))))

@@ -1,0 +1,346 @@
+"""The metrics of each experiment type, from the rows of its finished iterations.
+
+bin_static: figure 14 (fractions of parts passing candidacy, placeability and the container stage
+per bin) and the best bin. bin_emptying: Table 2 (emptied bins, parts removed: mean, min, max,
+standard deviation; searches before each pick). table_sweep: figure 15 (mean valid parts per n),
+the 4th-order polynomial fit, its maximum n* and the optimal range n* +- margin. feeder_emptying:
+Table 3 (emptied runs, vibrations to empty the feeder, and the time per vibration the refill
+interval allows). gripper_sweep (ours, not the paper's): per gripper and grasp set, the stage
+fractions and the valid parts per check with their 95 % interval, and the smallest gripper whose
+interval's low end reaches the experiment's min_valid. Standard deviations are sample ones
+(n - 1), 0 for a single value.
+"""
+
+import numpy as np
+from scipy import stats as scipy_stats
+
+from ..experiment_file import (
+    BIN_EMPTYING,
+    BIN_STATIC,
+    Experiment,
+    ExperimentFile,
+    GRIPPER_KEYS,
+    GRIPPER_SWEEP,
+    MAX_ITERATIONS,
+    MM,
+    TABLE_SWEEP,
+)
+
+# The physics faults an iteration is flagged with (procedures.faults); the first three leave it
+# out of the figures.
+PHYSICS_FAULT, TUNNELLED, THROWN, UNSETTLED = ('physics_fault', 'tunnelled', 'thrown',
+                                               'unsettled')
+FAULTS = (PHYSICS_FAULT, TUNNELLED, THROWN, UNSETTLED)
+EXCLUDED = (PHYSICS_FAULT, TUNNELLED, THROWN)
+
+FIT_ORDER = 4
+BOOTSTRAP = 4000        # resamples of a table_sweep's iterations for the interval of n*
+
+
+def stats(values) -> dict:
+    """mean, min, max, std (sample) and n of a list of numbers; None for an empty list (so that
+    summary.json stays strict JSON)."""
+    a = np.asarray(values, dtype=float)
+    if a.size == 0:
+        return {'n': 0, 'mean': None, 'min': None, 'max': None, 'std': None}
+    return {'n': int(a.size), 'mean': float(a.mean()), 'min': float(a.min()),
+            'max': float(a.max()), 'std': float(a.std(ddof=1)) if a.size > 1 else 0.0}
+
+
+def interval(values, confidence: float = 0.95, counts: bool = False
+             ) -> tuple[float | None, float | None]:
+    """The two-sided Student-t confidence interval of the mean of `values`; (None, None) for
+    fewer than two values (one value says nothing of its spread). counts: the values are counts
+    of parts, whose spread is taken as at least a Poisson count's (variance >= mean): a few
+    scenes that happen to agree (two scenes of 4 valid parts each) do not make a mean certain."""
+    a = np.asarray(values, dtype=float)
+    if a.size < 2:
+        return None, None
+    variance = a.var(ddof=1)
+    if counts:
+        variance = max(variance, a.mean())
+    half = scipy_stats.t.ppf(0.5 + confidence / 2, a.size - 1) * np.sqrt(variance / a.size)
+    return float(a.mean() - half), float(a.mean() + half)
+
+
+def rate_interval(successes, n, confidence: float = 0.95):
+    """The exact (Clopper-Pearson) two-sided confidence interval of a success rate from
+    `successes` of `n` trials (ints or int arrays of one shape), as (low, high); (None, None)
+    for n = 0. Exact rather than Wilson's: a verdict rests on a few iterations (the reduced
+    test case runs one), where Wilson's interval is too narrow (0 of 1: below 0.79, against
+    0.975 exact)."""
+    k, n = np.asarray(successes), np.asarray(n)
+    if not n.shape and n == 0:
+        return None, None
+    tail = (1.0 - confidence) / 2.0
+    with np.errstate(invalid='ignore', divide='ignore'):
+        low = np.where(k > 0, scipy_stats.beta.ppf(tail, k, n - k + 1), 0.0)
+        high = np.where(k < n, scipy_stats.beta.ppf(1.0 - tail, k + 1, n - k), 1.0)
+    return (float(low), float(high)) if not low.shape else (low, high)
+
+
+def iterations_to_decide(successes: int, n: int, rate: float, most: int = MAX_ITERATIONS
+                         ) -> int | None:
+    """The fewest iterations, more than n, whose rate_interval would lie wholly at or above
+    `rate` or wholly below it if the rate seen so far held (successes / n of them succeeding,
+    rounded); None when no count up to `most` would (a rate seen at the requirement itself)
+    or n = 0."""
+    if n == 0:
+        return None
+    m = np.arange(n + 1, most + 1)
+    low, high = rate_interval(np.round(successes / n * m), m)
+    decided = np.flatnonzero((low >= rate) | (high < rate))
+    return int(m[decided[0]]) if decided.size else None
+
+
+def _fractions(rows: list[dict]) -> dict:
+    out = {}
+    for stage in ('candidates', 'placeable', 'container_free', 'valid'):
+        values = [r[stage] / r['checked'] for r in rows if r['checked']]
+        out[stage] = stats(values)
+    return out
+
+
+def bin_static(exp: Experiment, rows: list[dict]) -> dict:
+    bins = []
+    for b, spec in enumerate(exp.bins):
+        mine = [r for r in rows if r['group'] == b]
+        bins.append({'index': b, 'size_mm': [round(s * 1000, 6) for s in spec.inner_size],
+                     'xy_area_mm2': round(spec.inner_size[0] * spec.inner_size[1] * 1e6, 3),
+                     'iterations': len(mine), 'fractions': _fractions(mine),
+                     'spilled': stats([r['spilled'] for r in mine])})
+    scored = [(b['fractions']['container_free']['mean'], -b['index']) for b in bins
+              if b['fractions']['container_free']['mean'] is not None]
+    best = -max(scored)[1] if scored else None
+    return {'bins': bins, 'best_bin': best,
+            'best_bin_mm': bins[best]['size_mm'] if best is not None else None}
+
+
+def bin_emptying(exp: Experiment, rows: list[dict], picks: list[dict]) -> dict:
+    """Table 2, with `emptied_ci95`: the 95 % interval of the share of bins emptied."""
+    first = rows[0] if rows else None
+    emptied = sum(bool(r['emptied']) for r in rows)
+    return {'iterations': len(rows), 'parts': exp.parts,
+            'bin_mm': [round(first[k] * 1000, 6) for k in ('container_x', 'container_y',
+                                                             'container_z')] if first else None,
+            'emptied': emptied, 'emptied_ci95': list(rate_interval(emptied, len(rows))),
+            'removed': stats([r['picks'] for r in rows]),
+            'searches_per_pick': stats([p['searches'] for p in picks]),
+            'first_check': _fractions(rows)}
+
+
+def fit(counts: np.ndarray, means: np.ndarray, order: int, first: int, last: int
+        ) -> tuple[np.ndarray, np.ndarray]:
+    """The least-squares polynomial of `order` through the counts' mean valid parts, every
+    count weighing the same, and its maximum over the integers in [first, last]; `means` (K,)
+    or (K, B): B fits at once (coefficients (order + 1, B), maxima (B,)). With as many
+    iterations at every count (the fixed counts) this is the fit to every iteration; an
+    adaptive sweep that drops more at some counts than at others fits the same curve."""
+    coefficients = np.polyfit(counts, means, order)
+    grid = np.arange(first, last + 1)
+    values = np.polyval(coefficients, grid if means.ndim == 1 else grid[:, None])
+    return coefficients, grid[np.argmax(values, axis=0)]
+
+
+def fit_optimum(counts, valid, first: int, last: int, margin: int) -> dict:
+    """The polynomial fit (order 4, lower with fewer distinct counts) of valid parts against
+    parts on the table (`counts`, `valid`: one per iteration; fit), n* at its maximum over the
+    integers in [first, last], and the range [max(1, n* - margin), n* + margin]. Coefficients
+    highest power first."""
+    n, v = np.asarray(counts, dtype=float), np.asarray(valid, dtype=float)
+    tested = np.unique(n)
+    order = min(FIT_ORDER, len(tested) - 1)
+    # No valid part at any count: the fit is flat and n* says nothing.
+    no_valid = not np.any(v > 0)
+    if order < 1:
+        best = int(n[0])
+        return {'order': 0, 'coefficients': [float(np.mean(v))], 'n_star': best,
+                'optimal_range': [max(1, best - margin), best + margin], 'no_valid': no_valid}
+    means = np.array([v[n == c].mean() for c in tested])
+    coefficients, best = fit(tested, means, order, first, last)
+    best = int(best)
+    return {'order': order, 'coefficients': coefficients.tolist(), 'n_star': best,
+            'fit_max': float(np.polyval(coefficients, best)),
+            'optimal_range': [max(1, best - margin), best + margin], 'no_valid': no_valid}
+
+
+def resampled_means(by_count: list, rng: np.random.Generator) -> np.ndarray:
+    """(counts, BOOTSTRAP) bootstrap means of each count's iterations (`by_count[i]`, m >= 2
+    of them), resampled about their mean with their deviations widened by sqrt(m / (m - 1)):
+    resampling m values as they are gives their mean (m - 1) / m of its variance (Davison and
+    Hinkley 1997, section 3.3), a fifth too little at an adaptive sweep's first look of 5."""
+    out = []
+    for v in by_count:
+        v = np.asarray(v, dtype=float)
+        widened = v.mean() + (v - v.mean()) * np.sqrt(len(v) / (len(v) - 1.0))
+        out.append(widened[rng.integers(0, len(v), (len(v), BOOTSTRAP))].mean(axis=0))
+    return np.stack(out)
+
+
+def n_star_interval(counts, by_count: list, order: int, first: int, last: int,
+                    confidence: float, rng: np.random.Generator) -> tuple[int, int] | None:
+    """The bootstrap interval of n*: BOOTSTRAP fits of `order` (fit) to the counts' means of
+    their iterations resampled (resampled_means; `by_count[i]`: the valid parts of
+    `counts[i]`'s iterations), and the quantiles of their maxima over [first, last]; None
+    while a count has fewer than two iterations (one says nothing of its spread)."""
+    if order < 1 or any(len(v) < 2 for v in by_count):
+        return None
+    _, stars = fit(np.asarray(counts, dtype=float), resampled_means(by_count, rng), order,
+                   first, last)
+    tail = (1.0 - confidence) / 2.0
+    return (int(np.quantile(stars, tail, method='lower')),
+            int(np.quantile(stars, 1.0 - tail, method='higher')))
+
+
+def table_sweep(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> dict:
+    """Valid parts per count, the fit and its n* with optimal range, and `n_star_ci95`: n*'s
+    95 % bootstrap interval (n_star_interval, seeded by the file's seed and the rows), when
+    every count has two iterations or more."""
+    per_n, by_count = [], []
+    for n in exp.counts:
+        mine = [r['valid'] for r in rows if r['group'] == n]
+        by_count.append(mine)
+        if mine:
+            per_n.append({'n': n, 'valid': stats(mine)})
+    out = {'iterations': exp.iterations, 'per_n': per_n, 'margin': exp.margin}
+    if rows:
+        out.update(fit_optimum([r['group'] for r in rows], [r['valid'] for r in rows],
+                               exp.counts[0], exp.counts[-1], exp.margin))
+        found = n_star_interval(exp.counts, by_count, out['order'], exp.counts[0],
+                                exp.counts[-1], 0.95, np.random.default_rng([file.seed, len(rows)]))
+        if found:
+            out['n_star_ci95'] = list(found)
+    return out
+
+
+def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
+                    optimal_range) -> dict:
+    """`emptied`: runs that emptied the feeder and the table; `accepted`: of them, those that
+    spilled at most requirements.max_spilled_parts over the tray's walls, and `accepted_ci95`
+    the 95 % interval of that share of the runs (rate_interval); `parts_per_hour`: the cell's
+    throughput per run that picked (cell_throughput) and its 95 % interval (interval)."""
+    emptied = [r for r in rows if r['emptied']]
+    hourly = throughputs(file.cell, rows)
+    tolerated = file.requirements.max_spilled
+    accepted = sum(r['spilled'] <= tolerated for r in emptied)
+    vibrations = stats([r['vibrations'] for r in emptied])
+    refill = file.requirements.refill_interval
+    per_vibration = (refill / vibrations['mean'] / 60.0
+                     if vibrations['mean'] else None)
+    return {'iterations': len(rows), 'parts': exp.parts, 'optimal_range': list(optimal_range),
+            'max_vibrations': exp.max_vibrations, 'emptied': len(emptied),
+            'accepted': accepted, 'accepted_ci95': list(rate_interval(accepted, len(rows))),
+            'max_spilled': tolerated, 'runs_spilling': sum(r['spilled'] > 0 for r in rows),
+            'vibrations_to_empty': vibrations, 'feeds': stats([r['feeds'] for r in rows]),
+            'stops': {s: sum(r['stop'] == s for r in rows) for s in sorted({r['stop']
+                                                                            for r in rows})},
+            'minutes_per_vibration_allowed': per_vibration,
+            'parts_per_hour': stats(hourly), 'parts_per_hour_ci95': list(interval(hourly)),
+            'cell': {'pick_s': file.cell.pick_time, 'image_s': file.cell.image_time}}
+
+
+def throughputs(cell, rows: list[dict]) -> list[float]:
+    """cell_throughput of each feeder run that picked."""
+    return [cell_throughput(cell, r) for r in rows if r['picks']]
+
+
+def cell_throughput(cell, row: dict) -> float:
+    """The parts per hour a feeder run's cell would pick: its picks over the time they take
+    (each pick `cell.pick_time`, each check an image of `cell.image_time`) plus the time the
+    table's feeds and vibrations took until the parts rested (simulated, `table_time`)."""
+    busy = (row['picks'] * cell.pick_time + row['checks'] * cell.image_time
+            + row['table_time'])
+    return 3600.0 * row['picks'] / busy
+
+
+def gripper_sweep(exp: Experiment, rows: list[dict], checks: list[dict]) -> dict:
+    """Per variant (gripper and grasp set, in the experiment's order; check k of each scene is
+    variant k): the stage fractions, the valid parts per check with their 95 % interval
+    (interval(counts=True)) and the scenes with at least one valid part; `meets`: the
+    interval's low end is at least min_valid. `smallest`: the index of the smallest variant
+    that meets (GripperVariant.size; the first in the file's order among equals), None when
+    none does."""
+    kept = {(r['group'], r['iteration']) for r in rows}
+    variants = []
+    for k, v in enumerate(exp.variants):
+        mine = [c for c in checks if c['check'] == k and (c['group'], c['iteration']) in kept]
+        valid = [c['valid'] for c in mine]
+        low, high = interval(valid, counts=True)
+        variants.append({
+            'index': k, 'grasp_set': v.grasp_set, 'grasps': [g.name for g in v.grasps],
+            'gripper_mm': {key: round(getattr(v.gripper, attr) / MM, 6)
+                           for key, attr in GRIPPER_KEYS},
+            'scenes': len(mine), 'fractions': _fractions(mine), 'valid': stats(valid),
+            'valid_ci95': [low, high], 'scenes_with_valid': sum(x > 0 for x in valid),
+            'meets': low is not None and low >= exp.min_valid})
+    by_size = sorted(range(len(variants)), key=lambda k: (exp.variants[k].size, k))
+    smallest = next((k for k in by_size if variants[k]['meets']), None)
+    first = rows[0] if rows else None
+    return {'iterations': len(rows), 'parts': exp.parts,
+            'scene_mm': [round(first[k] * 1000, 6) for k in ('container_x', 'container_y',
+                                                               'container_z')] if first else None,
+            'min_valid': exp.min_valid, 'variants': variants, 'smallest': smallest}
+
+
+def physics(rows: list[dict]) -> dict:
+    """The physics health of every iteration (left-out ones too): parts spilled, tunnelled and
+    thrown (totals), the most parts left moving at a settle's end, the deepest penetration (m),
+    the fastest part (m/s) and the worst tray tracking error (fraction of the command)."""
+    return {'spilled': sum(r['spilled'] for r in rows),
+            'tunnelled': sum(r['tunnelled'] for r in rows),
+            'thrown': sum(r['thrown'] for r in rows),
+            'max_speed': max((r['max_speed'] for r in rows), default=0.0),
+            'unsettled': max((r['unsettled'] for r in rows), default=0),
+            'max_penetration': max((r['max_penetration'] for r in rows), default=0.0),
+            'tray_error': max((r['tray_error'] for r in rows), default=0.0)}
+
+
+def fault_counts(rows: list[dict]) -> dict:
+    """How many iterations each physics fault flagged (procedures.faults), and which."""
+    flagged = [r for r in rows if r['fault']]
+    return {**{name: sum(name in r['fault'].split('+') for r in rows) for name in FAULTS},
+            'flagged': [{'group': r['group'], 'iteration': r['iteration'],
+                         'fault': r['fault']} for r in flagged]}
+
+
+def left_out(rows: list[dict]) -> set[tuple[int, int]]:
+    """(group, iteration) of the iterations left out of the figures: those with a fault of
+    EXCLUDED."""
+    return {(r['group'], r['iteration']) for r in rows
+            if set(r['fault'].split('+')) & set(EXCLUDED)}
+
+
+def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: list[dict],
+              earlier: dict | None = None, checks: list[dict] = ()) -> dict:
+    """The metrics of one experiment from its rows of iterations.csv, picks.csv and checks.csv.
+    `earlier`: the summaries of the experiments before it (for feeder_emptying's range taken
+    from a table_sweep). Iterations that ended in a physics fault or with a tunnelled or
+    thrown part have no figures and are left out; every flagged iteration is listed in
+    `faults`, and `physics` tells the health of all."""
+    faults = fault_counts(rows)
+    health = physics(rows)
+    faulted = left_out(rows)
+    rows = [r for r in rows if (r['group'], r['iteration']) not in faulted]
+    picks = [p for p in picks if (p['group'], p['iteration']) not in faulted]
+    if exp.type == BIN_STATIC:
+        out = bin_static(exp, rows)
+    elif exp.type == BIN_EMPTYING:
+        out = bin_emptying(exp, rows, picks)
+    elif exp.type == TABLE_SWEEP:
+        out = table_sweep(file, exp, rows)
+    elif exp.type == GRIPPER_SWEEP:
+        out = gripper_sweep(exp, rows, checks)
+    else:
+        low_high = exp.optimal_range or (earlier or {})[exp.range_from]['optimal_range']
+        out = feeder_emptying(file, exp, rows, low_high)
+    return {'type': exp.type, **out, 'faults': faults, 'physics': health}
+
+
+def file_summary(file: ExperimentFile, summaries: dict) -> dict:
+    r = file.requirements
+    return {'id': file.id, 'seed': file.seed,
+            'requirements': {'parts_per_hour': r.parts_per_hour,
+                             'refill_interval_h': r.refill_interval / 3600.0,
+                             'capacity': r.capacity, 'success_rate': r.success_rate,
+                             'max_dimension_mm': round(r.max_dimension * 1000, 6)},
+            'experiments': summaries}

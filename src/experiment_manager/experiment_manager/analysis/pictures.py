@@ -1,0 +1,157 @@
+"""Pictures for the report, rendered with PyBullet's CPU renderer (no GPU needed).
+
+An iteration is re-simulated from its seed on the cores (the same physics as the nodes: the
+settled poses are identical to the recorded ones, which is checked and said in the caption):
+- `bin.png`: the first bin_emptying iteration's settled bin, with the gripper of its first pick
+  (green, a valid grasp) and the gripper of a rejected part at the tilt nearest 0, the most
+  vertical approach (red: it hits the bin or a neighbour);
+- `tray.png`: the first table_sweep iteration at the count nearest the optimum n*.
+"""
+
+import csv
+import json
+import os
+
+import matplotlib.image
+import numpy as np
+from pick_common.specs import SceneSpec
+from pick_sim_world.world import Overlay, World
+from pick_validity.geometry import BOX, Shape
+from pick_validity.results import STAGE_CONTAINER, STAGE_NEIGHBOUR
+from pick_validity.validity import Validator
+from scipy.spatial.transform import Rotation
+
+from ..experiment_file import BIN_EMPTYING, ExperimentFile, TABLE_SWEEP
+from ..experiment_file.plan import plan, Unit
+
+SIZE = (800, 600)
+GREEN, RED = (0.1, 0.8, 0.1, 0.55), (0.9, 0.1, 0.1, 0.55)
+
+
+def gripper_overlays(shapes: tuple[Shape, ...], pose, rgba) -> list[Overlay]:
+    """The validity check's simplified gripper (its shapes, in the gripper frame: the jaws'
+    cuboid around the grasp point and the body cylinder above it) at a pose (7,) of its
+    frame."""
+    pose = np.asarray(pose, dtype=float)
+    rotation = Rotation.from_quat(pose[3:])
+    overlays = []
+    for shape in shapes:
+        at = (*(pose[:3] + rotation.apply(shape.center)),
+              *(rotation * Rotation.from_matrix(shape.rotation)).as_quat())
+        size = (tuple(shape.half) if shape.kind == BOX
+                else (shape.half[0], 2 * shape.half[1]))
+        overlays.append(Overlay(shape.kind, size, at, rgba))
+    return overlays
+
+
+def _rows(run_dir: str, name: str, experiment: str, iteration: int = 0) -> list[dict]:
+    with open(os.path.join(run_dir, f'{name}.csv'), newline='') as f:
+        return [r for r in csv.DictReader(f) if r['experiment'] == experiment
+                and int(r['iteration']) == iteration]
+
+
+def _settle(file: ExperimentFile, unit: Unit) -> World:
+    world = World(SceneSpec(unit.container, file.part, 1, unit.seed))
+    world.drop(unit.parts)
+    return world
+
+
+def _same_as_recorded(world: World, rows: list[dict], group: int) -> bool:
+    recorded = {int(r['part_id']): [float(r[k]) for k in ('x', 'y', 'z', 'qx', 'qy', 'qz', 'qw')]
+                for r in rows if r['check'] == '0' and int(r['group']) == group}
+    states = world.snapshot()
+    return recorded == {i: p for i, p in zip(states.ids.tolist(), states.poses.tolist(),
+                                             strict=True)}
+
+
+def _camera(unit: Unit) -> dict:
+    x, y, z = unit.container.inner_size
+    return {'distance': 1.7 * max(x, y), 'target': (0.0, 0.0, z / 2)}
+
+
+def _save(path: str, image: np.ndarray) -> None:
+    matplotlib.image.imsave(path, image)
+
+
+def bin_picture(file: ExperimentFile, summary: dict, run_dir: str) -> str | None:
+    """bin.png with a valid and a rejected grasp; returns its caption (None: nothing to draw)."""
+    exp = next((e for e in file.experiments if e.type == BIN_EMPTYING), None)
+    if exp is None or exp.id not in summary['experiments'] or (
+            exp.bin_from and exp.bin_from not in summary['experiments']):
+        return None
+    unit = plan(file, exp, summary['experiments'])[0]
+    parts, picks = _rows(run_dir, 'parts', exp.id), _rows(run_dir, 'picks', exp.id)
+    if not parts:
+        return None
+    with _settle(file, unit) as world:
+        validator = Validator(file.setup, world.part)
+        grasps = validator.grasps
+        same = _same_as_recorded(world, parts, 0)
+        overlays, notes = [], []
+        if picks:
+            p = picks[0]
+            pose = [float(p[k]) for k in ('gripper_x', 'gripper_y', 'gripper_z', 'gripper_qx',
+                                          'gripper_qy', 'gripper_qz', 'gripper_qw')]
+            overlays += gripper_overlays(validator.gripper_shapes[int(p['grasp'])], pose,
+                                         GREEN)
+            notes.append(f'green: the first pick, part {p["part_id"]} (grasp '
+                         f'{grasps[int(p["grasp"])].name}), found after {p["searches"]} '
+                         'parts in search order')
+        rejected = next((r for r in parts if r['check'] == '0' and int(r['grasp']) >= 0
+                         and int(r['stage']) in (STAGE_CONTAINER, STAGE_NEIGHBOUR)), None)
+        if rejected is not None:
+            index = int(rejected['grasp'])
+            g = grasps[index]
+            position = np.array([float(rejected[k]) for k in ('x', 'y', 'z')])
+            part_rotation = Rotation.from_quat([float(rejected[k])
+                                                for k in ('qx', 'qy', 'qz', 'qw')])
+            frames = validator.approach_frames(part_rotation.as_matrix()[None],
+                                               np.array([index]))
+            tilt = int(np.abs(validator.tilts).argmin())
+            rotation = Rotation.from_matrix(frames[0, tilt])
+            origin = position + part_rotation.apply(g.point)
+            overlays += gripper_overlays(validator.gripper_shapes[index],
+                                         (*origin, *rotation.as_quat()), RED)
+            why = 'the bin' if int(rejected['stage']) == STAGE_CONTAINER else 'a neighbour'
+            notes.append(f'red: part {rejected["part_id"]} (grasp {g.name}) at the most '
+                         f'vertical approach, rejected: it hits {why}')
+        image = world.render(*SIZE, overlays=overlays, **_camera(unit))
+    _save(os.path.join(run_dir, 'bin.png'), image)
+    size = ' x '.join(f'{s * 1000:g}' for s in unit.container.inner_size)
+    return (f'The settled {size} mm bin of `{exp.id}` iteration 1 ({unit.parts} parts, seed '
+            f'{unit.seed}; re-simulated: poses '
+            f'{"identical to" if same else "DIFFERENT from"} the recorded ones). '
+            + '; '.join(notes) + '.')
+
+
+def tray_picture(file: ExperimentFile, summary: dict, run_dir: str) -> str | None:
+    """tray.png at the count nearest n*; returns its caption (None: nothing to draw)."""
+    exp = next((e for e in file.experiments if e.type == TABLE_SWEEP), None)
+    if exp is None or 'n_star' not in summary['experiments'].get(exp.id, {}):
+        return None
+    n_star = summary['experiments'][exp.id]['n_star']
+    n = min(exp.counts, key=lambda c: (abs(c - n_star), c))
+    unit = next(u for u in plan(file, exp, summary['experiments'])
+                if u.group == n and u.iteration == 0)
+    with _settle(file, unit) as world:
+        same = _same_as_recorded(world, _rows(run_dir, 'parts', exp.id), n)
+        image = world.render(*SIZE, **_camera(unit))
+    _save(os.path.join(run_dir, 'tray.png'), image)
+    return (f'{n} parts settled on the tray (`{exp.id}`, the tested count nearest n* = '
+            f'{n_star}, iteration 1, seed {unit.seed}; re-simulated: poses '
+            f'{"identical to" if same else "DIFFERENT from"} the recorded ones).')
+
+
+def write(file: ExperimentFile, run_dir: str) -> dict[str, str]:
+    """Render the pictures of a finished run; returns {file name: caption}, also written to
+    pictures.json for the report."""
+    with open(os.path.join(run_dir, 'summary.json'), encoding='utf-8') as f:
+        summary = json.load(f)
+    captions = {}
+    for name, draw in (('bin.png', bin_picture), ('tray.png', tray_picture)):
+        caption = draw(file, summary, run_dir)
+        if caption:
+            captions[name] = caption
+    with open(os.path.join(run_dir, 'pictures.json'), 'w', encoding='utf-8') as f:
+        json.dump(captions, f, indent=2)
+    return captions

@@ -1,0 +1,38 @@
+"""The experiment file: what a run uses of it, in SI units (`model`); the file as written, its
+keys, types, ranges and defaults (`schema`, pydantic models of the `values` the cores'
+rules check); reading and checking it with every error at once (`loading`), named by key path
+(`errors`); and the iterations it asks for, each with its seed (`plan`). Pure: no rclpy, no
+simulator.
+
+The names users call are here: `load`, `parse`, `reduced`, `InvalidFile`, and the model's
+types and constants.
+"""
+
+from .loading import InvalidFile, load, parse, reduced
+from .model import (
+    ADAPTIVE,
+    BIN_EMPTYING,
+    BIN_STATIC,
+    Cell,
+    Experiment,
+    ExperimentFile,
+    FEEDER_EMPTYING,
+    FIXED,
+    GRIPPER_SWEEP,
+    GripperVariant,
+    MAX_ITERATIONS,
+    MM,
+    Requirements,
+    Sampling,
+    SEARCH_ORDERS,
+    TABLE_SWEEP,
+    TYPES,
+)
+from .schema import GRIPPER_KEYS
+
+__all__ = [
+    'ADAPTIVE', 'BIN_EMPTYING', 'BIN_STATIC', 'Cell', 'Experiment', 'ExperimentFile',
+    'FEEDER_EMPTYING', 'FIXED', 'GRIPPER_KEYS', 'GRIPPER_SWEEP', 'GripperVariant', 'InvalidFile',
+    'load', 'MAX_ITERATIONS', 'MM', 'parse', 'reduced', 'Requirements', 'Sampling', 'SEARCH_ORDERS',
+    'TABLE_SWEEP', 'TYPES',
+]

@@ -1,0 +1,408 @@
+"""Reading an experiment file: YAML, then each section and each experiment through its model
+(`schema`; its errors named by `errors`), then the SI dataclasses a run uses (`model`), with
+the checks that relate one section to another and the cores' own checks, under the file's key
+names.
+
+Every error is an `InvalidArgument` naming the key by its path in the file, the value and the
+rule. Every section and every experiment is read, and all their errors come at once
+(`InvalidFile`); the checks that relate sections (a bin within requirements.max_dimension_mm,
+parts that fit their container, an experiment named by another) run where the sections they
+relate were read without error. The annotated example is `config/default_experiment.yaml`.
+"""
+
+from collections.abc import Callable, Mapping
+import itertools
+import math
+import os
+from typing import Any
+
+from feeder_controller.policy import check_feeder, FeederConfig
+from pick_common.containers import check_container, check_fits, ContainerSpec
+from pick_common.errors import check_int, check_number, InvalidArgument
+from pick_common.parts import build_part, PartGeometry, PartSpec
+from pick_common.specs import check_vibration, MOVES, Vibration
+from pick_validity.config import (
+    CAPACITOR_GRASPS,
+    check_grasps,
+    check_gripper,
+    check_place,
+    CheckConfig,
+    GraspPose,
+    Gripper,
+    PlaceSpec,
+    Setup,
+    tilts,
+)
+import yaml
+
+from . import schema
+from .errors import read as read_keys
+from .model import (
+    ADAPTIVE,
+    BIN_EMPTYING,
+    BIN_STATIC,
+    Cell,
+    DEG,
+    Experiment,
+    ExperimentFile,
+    FEEDER_EMPTYING,
+    G,
+    GRIPPER_SWEEP,
+    GripperVariant,
+    MAX_EXPERIMENTS,
+    MAX_FILE_BYTES,
+    MAX_ITERATIONS,
+    MAX_VARIANTS,
+    MM,
+    Requirements,
+    Sampling,
+    TABLE_SWEEP,
+)
+from .schema import GRIPPER_KEYS
+from .values import short
+
+
+class InvalidFile(InvalidArgument):
+    """Every error found in an experiment file. `errors` lists them; field, value and rule
+    are the first's, and the message lists all."""
+
+    def __init__(self, errors: list[InvalidArgument]) -> None:
+        first = errors[0]
+        super().__init__(first.field, first.value, first.rule)
+        self.errors = list(errors)
+        if len(errors) > 1:
+            self.args = (f'{len(errors)} errors:\n' + '\n'.join(f'  {e}' for e in errors),)
+
+
+def _checked(check: Callable, value: Any, where: str) -> Any:
+    """Run a core check, naming the field in the file that held the value."""
+    try:
+        return check(value)
+    except InvalidArgument as exc:
+        raise InvalidArgument(f'{where} ({exc.field})', exc.value, exc.rule) from None
+
+
+# ---------------------------------------------------------------- sections, to SI units
+def _part(p: schema.Part, base_dir: str) -> tuple[PartSpec, tuple[GraspPose, ...], PlaceSpec]:
+    mesh, mass = p.mesh, G * p.mass_g
+    if p.model == 'mesh':
+        if mass == 0.0:
+            raise InvalidArgument('part.mass_g', 0, 'is required (> 0) for a mesh part')
+        if not mesh:
+            raise InvalidArgument('part.mesh', mesh, 'is required when model is mesh')
+        mesh = os.path.normpath(os.path.join(base_dir, os.path.expanduser(mesh)))
+        if not os.path.isfile(mesh):
+            raise InvalidArgument('part.mesh', mesh, 'does not exist or is not a file')
+    elif mesh:
+        raise InvalidArgument('part.mesh', mesh, f'is only read when model is mesh '
+                              f'(model is {p.model})')
+    if 'pins_per_row' in p.dimensions_mm:
+        raise InvalidArgument('part.dimensions_mm.pins_per_row',
+                              p.dimensions_mm['pins_per_row'],
+                              'is a count, not a length: give it as part.pins_per_row')
+    dimensions: dict[str, float] = {k: MM * v for k, v in p.dimensions_mm.items()}
+    if p.pins_per_row is not None:
+        dimensions['pins_per_row'] = p.pins_per_row
+    spec = PartSpec(
+        model=p.model, dimensions=dimensions, mass=mass or None,
+        lateral_friction=p.lateral_friction, rolling_friction=MM * p.rolling_friction_mm,
+        spinning_friction=MM * p.spinning_friction_mm, restitution=p.restitution,
+        mesh_path=mesh, scale=p.mesh_scale)
+    place = PlaceSpec(place_axis=p.place.axis, seat_offset=MM * p.place.seat_offset_mm)
+    if p.grasps is None:
+        return spec, CAPACITOR_GRASPS, place
+    grasps = tuple(GraspPose(
+        name=g.name if g.name is not None else f'grasp_{i}', up_axis=g.up_axis,
+        closing_axis=g.closing_axis, jaw_opening=MM * g.jaw_opening_mm,
+        grasp_point=tuple(MM * v for v in g.grasp_point_mm)) for i, g in enumerate(p.grasps))
+    names = [g.name for g in grasps]
+    if len(set(names)) != len(names):
+        raise InvalidArgument('part.grasps', names, 'has a grasp name twice')
+    return spec, grasps, place
+
+
+def _gripper(g: schema.GripperSection) -> Gripper:
+    return Gripper(**{attr: MM * getattr(g, key) for key, attr in GRIPPER_KEYS})
+
+
+def _check(c: schema.CheckSection) -> CheckConfig:
+    return CheckConfig(tolerance=DEG * c.tolerance_deg, tilt_min=DEG * c.tilt_min_deg,
+                       tilt_max=DEG * c.tilt_max_deg, tilt_step=DEG * c.tilt_step_deg,
+                       approach_cone=DEG * c.approach_cone_deg,
+                       rim_tolerance=MM * c.rim_tolerance_mm)
+
+
+def _requirements(r: schema.RequirementsSection) -> Requirements:
+    return Requirements(parts_per_hour=r.parts_per_hour,
+                        refill_interval=3600.0 * r.refill_interval_h,
+                        max_dimension=MM * r.max_dimension_mm,
+                        max_spilled=r.max_spilled_parts, success_rate=r.success_rate)
+
+
+def _tray(top: schema.FileKeys) -> ContainerSpec:
+    tray = ContainerSpec.tray(tuple(MM * s for s in top.tray_mm))
+    _checked(check_container, tray, 'tray_mm')
+    return tray
+
+
+def _moves(top: schema.FileKeys) -> tuple[Vibration, ...]:
+    out = []
+    for i, m in enumerate(top.moves):
+        base = MOVES[m.move]
+        move = Vibration(
+            amplitude=tuple(MM * a for a in m.amplitude_mm) if m.amplitude_mm is not None
+            else tuple(MM * float(a / MM) for a in base.amplitude),
+            frequency=m.frequency_hz if m.frequency_hz is not None else float(base.frequency),
+            duration=m.duration_s if m.duration_s is not None else float(base.duration),
+            direction=m.direction if m.direction is not None else base.direction)
+        out.append(_checked(check_vibration, move, f'moves[{i}]'))
+    return tuple(out)
+
+
+def _geometry(part: PartSpec) -> PartGeometry:
+    try:
+        return build_part(part)
+    except InvalidArgument as exc:
+        raise InvalidArgument(f'part ({exc.field})', exc.value, exc.rule) from None
+
+
+# -------------------------------------------------------------------------- experiments
+class _Context:
+    """What an experiment's checks relate to: the part's geometry, the tray, the bins' wall
+    and size limit, the gripper and grasps, and the experiments read before it."""
+
+    def __init__(self, geometry: PartGeometry, tray: ContainerSpec, bin_wall: float,
+                 max_dimension: float, gripper: Gripper,
+                 grasps: tuple[GraspPose, ...]) -> None:
+        self.geometry, self.tray, self.bin_wall = geometry, tray, bin_wall
+        self.max_dimension, self.gripper, self.grasps = max_dimension, gripper, grasps
+        self.earlier: dict[str, Experiment] = {}
+
+
+def _bin(size_mm: tuple[float, ...], where: str, c: _Context) -> ContainerSpec:
+    size = tuple(MM * s for s in size_mm)
+    for i, s in enumerate(size):
+        if s > c.max_dimension + 1e-12:
+            raise InvalidArgument(f'{where}[{i}]', round(s / MM, 6),
+                                  f'mm is over the size limit requirements.max_dimension_mm '
+                                  f'= {c.max_dimension / MM:g}')
+    spec = ContainerSpec(inner_size=size, wall_thickness=c.bin_wall)
+    _checked(check_container, spec, where)
+    return spec
+
+
+def _earlier(where: str, exp_id: str, c: _Context, kind: str, alternative: str) -> Experiment:
+    """The earlier experiment of type `kind` named by id at `where`."""
+    source = c.earlier.get(exp_id)
+    if source is None or source.type != kind:
+        raise InvalidArgument(where, exp_id, f'names no earlier {kind} experiment (give its '
+                              f'id, or {alternative})')
+    return source
+
+
+def _bin_or_source(value: Any, parts: int, where: str, c: _Context) -> dict:
+    """An experiment's `bin`: a bin in mm ({'bin': spec}) or the id of an earlier bin_static
+    experiment whose best bin is used ({'bin_from': id}); {} when there is none. `parts` must
+    fit in it (in every bin of the source)."""
+    volume = c.geometry.volume
+    if value is None:
+        return {}
+    if isinstance(value, str):
+        source = _earlier(f'{where}.bin', value, c, BIN_STATIC, 'a bin [x, y, z] in mm')
+        for i, b in enumerate(source.bins):
+            check_fits(f'{where}.parts ({value}.bins_mm[{i}])', parts, volume, b)
+        return {'bin_from': value}
+    spec = _bin(value, f'{where}.bin', c)
+    check_fits(f'{where}.parts', parts, volume, spec)
+    return {'bin': spec}
+
+
+def _variants(e: schema.GripperSweepKeys, where: str, c: _Context
+              ) -> tuple[GripperVariant, ...]:
+    """gripper_sweep's grid: every combination of its grippers (the file's gripper standing in
+    for keys not given) and grasp sets (default: every grasp, named 'all'), in the order
+    given, body diameter varying slowest."""
+    axes = []
+    for key, attr in GRIPPER_KEYS:
+        given = getattr(e.grippers, key)
+        values = given if given is not None else (check_number(
+            f'{where}.grippers.{key}', getattr(c.gripper, attr) / MM, low=0.0),)
+        axes.append([(attr, v * MM) for v in values])
+    names = [g.name for g in c.grasps]
+    sets = []
+    for name, members in (e.grasp_sets or {'all': names}).items():
+        at = f'{where}.grasp_sets.{name}'
+        if not isinstance(members, list) or not members:
+            raise InvalidArgument(at, short(members), 'must be a non-empty list of grasp '
+                                  f'names (part.grasps: {", ".join(names)})')
+        for i, member in enumerate(members):
+            if member not in names:
+                raise InvalidArgument(f'{at}[{i}]', short(member), 'is not the name of a '
+                                      f'grasp of part.grasps ({", ".join(names)})')
+        if len(set(members)) != len(members):
+            raise InvalidArgument(at, members, 'names a grasp twice')
+        sets.append((str(name), tuple(g for g in c.grasps if g.name in members)))
+    total = math.prod(len(a) for a in axes) * len(sets)
+    if total > MAX_VARIANTS:
+        raise InvalidArgument(f'{where}.grippers', total, f'grippers x grasp sets is over the '
+                              f'limit of {MAX_VARIANTS} combinations per experiment')
+    out = []
+    for combination in itertools.product(*axes):
+        g = Gripper(**dict(combination))
+        _checked(check_gripper, g, f'{where}.grippers (' + ', '.join(
+            f'{key} {getattr(g, attr) / MM:g}' for key, attr in GRIPPER_KEYS) + ')')
+        out += [GripperVariant(g, name, members) for name, members in sets]
+    return tuple(out)
+
+
+def _experiment(e: schema.ExperimentKeys, where: str, c: _Context) -> Experiment:
+    if e.id in c.earlier:
+        raise InvalidArgument(f'{where}.id', e.id, 'is the id of an earlier experiment')
+    volume, tray = c.geometry.volume, c.tray
+    out: dict[str, Any] = {'id': e.id, 'type': e.type, 'iterations': e.iterations}
+    if e.type != TABLE_SWEEP:
+        out['parts'] = e.parts
+    if e.type == BIN_STATIC:
+        out['bins'] = tuple(_bin(v, f'{where}.bins_mm[{i}]', c) for i, v in enumerate(e.bins_mm))
+        for i, b in enumerate(out['bins']):
+            check_fits(f'{where}.parts (bins_mm[{i}])', e.parts, volume, b)
+    elif e.type == BIN_EMPTYING:
+        out.update(_bin_or_source(e.bin, e.parts, where, c))
+    elif e.type == TABLE_SWEEP:
+        out['counts'] = tuple(range(e.counts.first, e.counts.last + 1, e.counts.step))
+        check_fits(f'{where}.counts.last', out['counts'][-1], volume, tray)
+        out['margin'] = e.margin
+    elif e.type == GRIPPER_SWEEP:
+        scene = _bin_or_source(e.bin, e.parts, where, c)
+        if not scene:       # no bin: the parts lie on the tray, as in a table_sweep
+            check_fits(f'{where}.parts (tray_mm)', e.parts, volume, tray)
+        out.update(scene)
+        out['variants'] = _variants(e, where, c)
+        out['min_valid'] = e.min_valid
+    elif e.type == FEEDER_EMPTYING:
+        if isinstance(e.optimal_range, str):
+            source = _earlier(f'{where}.optimal_range', e.optimal_range, c, TABLE_SWEEP,
+                              '[min, max]')
+            out['range_from'] = e.optimal_range
+            high = source.counts[-1] + source.margin
+        else:
+            out['optimal_range'] = e.optimal_range
+            high = e.optimal_range[1]
+            _checked(check_feeder, FeederConfig(e.parts, *e.optimal_range, e.max_vibrations),
+                     where)
+        out['max_vibrations'] = e.max_vibrations
+        check_fits(f'{where}.optimal_range (max)', high, volume, tray)
+    return Experiment(**out)
+
+
+# ------------------------------------------------------------------------------- the file
+def parse(text: str, path: str = '') -> ExperimentFile:
+    """Read and check an experiment file's text. Raises InvalidArgument for one error,
+    InvalidFile (an InvalidArgument) listing every error found when there are more."""
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, 'problem_mark', None)
+        where = f'line {mark.line + 1}, column {mark.column + 1}' if mark else 'file'
+        raise InvalidArgument(where, path, f'is not valid YAML: '
+                              f'{getattr(exc, "problem", None) or exc}') from None
+    if not isinstance(data, Mapping):
+        raise InvalidArgument('file', short(data), 'must be a mapping of keys')
+    base_dir = os.path.dirname(os.path.abspath(path)) if path else os.getcwd()
+    errors: list[InvalidArgument] = []
+
+    def checked(step: Callable[[], Any]) -> Any:
+        """One check run; its error kept, and the next check run."""
+        try:
+            return step()
+        except InvalidArgument as exc:
+            errors.append(exc)
+        return None
+
+    def read(model: type[schema.Section], value: Any, where: str) -> Any:
+        value, found = read_keys(model, value, where)
+        errors.extend(found)
+        return value
+
+    top = read(schema.FileKeys, data, '')
+    s = {key: read(model, data.get(key, {}), key) for key, model in schema.SECTIONS.items()}
+    read_part = checked(lambda: _part(s['part'], base_dir)) if s['part'] else None
+    part, grasps, place = read_part or (None, None, None)
+    gripper = _gripper(s['gripper']) if s['gripper'] else None
+    check = _check(s['check']) if s['check'] else None
+    requirements = _requirements(s['requirements']) if s['requirements'] else None
+    tray = checked(lambda: _tray(top)) if top else None
+    moves = checked(lambda: _moves(top)) if top else None
+    # The cores' own checks, under the file's names.
+    if gripper is not None:
+        checked(lambda: _checked(check_gripper, gripper, 'gripper'))
+    if part is not None:
+        checked(lambda: _checked(check_grasps, list(grasps), 'part.grasps'))
+        checked(lambda: _checked(check_place, place, 'part.place'))
+    if check is not None:
+        checked(lambda: _checked(tilts, check, 'check'))
+    geometry = checked(lambda: _geometry(part)) if part is not None else None
+    context = None
+    if None not in (top, geometry, tray, requirements, gripper, grasps):
+        context = _Context(geometry, tray, MM * top.bin_wall_mm, requirements.max_dimension,
+                           gripper, grasps)
+    raw = data.get('experiments')
+    for i, item in enumerate(raw if isinstance(raw, list) and len(raw) <= MAX_EXPERIMENTS
+                             else []):
+        where = f'experiments[{i}]'
+        keys = read(schema.experiment_model(item), item, where)
+        if keys is not None and context is not None:
+            e = checked(lambda keys=keys, where=where: _experiment(keys, where, context))
+            if e is not None:
+                context.earlier[e.id] = e
+    # one error per field: a check that fails again on a value already refused is not news
+    fields: set[str] = set()
+    errors = [e for e in errors if not (e.field in fields or fields.add(e.field))]
+    if errors:
+        raise errors[0] if len(errors) == 1 else InvalidFile(errors)
+    return ExperimentFile(
+        id=top.id, seed=top.seed, output_dir=top.output_dir,
+        setup=Setup(part, gripper, grasps, place, check), search_order=s['check'].search_order,
+        tray=tray, moves=moves, bin_wall=MM * top.bin_wall_mm, requirements=requirements,
+        experiments=tuple(context.earlier.values()),
+        sampling=Sampling(mode=s['sampling'].mode, batch=s['sampling'].batch),
+        cell=Cell(pick_time=s['cell'].pick_s, image_time=s['cell'].image_s),
+        path=os.path.abspath(path) if path else '', text=text)
+
+
+def load(path: str) -> ExperimentFile:
+    """Read and check the experiment file at `path`."""
+    try:
+        size = os.path.getsize(path)
+        if size > MAX_FILE_BYTES:
+            raise InvalidArgument('experiment_file', path, f'is {size} bytes (limit '
+                                  f'{MAX_FILE_BYTES})')
+        with open(path, encoding='utf-8') as f:
+            text = f.read()
+    except OSError as exc:
+        raise InvalidArgument('experiment_file', path,
+                              f'cannot be read: {exc.strerror or exc}') from None
+    except UnicodeDecodeError as exc:
+        raise InvalidArgument('experiment_file', path, f'is not UTF-8 text: {exc}') from None
+    return parse(text, path)
+
+
+def reduced(file: ExperimentFile, max_iterations: int | None, adaptive: bool = False) -> str:
+    """The text of `file` with every experiment's iterations capped at `max_iterations` (None:
+    as they are), with adaptive sampling when `adaptive`, and the mesh path made absolute, as
+    a file that can live anywhere (a quick look at a long study; the run directory keeps the
+    file that ran). Comments are not kept."""
+    data = yaml.safe_load(file.text)
+    said = []
+    if max_iterations is not None:
+        check_int('max_iterations', max_iterations, low=1, high=MAX_ITERATIONS)
+        for item in data['experiments']:
+            item['iterations'] = min(int(item['iterations']), max_iterations)
+        said.append(f'every experiment capped at {max_iterations} iteration(s)')
+    if adaptive:
+        data['sampling'] = {**(data.get('sampling') or {}), 'mode': ADAPTIVE}
+        said.append('adaptive sampling')
+    if file.part.mesh_path:
+        data['part']['mesh'] = file.part.mesh_path
+    header = f'# {file.path or file.id}, with {" and ".join(said) or "no change"}\n'
+    return header + yaml.safe_dump(data, sort_keys=False)

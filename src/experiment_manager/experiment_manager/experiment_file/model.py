@@ -1,0 +1,169 @@
+"""What a run uses of an experiment file, in SI units: the frozen dataclasses the loader
+(`loading`) builds from the file as written (`schema`), and the names and limits both share."""
+
+from dataclasses import dataclass, field, replace
+import math
+
+from pick_common.containers import ContainerSpec
+from pick_common.parts import PartSpec
+from pick_common.specs import Vibration
+from pick_validity.config import CheckConfig, GraspPose, Gripper, PlaceSpec, Setup
+
+BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING, GRIPPER_SWEEP = (
+    'bin_static', 'bin_emptying', 'table_sweep', 'feeder_emptying', 'gripper_sweep')
+TYPES = (BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING, GRIPPER_SWEEP)
+SEARCH_ORDERS = ('top_first', 'random', 'id')
+FIXED, ADAPTIVE = 'fixed', 'adaptive'
+SAMPLING_MODES = (FIXED, ADAPTIVE)
+MAX_ITERATIONS = 10_000
+MAX_BINS = 100
+MAX_EXPERIMENTS = 50
+MAX_VARIANTS = 64         # grippers x grasp sets of one gripper_sweep
+MAX_FILE_BYTES = 1_000_000
+ID_CHARS = set('abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-')
+MM, G, DEG = 1e-3, 1e-3, math.pi / 180.0   # the file's mm, g and degrees in SI
+
+
+@dataclass(frozen=True)
+class Requirements:
+    """The production requirement: parts of this type per hour, hours between refills of a bin
+    or the feeder, the largest bin length in any dimension, m, the parts a feeder run may
+    spill over the tray's walls (a cell catches none by default: a spilled part is lost), and
+    the share of bins and of feeder runs that must succeed (empty, within the spill limit),
+    which a verdict needs at 95 % confidence (analysis/verdicts.py). 0.9: the highest share that the
+    paper's fixed counts can show when every iteration succeeds (40 bins: 95 % interval from
+    0.912; 50 runs: from 0.929; 36 iterations are the fewest that reach 0.9)."""
+
+    parts_per_hour: float = 60.0
+    refill_interval: float = 4.0 * 3600.0      # s
+    max_dimension: float = 0.3                 # m
+    max_spilled: int = 0                       # parts per feeder run
+    success_rate: float = 0.9                  # share of bins / feeder runs
+
+    @property
+    def capacity(self) -> int:
+        """Parts a bin or feeder must hold to last one refill interval."""
+        return math.ceil(self.parts_per_hour * self.refill_interval / 3600.0)
+
+
+@dataclass(frozen=True)
+class Cell:
+    """The picking cell's own times, for its throughput (analysis/metrics.py): the robot's
+    pick-and-place cycle per part, s, and the vision system's image per check (after every
+    pick and every vibration), s. The table's time comes from the simulation: each feed's and
+    vibration's simulated duration until the parts rest. 4 s per pick: the fast end of the 4
+    to 10 s a hand insertion of a wired part takes (docs/decisions.md); 0 s per image: not
+    counted unless set. Set both to the cell's measured figures."""
+
+    pick_time: float = 4.0      # s
+    image_time: float = 0.0     # s
+
+
+@dataclass(frozen=True)
+class Sampling:
+    """How many iterations an experiment runs. fixed: its `iterations` (per bin or count), as
+    the paper's counts. adaptive: batches of `batch` iterations per group until its decision
+    is settled (running/sampling.py), at most its `iterations`."""
+
+    mode: str = FIXED
+    batch: int = 5
+
+    @property
+    def adaptive(self) -> bool:
+        return self.mode == ADAPTIVE
+
+
+@dataclass(frozen=True)
+class GripperVariant:
+    """One gripper and grasp set of a gripper_sweep: the gripper, the name of the grasp set
+    (a key of the experiment's `grasp_sets`) and its grasps, in part.grasps order."""
+
+    gripper: Gripper
+    grasp_set: str
+    grasps: tuple[GraspPose, ...]
+
+    @property
+    def size(self) -> tuple[float, float, float, float]:
+        """What "smaller" means when grippers are compared: the body's diameter first (what
+        must fit between neighbours), then the jaws' depth and height, then the body's length."""
+        g = self.gripper
+        return g.body_diameter, g.jaw_depth, g.jaw_height, g.body_length
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """One experiment of the file.
+
+    bins: bin_static's candidate bins. bin: bin_emptying's bin, or None when `bin_from` names
+    the bin_static experiment whose best bin is used (gripper_sweep: the same, and neither
+    means the tray). counts: table_sweep's parts on the tray. optimal_range:
+    feeder_emptying's [min*, max*], or None when `range_from` names the table_sweep whose
+    optimum is used. variants: gripper_sweep's grippers and grasp sets, checked on the same
+    scenes; min_valid: the valid parts per check a gripper must give (its 95 % interval's low
+    end at least this).
+    """
+
+    id: str
+    type: str
+    iterations: int
+    parts: int = 0
+    bins: tuple[ContainerSpec, ...] = ()
+    bin: ContainerSpec | None = None
+    bin_from: str = ''
+    counts: tuple[int, ...] = ()
+    margin: int = 5
+    optimal_range: tuple[int, int] | None = None
+    range_from: str = ''
+    max_vibrations: int = 500
+    variants: tuple[GripperVariant, ...] = ()
+    min_valid: float = 1.0
+
+
+@dataclass(frozen=True)
+class ExperimentFile:
+    """Everything a run needs, in SI units. `path` is the file read; `text` its content."""
+
+    id: str
+    seed: int
+    output_dir: str
+    setup: Setup            # the part, gripper, grasps, placing and check settings, packed once
+    search_order: str
+    tray: ContainerSpec
+    moves: tuple[Vibration, ...]
+    bin_wall: float
+    requirements: Requirements
+    experiments: tuple[Experiment, ...]
+    sampling: Sampling = Sampling()
+    cell: Cell = Cell()
+    path: str = ''
+    text: str = field(default='', repr=False)
+
+    def experiment(self, experiment_id: str) -> Experiment:
+        return next(e for e in self.experiments if e.id == experiment_id)
+
+    @property
+    def part(self) -> PartSpec:
+        return self.setup.part
+
+    @property
+    def gripper(self) -> Gripper:
+        return self.setup.gripper
+
+    @property
+    def grasps(self) -> tuple[GraspPose, ...]:
+        return self.setup.grasps
+
+    @property
+    def place(self) -> PlaceSpec:
+        return self.setup.place
+
+    @property
+    def check(self) -> CheckConfig:
+        return self.setup.config
+
+    def variant_setup(self, variant: GripperVariant | None) -> Setup:
+        """The setup a check runs with: the file's, or a gripper_sweep variant's gripper and
+        grasps in it."""
+        if variant is None:
+            return self.setup
+        return replace(self.setup, gripper=variant.gripper, grasps=variant.grasps)

@@ -1,0 +1,109 @@
+"""The plan of a run: the iterations (units) of each experiment and their seeds.
+
+Every iteration is a unit of work with its own seed, derived from the file's seed, the
+experiment id and the iteration's key (`iteration_seed`), on a fresh scene of one instance: its
+result depends on nothing else, so order, resumption and the worker that ran it do not matter.
+"""
+
+from dataclasses import dataclass
+import zlib
+
+from feeder_controller.policy import FeederConfig
+import numpy as np
+from pick_common.containers import ContainerSpec
+from pick_common.specs import MAX_SEED
+
+from .model import (
+    BIN_EMPTYING,
+    BIN_STATIC,
+    Experiment,
+    ExperimentFile,
+    GRIPPER_SWEEP,
+    TABLE_SWEEP,
+)
+
+
+def iteration_seed(seed: int, experiment_id: str, key: tuple[int, ...]) -> int:
+    """The seed of one iteration, from the file's seed, the experiment id and the iteration's
+    key ((bin index, i) for bin_static, (n, i) for table_sweep, (i,) otherwise)."""
+    words = [seed & 0xFFFFFFFF, seed >> 32, zlib.crc32(experiment_id.encode()), *key]
+    state = np.random.SeedSequence(words).generate_state(1, np.uint64)[0]
+    return int(state) & MAX_SEED
+
+
+@dataclass(frozen=True)
+class Unit:
+    """One iteration: experiment, key (group, iteration), seed and what it runs on.
+    group: the bin index for bin_static, n for table_sweep, 0 otherwise."""
+
+    experiment: Experiment
+    group: int
+    iteration: int
+    seed: int
+    container: ContainerSpec
+    parts: int
+    feeder: FeederConfig | None = None
+
+    @property
+    def key(self) -> tuple[str, int, int]:
+        """(experiment id, group, iteration): the key of its rows in the results files."""
+        return self.experiment.id, self.group, self.iteration
+
+    @property
+    def label(self) -> str:
+        """The iteration as a progress line says it."""
+        kind = self.experiment.type
+        if kind == BIN_STATIC:
+            return (f'bin {self.group + 1}/{len(self.experiment.bins)}, '
+                    f'iteration {self.iteration + 1}')
+        if kind == TABLE_SWEEP:
+            return f'{self.group} parts, iteration {self.iteration + 1}'
+        return f'iteration {self.iteration + 1}/{self.experiment.iterations}'
+
+
+def groups(exp: Experiment) -> list[int]:
+    """The groups of `exp`'s iterations (Unit.group): its bins' indexes, its counts, or 0."""
+    if exp.type == BIN_STATIC:
+        return list(range(len(exp.bins)))
+    if exp.type == TABLE_SWEEP:
+        return list(exp.counts)
+    return [0]
+
+
+def experiment_iterations(exp: Experiment) -> int:
+    """The iterations of `exp`: its iterations per bin (bin_static) or per n (table_sweep)."""
+    return len(groups(exp)) * exp.iterations
+
+
+def count_iterations(file: ExperimentFile) -> int:
+    return sum(experiment_iterations(e) for e in file.experiments)
+
+
+def plan(file: ExperimentFile, exp: Experiment, summary: dict) -> list[Unit]:
+    """The iterations of `exp`, given the metrics of the experiments before it."""
+    units = []
+
+    def unit(group: int, i: int, container: ContainerSpec, parts: int, **kw) -> Unit:
+        return Unit(exp, group, i, iteration_seed(file.seed, exp.id, (group, i)), container,
+                    parts, **kw)
+
+    if exp.type == BIN_STATIC:
+        for b, container in enumerate(exp.bins):
+            units += [unit(b, i, container, exp.parts) for i in range(exp.iterations)]
+    elif exp.type in (BIN_EMPTYING, GRIPPER_SWEEP):
+        container = exp.bin
+        if exp.bin_from:
+            best = summary[exp.bin_from]['best_bin']
+            container = file.experiment(exp.bin_from).bins[best]
+        elif container is None:     # a gripper_sweep without a bin: the tray
+            container = file.tray
+        units = [unit(0, i, container, exp.parts) for i in range(exp.iterations)]
+    elif exp.type == TABLE_SWEEP:
+        for n in exp.counts:
+            units += [unit(n, i, file.tray, n) for i in range(exp.iterations)]
+    else:
+        low, high = exp.optimal_range or summary[exp.range_from]['optimal_range']
+        feeder = FeederConfig(exp.parts, low, high, exp.max_vibrations)
+        units = [unit(0, i, file.tray, exp.parts, feeder=feeder)
+                 for i in range(exp.iterations)]
+    return units

@@ -1,0 +1,220 @@
+"""Adaptive sampling: how many iterations an experiment needs before its decision is settled.
+
+With `sampling.mode: adaptive` an experiment's iterations run in batches of `sampling.batch`
+per group (bin, count of parts on the tray; one group otherwise), up to the file's
+`iterations`, which stay the most it may take. After each batch is written, the scheduler
+asks `unsettled` which groups still need one; when none does (or none has iterations left),
+the experiment stops. The
+iterations keep the keys and seeds of the fixed counts (plan.py), so an adaptive run is the
+first iterations of the fixed-count run of the same file, and its figures are computed from
+them exactly as the fixed counts' (metrics.py).
+
+What settles each decision, looked at after every batch:
+- bin_emptying, feeder_emptying: the success rate (bins emptied; runs emptied within the spill
+  limit) against requirements.success_rate, as the verdict reads it (verdicts.py): settled when
+  its exact interval lies wholly at or above the requirement, or wholly below it; for
+  feeder_emptying the cell's throughput too (metrics.throughputs against
+  requirements.parts_per_hour): settled when its interval lies wholly below (NOT FEASIBLE
+  whatever the rate), and a rate above needs the throughput's interval wholly above. An
+  iteration left out of the figures (a physics fault) settles it too: the verdict is NOT
+  FEASIBLE then.
+- bin_static, a race: a bin leaves it when the interval of its mean container-free fraction lies
+  wholly below the interval of the leading bin's (the highest mean). The race ends with one bin
+  left (the best bin) or at the most iterations.
+- table_sweep: the optimum n* of the fit, bootstrapped (metrics.n_star_interval: iterations
+  resampled within each count, a seed of the file's): settled when the interval of n* lies
+  inside the optimal range n* +- margin, so the feeder runs' range holds the optimum. Every
+  count gets the first batch (the fit needs its whole curve); each later look places as many
+  parts' worth of drops as a batch at every count would, where they narrow n* most
+  (_sweep_batches), so a sweep takes about as many looks as with a batch at every count.
+- gripper_sweep: the smallest gripper meeting min_valid (metrics.gripper_sweep): settled when,
+  in size order, every gripper before the first that meets is known not to meet (its interval
+  of valid parts per check lies below min_valid) and that one is known to meet (its interval's
+  low end at least min_valid), or every gripper is known not to meet.
+
+Looking again and again at the same growing sample and stopping at the first clear interval
+would make a 95 % interval wrong more often than 1 in 20. So a look before the last uses
+INTERIM_CONFIDENCE (99.9 %) intervals, and only the last look, at the most iterations, the 95 %
+ones every figure reports: the Haybittle-Peto rule of clinical trials (Haybittle 1971, Peto et
+al. 1976). With L looks the chance of a wrong early stop is at most L x 0.1 %.
+"""
+
+import numpy as np
+
+from ..analysis import metrics
+from ..experiment_file import (
+    BIN_EMPTYING,
+    BIN_STATIC,
+    Experiment,
+    ExperimentFile,
+    FEEDER_EMPTYING,
+    GRIPPER_SWEEP,
+    TABLE_SWEEP,
+)
+from ..experiment_file.plan import groups
+
+INTERIM_CONFIDENCE = 0.999
+
+
+def unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict],
+              checks: list[dict] = ()) -> list[int]:
+    """The groups of `exp` that need more iterations for its decision, from `rows` (its
+    iterations written so far, any order) and `checks` (its rows of checks.csv, for a
+    gripper_sweep), at INTERIM_CONFIDENCE; [] when the decision is settled."""
+    rows = sorted(rows, key=lambda r: (r['group'], r['iteration']))
+    out = metrics.left_out(rows)
+    if out and exp.type in (BIN_EMPTYING, FEEDER_EMPTYING):
+        return []           # a left-out iteration makes the option NOT FEASIBLE: settled
+    kept = [r for r in rows if (r['group'], r['iteration']) not in out]
+    if exp.type == BIN_STATIC:
+        return _racing(exp, kept)
+    if exp.type == TABLE_SWEEP:
+        return _sweep_unsettled(file, exp, kept)
+    if exp.type == GRIPPER_SWEEP:
+        kept_keys = {(r['group'], r['iteration']) for r in kept}
+        return [] if _smallest_settled(exp, [c for c in checks if (c['group'], c['iteration'])
+                                             in kept_keys]) else groups(exp)
+    required = file.requirements
+    if exp.type == BIN_EMPTYING:
+        successes = sum(bool(r['emptied']) for r in kept)
+        return [] if rate_settled(successes, len(kept), required.success_rate) else groups(exp)
+    successes = sum(bool(r['emptied']) and r['spilled'] <= required.max_spilled for r in kept)
+    return [] if _feeder_settled(file, successes, kept) else groups(exp)
+
+
+def _feeder_settled(file: ExperimentFile, successes: int, rows: list[dict]) -> bool:
+    """The table's verdict is known: its rate of runs emptied within the spill limit lies
+    wholly below the required share, or the interval of its throughput wholly below the
+    required parts per hour (either makes it NOT FEASIBLE), or the rate lies wholly at or above
+    the share and the throughput's interval at or above the parts per hour."""
+    required = file.requirements
+    if not rows:
+        return False
+    low, high = metrics.rate_interval(successes, len(rows), INTERIM_CONFIDENCE)
+    least, most = metrics.interval(metrics.throughputs(file.cell, rows), INTERIM_CONFIDENCE)
+    if high < required.success_rate or (most is not None and most < required.parts_per_hour):
+        return True
+    return low >= required.success_rate and least is not None and (
+        least >= required.parts_per_hour)
+
+
+def rate_settled(successes: int, n: int, required: float,
+                 confidence: float = INTERIM_CONFIDENCE) -> bool:
+    """The rate's exact interval lies wholly at or above `required`, or wholly below it."""
+    if n == 0:
+        return False
+    low, high = metrics.rate_interval(successes, n, confidence)
+    return low >= required or high < required
+
+
+def _racing(exp: Experiment, rows: list[dict]) -> list[int]:
+    """The bins still in the race: every bin whose interval of the mean container-free
+    fraction reaches the leader's; all of them while any has fewer than two iterations; none
+    when there is one bin (it is the best)."""
+    if len(groups(exp)) == 1:
+        return []
+    fractions = {g: [r['container_free'] / r['checked'] for r in rows
+                     if r['group'] == g and r['checked']] for g in groups(exp)}
+    intervals = {g: metrics.interval(v, INTERIM_CONFIDENCE) for g, v in fractions.items()}
+    if any(low is None for low, _ in intervals.values()):
+        return groups(exp)
+    leader = max(groups(exp), key=lambda g: (np.mean(fractions[g]), -g))
+    floor = intervals[leader][0]
+    racing = [g for g in groups(exp) if intervals[g][1] >= floor]
+    return racing if len(racing) > 1 else []
+
+
+def _sweep_unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> list[int]:
+    """[] when the sweep's n* is settled (its bootstrap interval at INTERIM_CONFIDENCE lies
+    inside n* +- margin), else where the next look's drops go (_sweep_batches). The counts'
+    rows and the fit are made once for both."""
+    by_count = [np.array([r['valid'] for r in rows if r['group'] == n], dtype=float)
+                for n in exp.counts]
+    if any(len(v) < 2 for v in by_count):      # also every row left out: nothing to fit
+        return _sweep_batches(file, exp, by_count, None)
+    first, last = exp.counts[0], exp.counts[-1]
+    fitted = metrics.fit_optimum([r['group'] for r in rows], [r['valid'] for r in rows],
+                                 first, last, exp.margin)
+    if fitted['order'] < 1:
+        return []           # one count: n* is that count
+    best = fitted['n_star']
+    low, high = metrics.n_star_interval(exp.counts, by_count, fitted['order'], first, last,
+                                        INTERIM_CONFIDENCE,
+                                        np.random.default_rng([file.seed, len(rows)]))
+    if best - exp.margin <= low and high <= best + exp.margin:
+        return []
+    return _sweep_batches(file, exp, by_count, fitted)
+
+
+def _sweep_batches(file: ExperimentFile, exp: Experiment, by_count: list[np.ndarray],
+                   fitted: dict | None) -> list[int]:
+    """Where a sweep's next look puts its iterations: as many parts' worth of drops as a batch
+    at every count, given a batch at a time to the count where a batch shrinks the variance of
+    the fit's slope at n* most per part dropped (a greedy sequential c-optimal design: n* is
+    where that slope crosses zero, so its spread is the slope's over the curvature). The fit
+    weighs every count's mean the same (metrics.fit), so the slope's variance is the sum over
+    counts of influence^2 x variance / iterations, and more drops at a count narrow n* without
+    moving the curve the fixed counts fit. Each count's variance of valid parts is smoothed by
+    a quadratic in n (a count seen five times can show no spread by chance). A count listed k
+    times gets k batches. Every count has had the first batch, so the whole curve is known.
+    Falls back to a batch at every count when the fit cannot say (no fit, no spread at all,
+    or too few counts). `by_count`: each count's valid parts; `fitted`: metrics.fit_optimum's
+    fit of them, None while a count has fewer than two iterations."""
+    batch = file.sampling.batch
+    counts = np.array(exp.counts, dtype=float)
+    taken = np.array([len(v) for v in by_count], dtype=float)
+    left = exp.iterations - taken
+    # not settled: never [], even with no iterations left (the scheduler then stops)
+    everywhere = [n for n, k in zip(exp.counts, left, strict=True) if k > 0] or list(exp.counts)
+    if fitted is None or fitted['order'] < 1 or len(counts) < 3:
+        return everywhere
+    first, last, order = exp.counts[0], exp.counts[-1], fitted['order']
+    spread = np.array([v.var(ddof=1) for v in by_count])
+    if not spread.any():
+        return everywhere
+    smooth = np.polyval(np.polyfit(counts, spread, 2, w=np.sqrt(taken - 1.0)), counts)
+    variance = np.maximum(smooth, 1e-3 * spread.max())
+    u = 2.0 * (counts - first) / (last - first) - 1.0      # the fit's basis, scaled
+    basis = np.vander(u, order + 1)
+    at = 2.0 * (fitted['n_star'] - first) / (last - first) - 1.0
+    slope = np.array([k * at ** (k - 1) if k else 0.0 for k in range(order, -1, -1)])
+    influence = basis @ np.linalg.solve(basis.T @ basis, slope)   # d slope / d mean, per count
+    weight = influence ** 2 * variance
+
+    def gains(m: np.ndarray, step: np.ndarray) -> np.ndarray:
+        """The slope's variance removed per part dropped by `step` more iterations."""
+        with np.errstate(divide='ignore', invalid='ignore'):
+            return np.where(step > 0, weight * (1.0 / m - 1.0 / (m + step)) / (step * counts),
+                            -np.inf)
+
+    # A look drops at most as many parts as a batch at every count, so a sweep takes about as
+    # many looks as with a batch at every count (the interim confidence's bound grows with the
+    # looks; PTH0's unsettled sweep: 9 against 8).
+    budget = batch * counts.sum()
+    given = np.zeros(len(counts))
+    out = []
+    while True:
+        step = np.minimum(batch, left - given)
+        g = np.where(step * counts <= budget, gains(taken + given, step), -np.inf)
+        best = int(np.argmax(g))
+        if g[best] == -np.inf:
+            break
+        budget -= step[best] * counts[best]
+        given[best] += step[best]
+        out.append(exp.counts[best])
+    return out or everywhere
+
+
+def _smallest_settled(exp: Experiment, checks: list[dict]) -> bool:
+    """In size order: every gripper known not to meet min_valid up to one known to meet it,
+    or all known not to."""
+    for k in sorted(range(len(exp.variants)), key=lambda k: (exp.variants[k].size, k)):
+        low, high = metrics.interval([c['valid'] for c in checks if c['check'] == k],
+                                     INTERIM_CONFIDENCE, counts=True)
+        if low is None:
+            return False
+        if low >= exp.min_valid:
+            return True
+        if high >= exp.min_valid:
+            return False
+    return True
