@@ -23,10 +23,12 @@ IMPORT_KEYS = {
     'pydantic': 'python3-pydantic',
     'pydantic_core': 'python3-pydantic',     # pydantic's own core, installed with it
     'matplotlib': 'python3-matplotlib',
+    'mpl_toolkits': 'python3-matplotlib',   # matplotlib's 3D axes, shipped with it
     'tqdm': 'python3-tqdm',
     'pytest': 'python3-pytest',
     'hypothesis': 'python3-hypothesis',
     'trimesh': 'python3-trimesh-pip',
+    'networkx': 'python3-networkx',         # imported by trimesh (split, fill_holes)
     'fcl': 'python-fcl-pip',
     'pybullet': 'python3-pybullet-pip',
     'mcap': None,

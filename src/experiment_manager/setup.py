@@ -14,6 +14,8 @@ setup(
         ('share/' + package_name + '/config', ['config/default_experiment.yaml']),
         # the paper's test case, so that an installed workspace can run it by its share path
         ('share/' + package_name + '/config/test_case', sorted(glob('config/test_case/*.yaml'))),
+        # parts from real CAD files, with their source and licence
+        ('share/' + package_name + '/config/parts', sorted(glob('config/parts/*'))),
         ('share/' + package_name + '/launch', ['launch/experiment_launch.py']),
         # the Foxglove layout for recordings of a run in the root namespace (README)
         ('share/' + package_name + '/foxglove', ['foxglove/pick_sim_layout.json']),

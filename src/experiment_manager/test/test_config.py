@@ -92,7 +92,7 @@ BAD = [
      r'counts\.last: 3 must be within \[9, '),
     (MINIMAL + '  - {id: s, type: table_sweep, iterations: 1, bins_mm: [[1, 1, 1]]}\n',
      r'experiments\[1\]\.bins_mm: .* is not a known key here'),
-    ('part: {model: mesh, mass_g: 1, mesh: no_such.stl}\n' + MINIMAL,
+    ('part: {model: mesh, mass_g: 1, mesh: no_such.stl, units: mm}\n' + MINIMAL,
      r'part\.mesh: .*no_such\.stl. does not exist or is not a file'),
     ('part: {model: mesh, mass_g: 1}\n' + MINIMAL,
      r'part\.mesh: .. is required when model is mesh'),
@@ -177,7 +177,8 @@ def test_a_mesh_path_is_relative_to_the_file(tmp_path):
     import trimesh
     trimesh.creation.box((0.004, 0.002, 0.01)).export(tmp_path / 'clip.stl')
     path = tmp_path / 'exp.yaml'
-    path.write_text('part:\n  model: mesh\n  mesh: clip.stl\n  mass_g: 0.2\n  grasps:\n'
+    path.write_text('part:\n  model: mesh\n  mesh: clip.stl\n  units: m\n  mass_g: 0.2\n'
+                    '  place: {seat_offset_mm: 5}\n  grasps:\n'
                     '    - {up_axis: [0, 0, 1], closing_axis: [1, 0, 0], jaw_opening_mm: 8}\n'
                     + MINIMAL)
     f = experiment_file.load(str(path))
@@ -265,3 +266,73 @@ def test_a_misspelt_required_key_is_named_as_the_typo_it_is():
     assert str(info.value) == ('experiments[0].iteration: 1 is not a known key here '
                                '(did you mean iterations? it is required)')
     assert not isinstance(info.value, experiment_file.InvalidFile)     # one error, told once
+
+
+STEP = os.path.join(HERE, '..', 'config', 'parts', 'TO-220-3_Vertical.step')
+# KiCad's TO-220: origin at pin 1 on the board plane; the body is 10.25 mm across x at
+# (2.54, 0, 9) mm, 4.46 mm across y there (-1.29 to 3.16 mm about it).
+TO220 = """id: t
+part:
+  model: mesh
+  mesh: {mesh}
+  mass_g: 2
+  place: {{axis: [0, 0, -1], seat_offset_mm: 0}}
+  grasps:
+    - {{name: across, up_axis: [0, 1, 0], closing_axis: [1, 0, 0], jaw_opening_mm: {opening},
+       grasp_point_mm: {point}}}
+experiments:
+  - {{id: s, type: table_sweep, iterations: 1, counts: {{first: 5, last: 10, step: 5}}}}
+"""
+
+
+def _to220(mesh=STEP, opening=16, point='[2.54, 0, 9]', extra=''):
+    return TO220.format(mesh=mesh, opening=opening, point=point).replace(
+        '  mass_g: 2\n', '  mass_g: 2\n' + extra)
+
+
+def test_a_step_file_is_read_in_its_own_units():
+    f = experiment_file.parse(_to220(), STEP)
+    assert f.part.scale == 1.0 and f.part.mesh_path == os.path.normpath(STEP)
+    from pick_common.parts import build_part
+    assert build_part(f.part).visual.extents == pytest.approx((0.01025, 0.004455, 0.028525),
+                                                              abs=1e-6)
+
+
+@pytest.mark.parametrize('text, message', [
+    (_to220(point='[0, -1, 18]'), r"part\.grasps\[0\]\.grasp_point_mm \(grasp 'across'\): "
+     r'\[0\.0, -1\.0, 18\.0\] closes on nothing'),
+    (_to220(opening=9), r"grasp 'across'\): .* cannot close on the part: it is 10\.25 mm across "
+     r'the closing axis .* the jaws open 9\.00 mm'),
+    (_to220(point='[9, 0, 9]'), r'grasp point off the part: the material on its closing line '
+     r'begins 1\.34 mm from it'),
+    (_to220(extra='  mesh_scale: 0.001\n'), r'part\.mesh_scale: 0\.001 is not read for '
+     r'TO-220-3_Vertical\.step: the file states its own units'),
+    (_to220(extra='  units: mm\n'), r'part\.units: .mm. is not read for'),
+    (_to220().split('  grasps:')[0] + 'experiments:' + _to220().split('experiments:')[1],
+     r'part\.grasps: None are required for a mesh part'),
+    (_to220().replace('seat_offset_mm: 0', 'axis: [0, 0, -1]').replace(
+        '{axis: [0, 0, -1], axis', '{axis'), r'part\.place\.seat_offset_mm: None is required '
+     'for a mesh part'),
+])
+def test_a_wrong_mesh_part_is_refused_with_what_was_measured(text, message):
+    with pytest.raises(InvalidArgument) as info:
+        experiment_file.parse(text, STEP)
+    assert re.search(message, str(info.value)), str(info.value)
+
+
+def test_a_file_without_units_needs_them_and_a_wrong_unit_is_named(tmp_path):
+    import trimesh
+    trimesh.creation.box((6.0, 4.0, 2.0)).export(tmp_path / 'clip.stl')     # in mm
+    text = _to220(mesh='clip.stl', point='[0, 0, 0]')
+    with pytest.raises(InvalidArgument, match=r'part\.units: None is required for clip\.stl, '
+                       r'which states no units: one of mm, cm, m, in'):
+        experiment_file.parse(text, str(tmp_path / 'exp.yaml'))
+    with pytest.raises(InvalidArgument, match=r'part\.mesh: .* is 6000 mm across at scale 1; '
+                       r'a part must be 0\.5 to 300 mm across: in mm \(scale 0\.001\) it is 6 '
+                       r'mm, in cm \(scale 0\.01\) it is 60 mm, in in \(scale 0\.0254\) it is '
+                       r'152\.4 mm'):
+        experiment_file.parse(_to220(mesh='clip.stl', point='[0, 0, 0]', extra='  units: m\n'),
+                              str(tmp_path / 'exp.yaml'))
+    f = experiment_file.parse(_to220(mesh='clip.stl', point='[0, 0, 0]', extra='  units: mm\n'),
+                              str(tmp_path / 'exp.yaml'))
+    assert f.part.scale == 0.001

@@ -112,3 +112,15 @@ def rotate(quaternions: np.ndarray, vector: np.ndarray) -> np.ndarray:
     xyz, w = quaternions[:, :3], quaternions[:, 3:4]
     t = 2.0 * np.cross(xyz, vector)
     return vector + w * t + np.cross(xyz, t)
+
+
+def quaternion_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The products a * b (n, 4) of quaternions (n, 4) and one (4,) or (n, 4), xyzw: rotate by
+    b, then by a."""
+    b = np.broadcast_to(b, a.shape)
+    ax, ay, az, aw = a.T
+    bx, by, bz, bw = b.T
+    return np.stack([aw * bx + ax * bw + ay * bz - az * by,
+                     aw * by - ax * bz + ay * bw + az * bx,
+                     aw * bz + ax * by - ay * bx + az * bw,
+                     aw * bw - ax * bx - ay * by - az * bz], axis=1)

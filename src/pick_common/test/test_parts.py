@@ -1,11 +1,18 @@
 """Part models: built-in geometry and user meshes, good and degenerate (no physics: the
 world's tests drop a user mesh)."""
 
+import os
+
+from hypothesis import given, HealthCheck, settings
+from hypothesis import strategies as st
 import numpy as np
 from pick_common.errors import InvalidArgument, MeshError
-from pick_common.parts import build_part, BUILTIN_MODELS, PartSpec
+from pick_common.parts import build_part, BUILTIN_MODELS, MESH_EXTENT, PartSpec
 import pytest
 import trimesh
+
+STEP = os.path.join(os.path.dirname(__file__), '..', '..', 'experiment_manager', 'config',
+                    'parts', 'TO-220-3_Vertical.step')
 
 
 @pytest.mark.parametrize('model', sorted(BUILTIN_MODELS))
@@ -89,9 +96,88 @@ def test_mesh_scale_and_mass_are_checked(tmp_path):
     _two_body_mesh().export(path)
     with pytest.raises(InvalidArgument, match='part.mass: None is required for a mesh part'):
         build_part(PartSpec(model='mesh', mesh_path=str(path)))
-    with pytest.raises(MeshError, match='check part.scale'):
+    with pytest.raises(MeshError, match=r'is 6000 mm across at scale 1000; a part must be 0\.5 to '
+                       r'300 mm across: in mm \(scale 0\.001\) it is 0\.006 mm|in m \(scale 1\)'):
         build_part(PartSpec(model='mesh', mesh_path=str(path), scale=1000.0, mass=0.001))
     with pytest.raises(InvalidArgument, match='part.scale: 0.0 must be > 0'):
         build_part(PartSpec(model='mesh', mesh_path=str(path), scale=0.0, mass=0.001))
     with pytest.raises(MeshError, match='part.mesh_path: .* is empty'):
         build_part(PartSpec(model='mesh', mass=0.001))
+
+
+def test_a_step_file_is_read_in_metres_and_takes_no_scale():
+    # KiCad's TO-220 states millimetres; trimesh (with cascadio) reads it in metres.
+    part = build_part(PartSpec(model='mesh', mesh_path=STEP, mass=0.002))
+    assert part.visual.extents == pytest.approx((0.01025, 0.004455, 0.028525), abs=1e-6)
+    with pytest.raises(MeshError, match=r'part\.scale: 0\.001 must be 1 for '
+                       r'TO-220-3_Vertical\.step: the file states its units'):
+        build_part(PartSpec(model='mesh', mesh_path=STEP, scale=0.001, mass=0.002))
+
+
+@pytest.mark.parametrize('size, wrong', [(0.0004, True), (0.0006, False), (0.29, False),
+                                         (0.31, True)])
+def test_a_mesh_part_outside_sane_sizes_is_refused(tmp_path, size, wrong):
+    path = str(tmp_path / 'box.stl')
+    trimesh.creation.box((size, size / 2, size / 2)).export(path)
+    spec = PartSpec(model='mesh', mesh_path=path, mass=0.001)
+    if wrong:
+        with pytest.raises(MeshError, match=f'is {size * 1000:g} mm across at scale 1'):
+            build_part(spec)
+    else:
+        assert build_part(spec).visual.extents.max() == pytest.approx(size)
+
+
+_coordinate = st.one_of(st.floats(-0.02, 0.02), st.sampled_from(
+    [0.0, np.nan, np.inf, -np.inf, 1e300, -1e-300, 1e6]))
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow,
+                                                                    HealthCheck.function_scoped_fixture])
+@given(vertices=st.lists(st.tuples(_coordinate, _coordinate, _coordinate), min_size=0,
+                         max_size=12),
+       faces=st.lists(st.tuples(*[st.integers(-2, 14)] * 3), min_size=0, max_size=16),
+       suffix=st.sampled_from(['.obj', '.stl', '.ply']))
+def test_broken_meshes_get_a_mesh_error_or_a_sane_part(tmp_path, vertices, faces, suffix):
+    """Whatever is in the file, the loader says what is wrong with it (MeshError) or returns a
+    part whose geometry is finite and of sane size: never another exception, never a NaN."""
+    path = tmp_path / f'broken{suffix}'
+    if suffix == '.obj':
+        text = ''.join(f'v {x!r} {y!r} {z!r}\n' for x, y, z in vertices)
+        text += ''.join(f'f {a + 1} {b + 1} {c + 1}\n' for a, b, c in faces)
+        path.write_text(text)
+    else:
+        try:
+            trimesh.Trimesh(np.array(vertices, dtype=float).reshape(-1, 3),
+                            np.array(faces, dtype=np.int64).reshape(-1, 3),
+                            process=False).export(path)
+        except Exception:       # a file trimesh cannot even write: write bytes of it
+            path.write_bytes(b'solid x\nendsolid x\n' if suffix == '.stl' else b'ply\n')
+    try:
+        part = build_part(PartSpec(model='mesh', mesh_path=str(path), mass=0.001))
+    except MeshError:
+        return
+    assert np.isfinite(part.visual.vertices).all() and part.volume > 0
+    assert MESH_EXTENT[0] <= part.visual.extents.max() <= MESH_EXTENT[1]
+    for p in part.primitives:
+        assert np.isfinite(p.vertices).all()
+
+
+def test_a_closed_mesh_turned_inside_out_is_turned_back(tmp_path):
+    box = trimesh.creation.box((0.006, 0.004, 0.002))
+    box.invert()
+    box.export(tmp_path / 'inverted.stl')
+    part = build_part(PartSpec(model='mesh', mesh_path=str(tmp_path / 'inverted.stl'),
+                               mass=0.001))
+    assert part.volume == pytest.approx(0.006 * 0.004 * 0.002, rel=1e-6)
+
+
+def test_a_step_file_and_its_stl_in_mm_are_the_same_part(tmp_path):
+    step = build_part(PartSpec(model='mesh', mesh_path=STEP, mass=0.002))
+    mesh = step.visual.copy()
+    mesh.apply_scale(1000.0)                        # written out in mm, as CAD tools export
+    mesh.export(tmp_path / 'to220.stl')
+    stl = build_part(PartSpec(model='mesh', mesh_path=str(tmp_path / 'to220.stl'),
+                              scale=0.001, mass=0.002))
+    assert stl.volume == pytest.approx(step.volume, rel=1e-6)
+    assert stl.mass_frame[0] == pytest.approx(step.mass_frame[0], abs=1e-9)
+    assert [len(p.vertices) for p in stl.primitives] == [len(p.vertices) for p in step.primitives]

@@ -11,6 +11,7 @@ import numpy as np
 from pick_common import containers
 from pick_common.containers import ContainerSpec
 from pick_common.parts import PartGeometry
+from pick_common.states import quaternion_multiply, rotate
 import pybullet as pb
 import trimesh
 
@@ -97,14 +98,33 @@ def create_part(client: int, shape: int, part: PartGeometry, pose: np.ndarray) -
     for bit, world README "Thrown parts"). Streamed drops keep falls short instead, and the
     world reports parts that tunnel or are thrown."""
     spec = part.spec
+    inertial = {}
+    if part.mass_frame is not None:     # a mesh's own mass centre and principal axes
+        centre, axes = part.mass_frame
+        inertial = {'baseInertialFramePosition': centre.tolist(),
+                    'baseInertialFrameOrientation': axes.tolist()}
     body = pb.createMultiBody(part.mass, shape, basePosition=pose[:3].tolist(),
                               baseOrientation=pose[3:].tolist(), useMaximalCoordinates=True,
-                              physicsClientId=client)
+                              physicsClientId=client, **inertial)
     pb.changeDynamics(
         body, -1, lateralFriction=spec.lateral_friction, rollingFriction=spec.rolling_friction,
         spinningFriction=spec.spinning_friction, restitution=spec.restitution,
         activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING, physicsClientId=client)
     return body
+
+
+def part_frame_poses(poses: np.ndarray, part: PartGeometry) -> np.ndarray:
+    """The poses (N, 7) of a part's own frame from PyBullet's base poses, which are of its mass
+    centre's frame (part.mass_frame); the same poses for a built-in model."""
+    if part.mass_frame is None or not len(poses):
+        return poses
+    centre, axes = part.mass_frame
+    out = poses.copy()
+    # frame = base * inverse(inertial): orientation q_base * conj(q_axes), then back off the
+    # mass centre along the frame's axes
+    out[:, 3:] = quaternion_multiply(poses[:, 3:], axes * np.array([-1.0, -1.0, -1.0, 1.0]))
+    out[:, :3] = poses[:, :3] - rotate(out[:, 3:], centre)
+    return out
 
 
 def base_poses(client: int, bodies: list[int]) -> np.ndarray:

@@ -179,13 +179,14 @@ class World:
         wanted = self._instance_ids(instances)
         ids = [pid for k in wanted for pid in self._instances[k].part_ids]
         owners = np.array([self._owner[i] for i in ids], dtype=np.int64)
-        poses = bodies.base_poses(self._client, [self._bodies[i] for i in ids])
+        base = bodies.base_poses(self._client, [self._bodies[i] for i in ids])
         if len(ids):
-            poses[:, :3] -= np.array([self._instances[k].origin for k in owners])
+            base[:, :3] -= np.array([self._instances[k].origin for k in owners])
         inside = np.zeros(len(ids), dtype=bool)
-        for k in wanted:
+        for k in wanted:     # judged at the mass centre (a built-in's frame origin)
             mask = owners == k
-            inside[mask] = containers.inside(self._scene.container, poses[mask, :3])
+            inside[mask] = containers.inside(self._scene.container, base[mask, :3])
+        poses = bodies.part_frame_poses(base, self._part)
         return PartStates(np.array(ids, dtype=np.int64), owners, poses, inside, self._sim_time)
 
     # ----------------------------------------------------------------------------- drop

@@ -51,6 +51,7 @@ from .geometry import (
     rotations_about_x,
     support,
 )
+from .grasp_fit import check_grasps_fit
 from .pairs import Pairs
 from .results import (
     CENTRE_TOLERANCE,
@@ -79,12 +80,14 @@ class Validator:
 
     def __init__(self, setup: Setup, part: PartGeometry | None = None) -> None:
         """`part`: the geometry of setup.part when the caller has built it already (the
-        world's); built here otherwise. Raises InvalidArgument for a bad setup."""
+        world's); built here otherwise. Raises InvalidArgument for a bad setup, a grasp whose
+        jaws cannot close on the part among them (grasp_fit)."""
         self.setup = setup
         self.config = setup.config
         self.part = part if part is not None else build_part(setup.part)
         self.gripper = check_gripper(setup.gripper)
         self.grasps = check_grasps(list(setup.grasps))
+        self.grasp_fits = check_grasps_fit(self.part, setup.grasps)
         self.place_axis, self.seat_offset = check_place(setup.place)
         self.tilts = tilts(self.config)
         self._rotations = rotations_about_x(self.tilts)

@@ -19,22 +19,21 @@ from typing import Any
 from feeder_controller.policy import check_feeder, FeederConfig
 from pick_common.containers import check_container, check_fits, ContainerSpec
 from pick_common.errors import check_int, check_number, InvalidArgument
-from pick_common.parts import build_part, PartGeometry, PartSpec
+from pick_common.parts import PartGeometry
 from pick_common.specs import check_vibration, MOVES, Vibration
 from pick_validity.config import (
-    CAPACITOR_GRASPS,
     check_grasps,
     check_gripper,
     check_place,
     CheckConfig,
     GraspPose,
     Gripper,
-    PlaceSpec,
     Setup,
     tilts,
 )
 import yaml
 
+from . import part as part_section
 from . import schema
 from .errors import read as read_keys
 from .model import (
@@ -46,7 +45,6 @@ from .model import (
     Experiment,
     ExperimentFile,
     FEEDER_EMPTYING,
-    G,
     GRIPPER_SWEEP,
     GripperVariant,
     MAX_EXPERIMENTS,
@@ -83,44 +81,6 @@ def _checked(check: Callable, value: Any, where: str) -> Any:
 
 
 # ---------------------------------------------------------------- sections, to SI units
-def _part(p: schema.Part, base_dir: str) -> tuple[PartSpec, tuple[GraspPose, ...], PlaceSpec]:
-    mesh, mass = p.mesh, G * p.mass_g
-    if p.model == 'mesh':
-        if mass == 0.0:
-            raise InvalidArgument('part.mass_g', 0, 'is required (> 0) for a mesh part')
-        if not mesh:
-            raise InvalidArgument('part.mesh', mesh, 'is required when model is mesh')
-        mesh = os.path.normpath(os.path.join(base_dir, os.path.expanduser(mesh)))
-        if not os.path.isfile(mesh):
-            raise InvalidArgument('part.mesh', mesh, 'does not exist or is not a file')
-    elif mesh:
-        raise InvalidArgument('part.mesh', mesh, f'is only read when model is mesh '
-                              f'(model is {p.model})')
-    if 'pins_per_row' in p.dimensions_mm:
-        raise InvalidArgument('part.dimensions_mm.pins_per_row',
-                              p.dimensions_mm['pins_per_row'],
-                              'is a count, not a length: give it as part.pins_per_row')
-    dimensions: dict[str, float] = {k: MM * v for k, v in p.dimensions_mm.items()}
-    if p.pins_per_row is not None:
-        dimensions['pins_per_row'] = p.pins_per_row
-    spec = PartSpec(
-        model=p.model, dimensions=dimensions, mass=mass or None,
-        lateral_friction=p.lateral_friction, rolling_friction=MM * p.rolling_friction_mm,
-        spinning_friction=MM * p.spinning_friction_mm, restitution=p.restitution,
-        mesh_path=mesh, scale=p.mesh_scale)
-    place = PlaceSpec(place_axis=p.place.axis, seat_offset=MM * p.place.seat_offset_mm)
-    if p.grasps is None:
-        return spec, CAPACITOR_GRASPS, place
-    grasps = tuple(GraspPose(
-        name=g.name if g.name is not None else f'grasp_{i}', up_axis=g.up_axis,
-        closing_axis=g.closing_axis, jaw_opening=MM * g.jaw_opening_mm,
-        grasp_point=tuple(MM * v for v in g.grasp_point_mm)) for i, g in enumerate(p.grasps))
-    names = [g.name for g in grasps]
-    if len(set(names)) != len(names):
-        raise InvalidArgument('part.grasps', names, 'has a grasp name twice')
-    return spec, grasps, place
-
-
 def _gripper(g: schema.GripperSection) -> Gripper:
     return Gripper(**{attr: MM * getattr(g, key) for key, attr in GRIPPER_KEYS})
 
@@ -157,13 +117,6 @@ def _moves(top: schema.FileKeys) -> tuple[Vibration, ...]:
             direction=m.direction if m.direction is not None else base.direction)
         out.append(_checked(check_vibration, move, f'moves[{i}]'))
     return tuple(out)
-
-
-def _geometry(part: PartSpec) -> PartGeometry:
-    try:
-        return build_part(part)
-    except InvalidArgument as exc:
-        raise InvalidArgument(f'part ({exc.field})', exc.value, exc.rule) from None
 
 
 # -------------------------------------------------------------------------- experiments
@@ -326,7 +279,7 @@ def parse(text: str, path: str = '') -> ExperimentFile:
 
     top = read(schema.FileKeys, data, '')
     s = {key: read(model, data.get(key, {}), key) for key, model in schema.SECTIONS.items()}
-    read_part = checked(lambda: _part(s['part'], base_dir)) if s['part'] else None
+    read_part = checked(lambda: part_section.read_part(s['part'], base_dir)) if s['part'] else None
     part, grasps, place = read_part or (None, None, None)
     gripper = _gripper(s['gripper']) if s['gripper'] else None
     check = _check(s['check']) if s['check'] else None
@@ -341,7 +294,9 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         checked(lambda: _checked(check_place, place, 'part.place'))
     if check is not None:
         checked(lambda: _checked(tilts, check, 'check'))
-    geometry = checked(lambda: _geometry(part)) if part is not None else None
+    geometry = checked(lambda: part_section.geometry(part)) if part is not None else None
+    if geometry is not None:
+        checked(lambda: part_section.check_fits(geometry, grasps))
     context = None
     if None not in (top, geometry, tray, requirements, gripper, grasps):
         context = _Context(geometry, tray, MM * top.bin_wall_mm, requirements.max_dimension,

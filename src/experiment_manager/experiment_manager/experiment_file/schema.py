@@ -12,7 +12,7 @@ from functools import partial
 from typing import Annotated, Any
 
 from pick_common.containers import TRAY_DEFAULT_SIZE
-from pick_common.parts import BUILTIN_MODELS, PartSpec
+from pick_common.parts import BUILTIN_MODELS, PartSpec, UNITS
 from pick_common.specs import DIRECTIONS, MAX_MOVES, MAX_PARTS_PER_INSTANCE, MAX_SEED, MOVES
 from pick_validity.config import CheckConfig, Gripper
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
@@ -85,7 +85,8 @@ class Part(Section):
     rolling_friction_mm: Number(0.0, 100.0) = PartSpec.rolling_friction / MM
     spinning_friction_mm: Number(0.0, 100.0) = PartSpec.spinning_friction / MM
     restitution: Number(0.0, 1.0) = 0.0
-    mesh_scale: Number(0.0, 1000.0, low_open=True) = 1.0
+    units: Text(*UNITS) | None = None                 # a mesh file's length unit
+    mesh_scale: Number(0.0, 1000.0, low_open=True) | None = None   # or its scale to metres
     place: Place = Place()
     grasps: Annotated[list[GraspEntry] | None, BeforeValidator(non_empty_list)] = \
         Field(default=None, validate_default=False)

@@ -1,0 +1,111 @@
+"""The part section of an experiment file: a built-in model or the user's CAD file, its
+material, its grasps and how it is placed, in SI units; and its geometry, with the check that
+each grasp's jaws close on it, every error named by the file's keys."""
+
+import os
+
+from pick_common.errors import InvalidArgument
+from pick_common.parts import build_part, PartGeometry, PartSpec, states_units, UNITS
+from pick_validity.config import CAPACITOR_GRASPS, GraspPose, PlaceSpec
+from pick_validity.grasp_fit import check_grasps_fit
+
+from . import schema
+from .model import G, MM
+
+
+def mesh_file(p: schema.Part, base_dir: str) -> tuple[str, float]:
+    """A mesh part's file (absolute) and its scale to metres: 1 for a file that states its
+    units (STEP, glTF), else from `units` or `mesh_scale`, one of which is required."""
+    if not p.mesh:
+        raise InvalidArgument('part.mesh', p.mesh, 'is required when model is mesh')
+    mesh = os.path.normpath(os.path.join(base_dir, os.path.expanduser(p.mesh)))
+    if not os.path.isfile(mesh):
+        raise InvalidArgument('part.mesh', mesh, 'does not exist or is not a file')
+    if p.units is not None and p.mesh_scale is not None:
+        raise InvalidArgument('part.mesh_scale', p.mesh_scale,
+                              f'and part.units ({p.units}) say the same: give one of them')
+    if states_units(mesh):
+        given = 'units' if p.units is not None else 'mesh_scale' if p.mesh_scale else ''
+        if given:
+            raise InvalidArgument(f'part.{given}', getattr(p, given),
+                                  f'is not read for {os.path.basename(mesh)}: the file states '
+                                  'its own units')
+        return mesh, 1.0
+    if p.units is None and p.mesh_scale is None:
+        raise InvalidArgument('part.units', None, f'is required for {os.path.basename(mesh)}, '
+                              f'which states no units: one of {", ".join(UNITS)} (or '
+                              'part.mesh_scale, the factor to metres)')
+    return mesh, UNITS[p.units] if p.units is not None else p.mesh_scale
+
+
+def read_part(p: schema.Part, base_dir: str) -> tuple[PartSpec, tuple[GraspPose, ...], PlaceSpec]:
+    mesh, scale, mass = '', 1.0, G * p.mass_g
+    if p.model == 'mesh':
+        if mass == 0.0:
+            raise InvalidArgument('part.mass_g', 0, 'is required (> 0) for a mesh part')
+        mesh, scale = mesh_file(p, base_dir)
+        # no defaults taken from the built-in capacitor for a part of the user's own
+        if p.grasps is None:
+            raise InvalidArgument('part.grasps', None, 'are required for a mesh part: the '
+                                  "grasp poses, each with its grasp_point_mm in the file's "
+                                  'frame')
+        if 'seat_offset_mm' not in p.place.model_fields_set:
+            raise InvalidArgument('part.place.seat_offset_mm', None, 'is required for a mesh '
+                                  "part: how far its seating plane lies from the file's "
+                                  'origin along place.axis')
+    else:
+        for key in ('mesh', 'units', 'mesh_scale'):
+            if getattr(p, key) not in (None, ''):
+                raise InvalidArgument(f'part.{key}', getattr(p, key), f'is only read when '
+                                      f'model is mesh (model is {p.model})')
+    if 'pins_per_row' in p.dimensions_mm:
+        raise InvalidArgument('part.dimensions_mm.pins_per_row',
+                              p.dimensions_mm['pins_per_row'],
+                              'is a count, not a length: give it as part.pins_per_row')
+    dimensions: dict[str, float] = {k: MM * v for k, v in p.dimensions_mm.items()}
+    if p.pins_per_row is not None:
+        dimensions['pins_per_row'] = p.pins_per_row
+    spec = PartSpec(
+        model=p.model, dimensions=dimensions, mass=mass or None,
+        lateral_friction=p.lateral_friction, rolling_friction=MM * p.rolling_friction_mm,
+        spinning_friction=MM * p.spinning_friction_mm, restitution=p.restitution,
+        mesh_path=mesh, scale=scale)
+    place = PlaceSpec(place_axis=p.place.axis, seat_offset=MM * p.place.seat_offset_mm)
+    if p.grasps is None:
+        return spec, CAPACITOR_GRASPS, place
+    grasps = tuple(GraspPose(
+        name=g.name if g.name is not None else f'grasp_{i}', up_axis=g.up_axis,
+        closing_axis=g.closing_axis, jaw_opening=MM * g.jaw_opening_mm,
+        grasp_point=tuple(MM * v for v in g.grasp_point_mm)) for i, g in enumerate(p.grasps))
+    names = [g.name for g in grasps]
+    if len(set(names)) != len(names):
+        raise InvalidArgument('part.grasps', names, 'has a grasp name twice')
+    return spec, grasps, place
+
+
+# The core's names of a mesh part's fields, and the file's keys for them; the core's other
+# fields are named as `part (core field)`, their values in SI units.
+FILE_KEYS = {'part.mesh_path': 'part.mesh', 'part.scale': 'part.mesh_scale'}
+
+
+def _file_key(field: str) -> str:
+    return FILE_KEYS.get(field, f'part ({field})')
+
+
+def geometry(part: PartSpec) -> PartGeometry:
+    """The part's geometry; a core error names the file's key."""
+    try:
+        return build_part(part)
+    except InvalidArgument as exc:
+        raise InvalidArgument(_file_key(exc.field), exc.value, exc.rule) from None
+
+
+def check_fits(geometry: PartGeometry, grasps: tuple[GraspPose, ...]) -> None:
+    """Every grasp closes on the part (grasp_fit), named by its place in the file."""
+    try:
+        check_grasps_fit(geometry, grasps)
+    except InvalidArgument as exc:
+        name = exc.field.split('.')[1]
+        index = next(i for i, g in enumerate(grasps) if g.name == name)
+        raise InvalidArgument(f'part.grasps[{index}].grasp_point_mm (grasp {name!r})',
+                              exc.value, exc.rule.removeprefix('(mm) ')) from None

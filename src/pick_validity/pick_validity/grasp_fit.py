@@ -1,0 +1,96 @@
+"""Whether a grasp pose can hold the part at all, before any scene: its jaws, centred on the
+grasp point and open to the jaw opening, must close on material.
+
+Along the line through the grasp point in the closing direction, the part's material (where
+the line crosses the part's surface) must lie within the open jaws, +-U/2 about the grasp
+point, and the grasp point must lie on it (between the outermost crossings). A grasp point
+where the jaws close on nothing (a corner of the part, its frame's origin beside it) or a part
+wider than the jaws is refused with the width measured, so that a wrong grasp cannot reach a
+run unnoticed: every candidate would fail placeability for want of a part between the jaws.
+
+Units: metres; the part frame.
+"""
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from pick_common.errors import InvalidArgument
+from pick_common.parts import PartGeometry
+
+from .config import GraspPose
+
+TOLERANCE = 1e-6        # m: a grasp point this near the surface is on it
+
+
+@dataclass(frozen=True)
+class GraspFit:
+    """What the jaws of a grasp close on: `span` (low, high), m along the closing axis from
+    the grasp point, of the part's material on the line through it (None when the line misses
+    the part); `width` = high - low."""
+
+    name: str
+    span: tuple[float, float] | None
+    jaw_opening: float
+
+    @property
+    def width(self) -> float:
+        return 0.0 if self.span is None else self.span[1] - self.span[0]
+
+    def problem(self) -> str:
+        """Why the jaws cannot hold the part, or ''."""
+        mm = 1000.0
+        if self.span is None:
+            return ('closes on nothing: the line through grasp_point along closing_axis '
+                    'misses the part')
+        low, high = self.span
+        if not low - TOLERANCE <= 0.0 <= high + TOLERANCE:
+            gap = low if low > 0 else -high
+            return (f'has its grasp point off the part: the material on its closing line '
+                    f'begins {gap * mm:.2f} mm from it')
+        if self.width >= self.jaw_opening or max(-low, high) > self.jaw_opening / 2:
+            return (f'cannot close on the part: it is {self.width * mm:.2f} mm across the '
+                    f'closing axis ({-low * mm:.2f} and {high * mm:.2f} mm either side of the '
+                    f'grasp point), and the jaws open {self.jaw_opening * mm:.2f} mm about it')
+        return ''
+
+
+def crossings(triangles: np.ndarray, origin: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """Where the line origin + t * direction crosses the triangles (T, 3, 3): the t of each
+    crossing (Moeller-Trumbore, both faces, the whole line)."""
+    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    e1, e2 = b - a, c - a
+    p = np.cross(direction, e2)
+    det = np.einsum('ij,ij->i', e1, p)
+    ok = np.abs(det) > 1e-18
+    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+    s = origin - a
+    u = np.einsum('ij,ij->i', s, p) * inv
+    q = np.cross(s, e1)
+    v = (q @ direction) * inv
+    t = np.einsum('ij,ij->i', e2, q) * inv
+    hit = ok & (u >= -1e-9) & (v >= -1e-9) & (u + v <= 1.0 + 1e-9)
+    return t[hit]
+
+
+def grasp_fit(part: PartGeometry, grasp: GraspPose) -> GraspFit:
+    """What the jaws of `grasp` close on, on the part's own surface (its visual mesh)."""
+    closing = np.asarray(grasp.closing_axis, dtype=np.float64)
+    closing = closing / np.linalg.norm(closing)
+    point = np.asarray(grasp.grasp_point, dtype=np.float64)
+    t = crossings(np.asarray(part.visual.triangles), point, closing)
+    span = (float(t.min()), float(t.max())) if len(t) else None
+    return GraspFit(grasp.name, span, float(grasp.jaw_opening))
+
+
+def check_grasps_fit(part: PartGeometry, grasps: Sequence[GraspPose]) -> tuple[GraspFit, ...]:
+    """Each grasp's fit; raises InvalidArgument for the first whose jaws cannot hold the part,
+    naming the grasp, what it closes on and the width measured."""
+    fits = tuple(grasp_fit(part, g) for g in grasps)
+    for g, fit in zip(grasps, fits, strict=True):
+        problem = fit.problem()
+        if problem:
+            raise InvalidArgument(f'grasps.{g.name}.grasp_point',
+                                  [round(1000.0 * v, 3) for v in g.grasp_point],
+                                  f'(mm) {problem}')
+    return fits
