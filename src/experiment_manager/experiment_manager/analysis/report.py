@@ -1,7 +1,8 @@
 """The report of a run: the decision the engineer came for, with the figures behind it.
 
-From a run directory (`summary.json`, `experiment.yaml`, and `pictures.json` with the pictures
-of pictures.py when they were rendered) it writes
+From a run directory (`summary.json`, `experiment.yaml`, `pictures.json` with the pictures of
+pictures.py when they were rendered, and `part.json` with the part's account and sheet of
+part_sheet.py) it writes
 `report.md` and `report.html` (the same content) and the plots `fig14_bins.png` (fractions of
 parts passing each stage per bin, paper figure 14) and `fig15_table.png` (valid parts against
 parts on the tray with the 4th-order fit, paper figure 15) and, for a gripper_sweep,
@@ -189,8 +190,9 @@ def _sizes(given: dict | None, lead: str) -> str:
 
 
 def markdown(summary: dict, spec: dict, figures: dict[str, bool],
-             pictures: dict[str, str] | None = None) -> str:
-    """The report as Markdown. pictures: {image file: caption} (pictures.py)."""
+             pictures: dict[str, str] | None = None, account: list[str] | None = None) -> str:
+    """The report as Markdown. pictures: {image file: caption} (pictures.py); account: the
+    part's account (part_sheet.describe), with its sheet `part.png`."""
     paper = PAPER.get(summary['id'])
     part = spec.get('part', {})
     r = summary['requirements']
@@ -206,6 +208,12 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
     lines += table(['option', 'verdict', 'why'],
                     [[v['option'], f'**{v["verdict"]}**', '; '.join(v['reasons'])]
                      for v in verdicts(summary)])
+    if account:
+        lines += ['', '## The part', '', 'As the run saw it (the file, its frame, what the '
+                  'physics and the checks collide, what each grasp closes on):', '']
+        lines += [f'- {line.strip()}' for line in account]
+        lines += ['', '![the part sheet: the part, its collision pieces, and the gripper at '
+                  "each grasp's pick and place](part.png)"]
     lines += _sampling(summary)
     statics = of_type(summary, 'bin_static')
     if statics:
@@ -405,7 +413,11 @@ def write(run_dir: str) -> str:
     if os.path.exists(os.path.join(run_dir, 'pictures.json')):
         with open(os.path.join(run_dir, 'pictures.json'), encoding='utf-8') as f:
             pictures = json.load(f)
-    text = markdown(summary, spec, figures, pictures)
+    account = None
+    if os.path.exists(os.path.join(run_dir, 'part.json')):
+        with open(os.path.join(run_dir, 'part.json'), encoding='utf-8') as f:
+            account = json.load(f)
+    text = markdown(summary, spec, figures, pictures, account)
     with open(os.path.join(run_dir, 'report.md'), 'w', encoding='utf-8') as f:
         f.write(text)
     path = os.path.join(run_dir, 'report.html')

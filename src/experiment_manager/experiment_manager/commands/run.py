@@ -128,7 +128,13 @@ def _parse(argv: list[str]) -> argparse.Namespace:
                         f'{RESPAWNS}; 0: never, and the manager does not wait for it)')
     parser.add_argument('--logs', help="directory for the nodes' logs (default: a temporary "
                         'directory, printed)')
+    parser.add_argument('--check', action='store_true',
+                        help="only read each file and draw its part sheet (its part, mass "
+                        "centre, collision pieces, and the gripper at each grasp's pick and "
+                        "place) into --output or the file's output_dir; no graph is started")
     args = parser.parse_args(argv)
+    if args.check and (args.resume or not args.experiment_files):
+        parser.error('--check reads the experiment files given: give one or more')
     if args.resume and len(args.experiment_files) > 1:
         parser.error('--resume finishes one run: give one experiment file')
     if (args.iterations is not None or args.adaptive) and args.resume:
@@ -216,6 +222,9 @@ def _goals(args: argparse.Namespace,
 
 def main(argv: list[str] | None = None) -> int:
     args = _parse(sys.argv[1:] if argv is None else argv)
+    if args.check:
+        from .check import check  # the sheet's drawing is loaded only to draw it
+        return check(args.experiment_files, args.output)
     temporary: list[str] = []
     try:
         return _main(args, temporary)

@@ -14,7 +14,7 @@ import traceback
 
 from pick_common.errors import check_inside, InvalidArgument
 
-from ..analysis import report
+from ..analysis import part_sheet, report
 from ..analysis.results import ResultsWriter
 from ..experiment_file import ExperimentFile, load
 from ..running.backend import Backend
@@ -102,6 +102,7 @@ class RunSession:
                 self._logger.warning(f'no pictures: {exc}')
             else:
                 pictures.write(self.file, self.run_dir)
+            part_sheet.write_account(self.file, self.run_dir)
             return report.write(self.run_dir)
         except Exception as exc:  # the results stand without their report
             self._logger.error(f'the report could not be written: {exc}\n'

@@ -1,0 +1,196 @@
+"""The part of an experiment file as the run will see it, before any run: its size, mass, mass
+centre and collision pieces, and each grasp with what its jaws close on, in words (`describe`)
+and as a picture sheet (`write`): the part as drawn in its file beside its collision pieces,
+and per grasp the gripper at the pick (the part lying with the grasp's up axis up, the jaws
+across its closing axis, the fingertips where the checks put them) and at the place (the part
+turned so that place.axis points down, the gripper held as it picked, at the extreme wrist
+tilts and at 0, the placing surface drawn, and each tilt said clear or hitting it).
+
+matplotlib only (no simulator, no ROS); lengths drawn in mm, in the file's frame.
+"""
+
+import json
+import os
+
+import matplotlib
+
+matplotlib.use('Agg')
+import matplotlib.pyplot as plt
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+import numpy as np
+from pick_common.parts import build_part, PartGeometry, states_units
+from pick_validity.geometry import part_shapes, place, Shape, support
+from pick_validity.grasp_fit import grasp_fit
+from pick_validity.validity import Validator
+import trimesh
+
+from ..experiment_file import ExperimentFile
+
+MM = 1000.0
+PIECE_COLOURS = ('#4c72b0', '#dd8452', '#55a868', '#c44e52', '#8172b3', '#937860')
+
+
+def describe(file: ExperimentFile, part: PartGeometry | None = None) -> list[str]:
+    """What the run will use of the file's part and grasps, one fact a line."""
+    part = part or build_part(file.part)
+    spec = file.part
+    lo, hi = part.visual.bounds * MM
+    lines = []
+    if spec.model == 'mesh':
+        units = 'stated by the file, read in m' if states_units(spec.mesh_path) else \
+            f'scale {spec.scale:g} to m'
+        lines.append(f'part: {spec.mesh_path} ({units}; {len(part.visual.faces)} triangles, '
+                     f'{"closed" if part.visual.is_watertight else "not closed"})')
+    else:
+        lines.append(f'part: built-in {spec.model}')
+    lines.append(f'  size {" x ".join(f"{v:.2f}" for v in hi - lo)} mm; in its frame x '
+                 f'{lo[0]:.2f} to {hi[0]:.2f}, y {lo[1]:.2f} to {hi[1]:.2f}, z {lo[2]:.2f} to '
+                 f'{hi[2]:.2f} mm')
+    centre = part.mass_frame[0] if part.mass_frame is not None else np.zeros(3)
+    lines.append(f'  mass {part.mass * 1000:g} g, volume {part.volume * 1e9:.1f} mm^3; mass '
+                 f'centre at ({", ".join(f"{v:.2f}" for v in centre * MM)}) mm in its frame'
+                 + ('' if part.mass_frame is not None else ' (the frame origin: a built-in)'))
+    hulls = [p for p in part.primitives if p.kind == 'hull']
+    lines.append(f'  collision: {len(part.primitives)} piece(s)' + (
+        f', convex hulls of {", ".join(str(len(h.vertices)) for h in hulls)} vertices, '
+        f'{sum(_hull_volume(h) for h in hulls) * 1e9:.1f} mm^3 together'
+        if hulls else ' (boxes and cylinders)'))
+    for g in file.grasps:
+        fit = grasp_fit(part, g)
+        what = fit.problem() or (f'closes on {fit.width * MM:.2f} mm of part '
+                                 f'({-fit.span[0] * MM:.2f} and {fit.span[1] * MM:.2f} mm '
+                                 f'either side of the grasp point)')
+        away = np.linalg.norm(np.asarray(g.grasp_point) - centre) * MM
+        lines.append(f'  grasp {g.name!r}: jaws open {g.jaw_opening * MM:.2f} mm at '
+                     f'({", ".join(f"{v * MM:.2f}" for v in g.grasp_point)}) mm, '
+                     f'{away:.2f} mm from the mass centre, up {list(g.up_axis)}, closing '
+                     f'{list(g.closing_axis)}: {what}')
+    return lines
+
+
+def _hull_volume(primitive) -> float:
+    return float(trimesh.Trimesh(primitive.vertices, primitive.faces, process=False).volume)
+
+
+def _shape_mesh(shape: Shape, rotation: np.ndarray, centre: np.ndarray) -> trimesh.Trimesh:
+    """A validity shape as a mesh, placed with `rotation` (3, 3) and `centre` (3,)."""
+    if shape.kind == 'box':
+        mesh = trimesh.creation.box(extents=2.0 * shape.half)
+    elif shape.kind == 'cylinder':
+        mesh = trimesh.creation.cylinder(radius=shape.half[0], height=2.0 * shape.half[1],
+                                         sections=24)
+    else:
+        mesh = trimesh.convex.convex_hull(shape.vertices)
+    transform = np.eye(4)
+    transform[:3, :3], transform[:3, 3] = rotation, centre
+    return mesh.copy().apply_transform(transform)
+
+
+def _draw(ax, mesh: trimesh.Trimesh, view: np.ndarray, colour: str, alpha: float) -> None:
+    triangles = np.einsum('ij,ntj->nti', view, mesh.triangles) * MM
+    ax.add_collection3d(Poly3DCollection(triangles, facecolor=colour, edgecolor='none',
+                                         alpha=alpha))
+
+
+def _frame(ax, points: np.ndarray, title: str) -> None:
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    centre, half = (lo + hi) / 2, max((hi - lo).max() / 2, 1.0)
+    for axis, c in zip('xyz', centre, strict=True):
+        getattr(ax, f'set_{axis}lim')(c - half, c + half)
+        getattr(ax, f'set_{axis}label')(f'{axis} mm', fontsize=7)
+    ax.set_box_aspect((1, 1, 1))
+    ax.tick_params(labelsize=6)
+    ax.set_title(title, fontsize=8)
+
+
+def _turn(vector: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """The shortest rotation (3, 3) taking unit `vector` to unit `target`."""
+    v, t = vector / np.linalg.norm(vector), target / np.linalg.norm(target)
+    axis, c = np.cross(v, t), float(v @ t)
+    if np.linalg.norm(axis) < 1e-9:
+        if c > 0:
+            return np.eye(3)
+        other = np.array([1.0, 0, 0]) if abs(v[0]) < 0.9 else np.array([0, 1.0, 0])
+        axis = np.cross(v, other)
+    axis /= np.linalg.norm(axis)
+    angle = np.arctan2(np.linalg.norm(np.cross(v, t)), c)
+    return trimesh.transformations.rotation_matrix(angle, axis)[:3, :3]
+
+
+def write(file: ExperimentFile, path: str, part: PartGeometry | None = None) -> str:
+    """Draw the sheet into `path` (PNG); returns `path`."""
+    part = part or build_part(file.part)
+    validator = Validator(file.setup, part)
+    grasps = validator.grasps
+    rows = 1 + len(grasps)
+    fig = plt.figure(figsize=(8.0, 3.4 * rows))
+    visual = part.visual
+    # the part as drawn in its file, and its collision pieces
+    ax = fig.add_subplot(rows, 2, 1, projection='3d')
+    _draw(ax, visual, np.eye(3), '#999999', 0.6)
+    ax.scatter(*np.zeros(3), color='k', s=12)
+    if part.mass_frame is not None:
+        ax.scatter(*(part.mass_frame[0] * MM), color='r', s=18)
+    _frame(ax, visual.vertices * MM, 'as drawn in its file\n(black: origin, red: mass centre)')
+    ax = fig.add_subplot(rows, 2, 2, projection='3d')
+    for i, shape in enumerate(part_shapes(part)):
+        _draw(ax, _shape_mesh(shape, shape.rotation, shape.center), np.eye(3),
+              PIECE_COLOURS[i % len(PIECE_COLOURS)], 0.55)
+    _frame(ax, visual.vertices * MM, f'what the physics and the checks collide:\n'
+           f'{len(part.primitives)} convex piece(s)')
+    tilts = validator.tilts
+    shown = sorted({0, len(tilts) - 1, int(np.abs(tilts).argmin())})
+    for g, grasp in enumerate(grasps):
+        # pick: the part with the grasp's up axis up and its closing axis along x
+        pick = np.stack([grasp.closing, np.cross(grasp.up, grasp.closing), grasp.up])
+        ax = fig.add_subplot(rows, 2, 3 + 2 * g, projection='3d')
+        _draw(ax, visual.copy().apply_translation(-grasp.point), pick, '#999999', 0.7)
+        points = [pick @ (visual.vertices - grasp.point).T]
+        for shape in validator.gripper_shapes[g]:
+            mesh = _shape_mesh(shape, shape.rotation, shape.center)
+            _draw(ax, mesh, np.eye(3), '#4c72b0', 0.25)
+            points.append(mesh.vertices.T)
+        _frame(ax, np.hstack(points).T * MM, f'{grasp.name}: pick\njaws {grasp.jaw_opening * MM:g}'
+               f' mm, fingertips {validator.finger_depths[g] * MM:.1f} mm below the point')
+        # place: the part turned so that place.axis points down; gripper as it picked
+        ax = fig.add_subplot(rows, 2, 4 + 2 * g, projection='3d')
+        view = _turn(validator.place_axis, np.array([0.0, 0.0, -1.0]))
+        _draw(ax, visual, view, '#999999', 0.7)
+        points = [view @ visual.vertices.T]
+        words = []
+        for k in shown:
+            relative = pick.T @ trimesh.transformations.rotation_matrix(
+                tilts[k], [1, 0, 0])[:3, :3]
+            placed = [place(shape, relative[None], grasp.point[None])
+                      for shape in validator.gripper_shapes[g]]
+            # as the placeability check decides it: the gripper stays above the surface
+            clear = all(support(shape, rot, centre, validator.place_axis)[0]
+                        < validator.seat_offset for shape, (rot, centre) in
+                        zip(validator.gripper_shapes[g], placed, strict=True))
+            for shape, (rot, centre) in zip(validator.gripper_shapes[g], placed, strict=True):
+                mesh = _shape_mesh(shape, rot[0], centre[0])
+                _draw(ax, mesh, view, '#55a868' if clear else '#c44e52', 0.15)
+                points.append(view @ mesh.vertices.T)
+            words.append(f'{np.degrees(tilts[k]):+.0f} deg {"clear" if clear else "hits"}')
+        pts = np.hstack(points).T
+        seat = (view @ (validator.place_axis * validator.seat_offset))[2]
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        plane = np.array([[lo[0], lo[1], seat], [hi[0], lo[1], seat], [hi[0], hi[1], seat],
+                          [lo[0], hi[1], seat]]) * MM
+        ax.add_collection3d(Poly3DCollection([plane], facecolor='#e8c547', alpha=0.35))
+        _frame(ax, np.vstack([pts * MM, plane]), f'{grasp.name}: place (yellow: the surface)\n'
+               'tilt ' + ', '.join(words))
+    fig.tight_layout()
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path
+
+
+def write_account(file: ExperimentFile, run_dir: str) -> None:
+    """The part's account for a run's report: `part.json` (describe's lines) and `part.png`
+    (the sheet), in the run directory."""
+    part = build_part(file.part)
+    with open(os.path.join(run_dir, 'part.json'), 'w', encoding='utf-8') as f:
+        json.dump(describe(file, part), f, indent=1)
+    write(file, os.path.join(run_dir, 'part.png'), part)

@@ -1,0 +1,76 @@
+"""A part of the user's own, from a real CAD file (KiCad's TO-220 as STEP, in KiCad's frame):
+the worked example of docs/your-part.md reads, is described and drawn by `run --check`
+before any run, and runs end to end (on the cores, with small counts)."""
+
+import os
+
+from experiment_manager import experiment_file
+from experiment_manager.analysis import part_sheet, report
+from experiment_manager.analysis.results import ResultsWriter
+from experiment_manager.commands.run import main as run_main
+from experiment_manager.running.local_backend import LocalBackend
+from experiment_manager.running.scheduler import Runner
+import matplotlib.image
+import yaml
+
+EXAMPLE = os.path.join(os.path.dirname(__file__), '..', 'config', 'parts', 'to220_kicad.yaml')
+
+
+def test_the_example_is_described_as_the_run_will_see_it():
+    file = experiment_file.load(EXAMPLE)
+    lines = part_sheet.describe(file)
+    text = '\n'.join(lines)
+    assert 'TO-220-3_Vertical.step (stated by the file, read in m' in lines[0]
+    assert 'size 10.25 x 4.46 x 28.52 mm' in text
+    assert 'mass centre at (2.54, 1.11, 8.86) mm in its frame' in text   # not at pin 1
+    assert "grasp 'front_up': jaws open 16.00 mm" in text and 'closes on 10.25 mm of part' in text
+    assert "grasp 'edge_px'" in text and 'closes on 4.46 mm of part' in text
+
+
+def test_run_check_draws_the_sheet_without_a_graph(tmp_path, capsys):
+    assert run_main(['--check', EXAMPLE, '--output', str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    sheet = os.path.join(tmp_path, 'to220_kicad_part.png')
+    assert f'sheet: {sheet}' in out
+    picture = matplotlib.image.imread(sheet)
+    assert picture.shape[0] > 1000 and picture.shape[1] > 600        # 5 rows of 2 panels
+    assert (picture[..., :3].std(axis=(0, 1)) > 0.05).all()          # something is drawn
+
+
+def test_run_check_refuses_a_grasp_that_closes_on_nothing(tmp_path, capsys):
+    data = yaml.safe_load(open(EXAMPLE, encoding='utf-8'))
+    data['part']['mesh'] = os.path.abspath(os.path.join(os.path.dirname(EXAMPLE),
+                                                        data['part']['mesh']))
+    for grasp in data['part']['grasps']:        # the mistake: a point beside the body, the
+        grasp['grasp_point_mm'] = [7.5, -1.2, 16.0]     # tab's side of it, in front of the tab
+    path = tmp_path / 'wrong.yaml'
+    path.write_text(yaml.safe_dump(data))
+    assert run_main(['--check', str(path), '--output', str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert ("part.grasps[0].grasp_point_mm (grasp 'front_up'): [7.5, -1.2, 16.0] closes on "
+            'nothing') in err
+    assert not os.path.exists(tmp_path / 'to220_kicad_part.png')
+
+
+def test_the_example_runs_end_to_end(tmp_path):
+    data = yaml.safe_load(open(EXAMPLE, encoding='utf-8'))
+    data['experiments'] = [
+        {'id': 'sweep', 'type': 'table_sweep', 'iterations': 1,
+         'counts': {'first': 10, 'last': 30, 'step': 10}},
+        {'id': 'feeder', 'type': 'feeder_emptying', 'iterations': 1, 'parts': 30,
+         'optimal_range': [10, 20], 'max_vibrations': 60}]
+    file = experiment_file.parse(yaml.safe_dump(data), EXAMPLE)
+    with LocalBackend() as backend, ResultsWriter(str(tmp_path), file.text, False) as writer:
+        summary = Runner(file, [backend], writer).run()
+    sweep = summary['experiments']['sweep']
+    assert sweep['n_star'] is not None
+    feeder = summary['experiments']['feeder']
+    assert feeder['iterations'] == 1 and feeder['emptied'] in (0, 1)
+    # the report names the part file, its frame, its pieces and its grasps, with its sheet
+    part_sheet.write_account(file, str(tmp_path))
+    report.write(str(tmp_path))
+    text = open(tmp_path / 'report.md', encoding='utf-8').read()
+    assert '## The part' in text and 'TO-220-3_Vertical.step' in text
+    assert 'mass centre at (2.54, 1.11, 8.86) mm in its frame' in text
+    assert 'convex hulls of 26 vertices, 851.6 mm^3 together' in text
+    assert '](part.png)' in text and os.path.getsize(tmp_path / 'part.png') > 10_000
