@@ -35,11 +35,12 @@ def test_a_run_gets_its_report_files(run_dir):
     text = open(os.path.join(run_dir, 'report.md')).read()
     page = open(path).read()
     for heading in ('## Verdict', '## Static bins', '## Bin emptying', '## Vibrating table sweep',
-                    '## Feeder emptying', '## Gripper sweep', '## Physics health'):
+                    '## Feeder emptying', '## Gripper sweep', '## Physics health',
+                    '## Why parts were turned down'):
         assert heading in text
         assert f'<h2>{heading[3:]}' in page
     separators = [line for line in text.splitlines() if line.startswith('| --- |')]
-    assert page.count('<table>') == len(separators) == 6 and 'fig15_table.png' in page
+    assert page.count('<table>') == len(separators) == 7 and 'fig15_table.png' in page
     assert 'grippers.png' in page
     assert 'paper' not in text.split('## Verdict')[1]      # id `small`: no paper numbers
     assert 'No iteration was flagged' in text
@@ -303,3 +304,16 @@ def test_pictures_re_simulate_the_recorded_iteration(run_dir):
     report.write(run_dir)
     text = open(os.path.join(run_dir, 'report.md')).read()
     assert '## Pictures' in text and '![bin.png](bin.png)' in text
+
+
+def test_why_parts_were_turned_down_is_counted_per_stage():
+    from experiment_manager.analysis import stages
+    rows = [{'experiment': 'sweep', 'checked': 10, 'outside': 1, 'candidates': 8,
+             'placeable': 3, 'container_free': 3, 'valid': 2},
+            {'experiment': 'sweep', 'checked': 5, 'outside': 0, 'candidates': 5,
+             'placeable': 1, 'container_free': 0, 'valid': 0}]
+    stops = stages.turned_down(rows)
+    assert stops == {'sweep': {'in_container': 14, 'candidacy': 1, 'placeability': 9,
+                               'container collision': 1, 'neighbour collision': 1, 'valid': 2}}
+    text = '\n'.join(stages.lines(stops))
+    assert '`sweep`: placeability stops most, 64.3 % of the parts in the container' in text

@@ -74,3 +74,4 @@ def test_the_example_runs_end_to_end(tmp_path):
     assert 'mass centre at (2.54, 1.11, 8.86) mm in its frame' in text
     assert 'convex hulls of 26 vertices, 851.6 mm^3 together' in text
     assert '](part.png)' in text and os.path.getsize(tmp_path / 'part.png') > 10_000
+    assert '## Why parts were turned down' in text and 'stops most' in text

@@ -24,6 +24,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 import yaml
 
+from . import stages
+from .results import read_csv
 from .verdicts import (
     against_paper,
     FEASIBLE,
@@ -418,6 +420,9 @@ def write(run_dir: str) -> str:
         with open(os.path.join(run_dir, 'part.json'), encoding='utf-8') as f:
             account = json.load(f)
     text = markdown(summary, spec, figures, pictures, account)
+    checks = os.path.join(run_dir, 'checks.csv')
+    if os.path.exists(checks):
+        text += '\n'.join(stages.lines(stages.turned_down(read_csv(checks)))) + '\n'
     with open(os.path.join(run_dir, 'report.md'), 'w', encoding='utf-8') as f:
         f.write(text)
     path = os.path.join(run_dir, 'report.html')
