@@ -75,3 +75,38 @@ def test_the_example_runs_end_to_end(tmp_path):
     assert 'convex hulls of 26 vertices, 851.6 mm^3 together' in text
     assert '](part.png)' in text and os.path.getsize(tmp_path / 'part.png') > 10_000
     assert '## Why parts were turned down' in text and 'stops most' in text
+
+
+def test_an_open_mesh_export_in_mm_with_its_origin_away_is_checked_on_its_hull(tmp_path):
+    """A new user's export: the TO-220 in mm, its origin 47 mm from the part, a few triangles
+    missing. The grasp at the body's centre is accepted (its closing line crosses the hull on
+    both sides, where the open mesh has one side missing), one beside the part refused."""
+    import numpy as np
+    import trimesh
+    mesh = trimesh.load(os.path.join(os.path.dirname(EXAMPLE), 'TO-220-3_Vertical.step'),
+                        force='mesh')
+    mesh.apply_scale(1000.0)
+    mesh.apply_translation([40.0, -25.0, 3.0])
+    mesh.update_faces(np.arange(len(mesh.faces))[5:])
+    assert not mesh.is_watertight
+    mesh.export(tmp_path / 'to220.obj')
+    text = """id: newuser
+part:
+  model: mesh
+  mesh: to220.obj
+  units: mm
+  mass_g: 2
+  place: {axis: [0, 0, -1], seat_offset_mm: -3}
+  grasps:
+    - {name: across, up_axis: [0, -1, 0], closing_axis: [1, 0, 0], jaw_opening_mm: 16,
+       grasp_point_mm: POINT}
+experiments:
+  - {id: sweep, type: table_sweep, iterations: 1, counts: {first: 20, last: 40, step: 20}}
+"""
+    path = tmp_path / 'part.yaml'
+    path.write_text(text.replace('POINT', '[42.54, -24.06, 11.5]'))
+    lines = part_sheet.describe(experiment_file.load(str(path)))
+    assert any("grasp 'across'" in line and 'closes on 10.25 mm of part' in line
+               for line in lines), lines
+    path.write_text(text.replace('POINT', '[0, 0, 0]'))
+    assert run_main(['--check', str(path), '--output', str(tmp_path)]) == 2

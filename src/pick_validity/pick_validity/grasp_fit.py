@@ -73,12 +73,22 @@ def crossings(triangles: np.ndarray, origin: np.ndarray, direction: np.ndarray) 
     return t[hit]
 
 
+def _surface(part: PartGeometry) -> np.ndarray:
+    """The triangles (T, 3, 3) that bound the part's material: its own mesh when it is closed;
+    else its hulls (an open mesh's missing triangle would leave one side of a closing line
+    uncrossed, and a grasp through it refused), as the mass properties take them."""
+    if part.visual.is_watertight:
+        return np.asarray(part.visual.triangles)
+    hulls = [p.vertices[p.faces] for p in part.primitives if p.kind == 'hull']
+    return np.concatenate(hulls) if hulls else np.asarray(part.visual.triangles)
+
+
 def grasp_fit(part: PartGeometry, grasp: GraspPose) -> GraspFit:
-    """What the jaws of `grasp` close on, on the part's own surface (its visual mesh)."""
+    """What the jaws of `grasp` close on, on the surface that bounds the part's material."""
     closing = np.asarray(grasp.closing_axis, dtype=np.float64)
     closing = closing / np.linalg.norm(closing)
     point = np.asarray(grasp.grasp_point, dtype=np.float64)
-    t = crossings(np.asarray(part.visual.triangles), point, closing)
+    t = crossings(_surface(part), point, closing)
     span = (float(t.min()), float(t.max())) if len(t) else None
     return GraspFit(grasp.name, span, float(grasp.jaw_opening))
 
