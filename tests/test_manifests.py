@@ -14,7 +14,7 @@ import pytest
 SRC = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src')
 
 # What a top-level import needs, as a rosdep key or a ROS package name. None: no rosdep key
-# exists (mcap and mcap_ros2 are on PyPI only); requirements.txt installs them, and a
+# exists (mcap, mcap_ros2 and coacd are on PyPI only); requirements.txt installs them, and a
 # comment in the package.xml says so.
 IMPORT_KEYS = {
     'numpy': 'python3-numpy',
@@ -33,6 +33,7 @@ IMPORT_KEYS = {
     'pybullet': 'python3-pybullet-pip',
     'mcap': None,
     'mcap_ros2': None,
+    'coacd': None,
 }
 # ROS 2 Jazzy packages imported under their own names.
 ROS_PACKAGES = {

@@ -18,7 +18,7 @@ EXAMPLE = os.path.join(os.path.dirname(__file__), '..', 'config', 'parts', 'to22
 
 def test_the_example_is_described_as_the_run_will_see_it():
     file = experiment_file.load(EXAMPLE)
-    lines = part_sheet.describe(file)
+    lines = part_sheet.describe(file, part_sheet.validator(file))
     text = '\n'.join(lines)
     assert 'TO-220-3_Vertical.step (stated by the file, read in m' in lines[0]
     assert 'size 10.25 x 4.46 x 28.52 mm' in text
@@ -72,7 +72,8 @@ def test_the_example_runs_end_to_end(tmp_path):
     text = open(tmp_path / 'report.md', encoding='utf-8').read()
     assert '## The part' in text and 'TO-220-3_Vertical.step' in text
     assert 'mass centre at (2.54, 1.11, 8.86) mm in its frame' in text
-    assert 'convex hulls of 26 vertices, 851.6 mm^3 together' in text
+    assert ('9 convex piece(s) of 8, 14, 10, 10, 14, 22, 11, 14, 13 vertices, 496.6 mm^3 '
+            'together, +2.0 %') in text and 'cut into convex pieces by CoACD' in text
     assert '](part.png)' in text and os.path.getsize(tmp_path / 'part.png') > 10_000
     assert '## Why parts were turned down' in text and 'stops most' in text
 
@@ -105,7 +106,8 @@ experiments:
 """
     path = tmp_path / 'part.yaml'
     path.write_text(text.replace('POINT', '[42.54, -24.06, 11.5]'))
-    lines = part_sheet.describe(experiment_file.load(str(path)))
+    loaded = experiment_file.load(str(path))
+    lines = part_sheet.describe(loaded, part_sheet.validator(loaded))
     assert any("grasp 'across'" in line and 'closes on 10.25 mm of part' in line
                for line in lines), lines
     path.write_text(text.replace('POINT', '[0, 0, 0]'))

@@ -2,8 +2,8 @@
 
 A part model becomes a `PartGeometry`: a compound of collision primitives and convex hulls in the
 part frame (what the physics and the validity checks collide) plus a detailed visual mesh.
-Moving bodies never use a raw triangle mesh: a user mesh becomes the convex hulls of its
-connected components.
+Moving bodies never use a raw triangle mesh: a user mesh becomes convex pieces, a hull per
+convex or open body and CoACD's pieces of a concave closed one (`pieces`).
 
 Units: metres, kilograms. Quaternions are (x, y, z, w).
 """
@@ -15,6 +15,7 @@ import os
 import numpy as np
 import trimesh
 
+from . import pieces
 from .errors import check_int, check_number, InvalidArgument, Limit, MeshError, UnknownPart
 
 # Largest part accepted: a sanity limit well above small parts, in metres.
@@ -105,6 +106,8 @@ class PartGeometry:
     a thin part's true moments made the solver diverge (a 12 x 4 x 2 mm box at its solid
     moments, 8 times below Bullet's about its long axis, got NaN poses within 0.05 s at
     1/480 s; checked 2026-11-27).
+    collision_note: how a mesh part's pieces were made, in words (`_convex_cover`); empty for a
+    built-in model.
     """
 
     spec: PartSpec
@@ -116,6 +119,7 @@ class PartGeometry:
     radius: float
     volume: float
     mass_frame: tuple[np.ndarray, np.ndarray] | None = None
+    collision_note: str = ''
 
 
 # name -> (default dimensions in metres, default mass in kg, description)
@@ -266,7 +270,7 @@ def mass_properties(solids: list[trimesh.Trimesh], mass: float
 
 def _finish(spec: PartSpec, dims: Mapping[str, float], mass: float,
             collision: list[Primitive], visual: trimesh.Trimesh,
-            volume: float, mass_frame=None) -> PartGeometry:
+            volume: float, mass_frame=None, collision_note: str = '') -> PartGeometry:
     corners = np.vstack([_primitive_mesh(p).bounds for p in collision])
     low, high = corners.min(axis=0), corners.max(axis=0)
     center = (low + high) / 2
@@ -274,7 +278,8 @@ def _finish(spec: PartSpec, dims: Mapping[str, float], mass: float,
     radius = float(np.linalg.norm(points - center, axis=1).max())
     return PartGeometry(spec=spec, dimensions=dict(dims), mass=mass,
                         primitives=tuple(collision), visual=visual, center=center,
-                        radius=radius, volume=float(volume), mass_frame=mass_frame)
+                        radius=radius, volume=float(volume), mass_frame=mass_frame,
+                        collision_note=collision_note)
 
 
 def _builtin(spec: PartSpec) -> PartGeometry:
@@ -371,27 +376,67 @@ def _hull(points: np.ndarray) -> trimesh.Trimesh | None:
     return hull if hull.volume > 0 else None
 
 
+def _convex_cover(mesh: trimesh.Trimesh, path: str) -> tuple[list[trimesh.Trimesh], str]:
+    """The convex pieces a mesh collides as, and how they were made, in words.
+
+    Each connected body: closed and convex (`pieces.is_convex`), its hull; closed and concave,
+    CoACD's pieces (`pieces.convex_pieces`); open, its hull (an open body has no inside to cut,
+    so its concavities stay filled: said in the words). More than MAX_MESH_HULLS pieces in all,
+    or more than MAX_MESH_HULLS bodies: the hull of the whole mesh, said too.
+    """
+    bodies = mesh.split(only_watertight=False)
+    if len(bodies) > MAX_MESH_HULLS:
+        whole = _hull(mesh.vertices)
+        if whole is None:
+            raise MeshError('part.mesh_path', path, 'has zero volume (flat or a line)')
+        return [whole], (f'one convex hull of the whole mesh: it has {len(bodies)} separate '
+                         f'bodies, more than {MAX_MESH_HULLS}')
+    hulls, counts = [], {'convex': 0, 'concave': 0, 'open': 0}
+    for body in bodies:
+        closed = body.is_watertight and body.volume > 0
+        if closed and not pieces.is_convex(body):
+            cut = [h for h in (_hull(p) for p in pieces.convex_pieces(body)) if h is not None]
+            if cut:
+                hulls += cut
+                counts['concave'] += 1
+                continue
+        hull = _hull(body.vertices)
+        if hull is not None:
+            hulls.append(hull)
+            counts['convex' if closed else 'open'] += 1
+    if not hulls:
+        hull = _hull(mesh.vertices)
+        if hull is None:
+            raise MeshError('part.mesh_path', path, 'has zero volume (flat or a line)')
+        return [hull], 'one convex hull of the whole mesh: no body of it has volume'
+    if len(hulls) > MAX_MESH_HULLS:
+        return [_hull(mesh.vertices)], (f'one convex hull of the whole mesh: its pieces number '
+                                        f'{len(hulls)}, more than {MAX_MESH_HULLS}')
+    words = []
+    if counts['concave']:
+        words.append(f'{counts["concave"]} concave closed body(ies) cut into convex pieces by '
+                     f'CoACD (concavity threshold {pieces.THRESHOLD:g})')
+    if counts['convex']:
+        words.append(f'{counts["convex"]} convex closed body(ies) as its hull')
+    if counts['open']:
+        words.append(f'{counts["open"]} open body(ies) as its hull (not closed, so not cut: '
+                     'its hollows and gaps collide as filled; close the mesh to have it cut)')
+    return hulls, '; '.join(words)
+
+
 def _mesh_part(spec: PartSpec) -> PartGeometry:
     mesh = load_mesh(spec.mesh_path, spec.scale)
     if spec.mass is None:
         raise InvalidArgument('part.mass', None, 'is required for a mesh part, kg')
     mass = _check_material(spec, 0.0)
-    components = mesh.split(only_watertight=False)
-    if len(components) > MAX_MESH_HULLS:
-        components = [mesh]
-    hulls = [h for h in (_hull(c.vertices) for c in components) if h is not None]
-    if not hulls:
-        hull = _hull(mesh.vertices)
-        if hull is None:
-            raise MeshError('part.mesh_path', spec.mesh_path, 'has zero volume (flat or a line)')
-        hulls = [hull]
+    hulls, note = _convex_cover(mesh, spec.mesh_path)
     collision = [Primitive('hull', (), vertices=np.asarray(h.vertices, dtype=np.float64),
                            faces=np.asarray(h.faces, dtype=np.int64)) for h in hulls]
     volume = mesh.volume if mesh.is_watertight else sum(h.volume for h in hulls)
     # The mass where the material is: the solid itself when it is closed, else its hulls.
     solids = [mesh] if mesh.is_watertight and mesh.volume > 0 else hulls
     centre, axes, _ = mass_properties(solids, mass)
-    return _finish(spec, {}, mass, collision, mesh, volume, (centre, axes))
+    return _finish(spec, {}, mass, collision, mesh, volume, (centre, axes), note)
 
 
 def build_part(spec: PartSpec) -> PartGeometry:

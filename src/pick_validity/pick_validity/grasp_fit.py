@@ -93,6 +93,39 @@ def grasp_fit(part: PartGeometry, grasp: GraspPose) -> GraspFit:
     return GraspFit(grasp.name, span, float(grasp.jaw_opening))
 
 
+# A round body's cross-section: ROUND_DIRECTIONS lines through the grasp point, each meeting
+# the surface within ROUND_TOLERANCE (a fraction of the radius) of one radius on both sides. A
+# cylinder tessellated with 16 facets is round within 2 % (cos(pi/16) = 0.981); a square
+# section is not (its corners are 41 % further out than its sides).
+ROUND_DIRECTIONS = 24
+ROUND_TOLERANCE = 0.03
+
+
+def round_axis(part: PartGeometry, point: np.ndarray, closing: np.ndarray,
+               up: np.ndarray) -> np.ndarray:
+    """For a mesh part: the axis (unit, part frame) about which the part is round where the
+    jaws close on it, or zeros. The axis runs through the grasp point at right angles to the
+    closing axis, across the up axis or along it; the part is round about it when every line
+    through the point at right angles to it meets the part's surface at one radius on both
+    sides. Jaws closing across such a body grip it at any roll about the axis, as those of a
+    built-in capacitor do (`Validator.free_axes`)."""
+    surface = _surface(part)
+    for axis in (np.cross(closing, up), up):
+        axis = axis / np.linalg.norm(axis)
+        side = np.cross(axis, closing)
+        radii = []
+        for angle in np.linspace(0.0, np.pi, ROUND_DIRECTIONS, endpoint=False):
+            t = crossings(surface, point, np.cos(angle) * closing + np.sin(angle) * side)
+            if len(t) == 0 or t.min() > TOLERANCE or t.max() < -TOLERANCE:
+                break
+            radii += [-float(t.min()), float(t.max())]
+        else:
+            radius = float(np.median(radii))
+            if radius > 0 and max(abs(r - radius) for r in radii) <= ROUND_TOLERANCE * radius:
+                return axis
+    return np.zeros(3)
+
+
 def check_grasps_fit(part: PartGeometry, grasps: Sequence[GraspPose]) -> tuple[GraspFit, ...]:
     """Each grasp's fit; raises InvalidArgument for the first whose jaws cannot hold the part,
     naming the grasp, what it closes on and the width measured."""

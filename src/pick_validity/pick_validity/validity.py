@@ -51,7 +51,7 @@ from .geometry import (
     rotations_about_x,
     support,
 )
-from .grasp_fit import check_grasps_fit
+from .grasp_fit import check_grasps_fit, round_axis
 from .pairs import Pairs
 from .results import (
     CENTRE_TOLERANCE,
@@ -103,7 +103,10 @@ class Validator:
 
     def _free_axis(self, grasp: Grasp) -> np.ndarray:
         """The axis of a cylinder of the part that holds the grasp point on its axis and that
-        the closing axis crosses at a right angle, or zeros."""
+        the closing axis crosses at a right angle, or zeros. A built-in model's cylinders are
+        its primitives; a mesh's are found from its surface (`grasp_fit.round_axis`)."""
+        if self.part.spec.model == 'mesh':
+            return round_axis(self.part, grasp.point, grasp.closing, grasp.up)
         for shape in self.part_shapes:
             axis = shape.rotation[:, 2]
             off = grasp.point - shape.center

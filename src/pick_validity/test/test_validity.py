@@ -22,6 +22,7 @@ from pick_validity.results import (
 from pick_validity.validity import Validator
 import pytest
 from scipy.spatial.transform import Rotation
+import trimesh
 
 BIN = ContainerSpec(inner_size=(0.2, 0.2, 0.03))
 CAPACITOR = build_part(PartSpec())
@@ -149,6 +150,30 @@ def test_jaws_across_a_round_body_grip_it_at_any_roll(roll):
     assert abs(closing[2]) < 1e-9 and axis[2] > math.cos(math.radians(45))
     # the body stays where it lies: the jaws close on its axis, 2.5 mm above the floor
     assert np.allclose(result.gripper_pose[:3], [0, 0, RADIUS])
+
+
+@pytest.mark.parametrize('roll', [0.0, 30.0, -44.0, 130.0])
+def test_a_round_body_is_found_in_a_mesh(tmp_path, roll):
+    # The built-in capacitor written out as an STL in mm, as a CAD tool would: its body is
+    # found round from the surface, and its side grasps turn with its roll as the built-in's.
+    mesh = CAPACITOR.visual.copy()
+    mesh.apply_scale(1000.0)
+    mesh.export(tmp_path / 'capacitor.stl')
+    part = PartSpec(model='mesh', mesh_path=str(tmp_path / 'capacitor.stl'), scale=0.001,
+                    mass=0.0004)
+    sides = [GraspPose(f'side{k}', (math.cos(k * math.pi / 2), math.sin(k * math.pi / 2), 0.0),
+                       (-math.sin(k * math.pi / 2), math.cos(k * math.pi / 2), 0.0), 0.011)
+             for k in range(4)]
+    v = Validator(Setup(part=part, grasps=tuple(sides)))
+    assert np.allclose(np.abs(v.free_axes), [[0, 0, 1.0]] * 4)
+    result = v.check(BIN, [1], [_lying(0, 0, roll)]).results[0]
+    assert result.stage == STAGE_VALID and result.candidacy_angle < 1e-6, result.reason
+    # off the axis, or across a square section: fixed to the part
+    assert not Validator(Setup(part=part, grasps=(OFF_AXIS,))).free_axes.any()
+    trimesh.creation.box((5.0, 5.0, 11.0)).export(tmp_path / 'square.stl')
+    square = PartSpec(model='mesh', mesh_path=str(tmp_path / 'square.stl'), scale=0.001,
+                      mass=0.0004)
+    assert not Validator(Setup(part=square, grasps=(SIDE,))).free_axes.any()
 
 
 def test_the_fingertips_reach_down_the_grasped_part():

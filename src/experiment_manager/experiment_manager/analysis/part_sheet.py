@@ -18,9 +18,8 @@ matplotlib.use('Agg')
 import matplotlib.pyplot as plt
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 import numpy as np
-from pick_common.parts import build_part, PartGeometry, states_units
+from pick_common.parts import build_part, states_units
 from pick_validity.geometry import part_shapes, place, Shape, support
-from pick_validity.grasp_fit import grasp_fit
 from pick_validity.validity import Validator
 import trimesh
 
@@ -30,9 +29,15 @@ MM = 1000.0
 PIECE_COLOURS = ('#4c72b0', '#dd8452', '#55a868', '#c44e52', '#8172b3', '#937860')
 
 
-def describe(file: ExperimentFile, part: PartGeometry | None = None) -> list[str]:
-    """What the run will use of the file's part and grasps, one fact a line."""
-    part = part or build_part(file.part)
+def validator(file: ExperimentFile) -> Validator:
+    """The file's checks as a run builds them: its part's geometry, grasps and gripper."""
+    return Validator(file.setup, build_part(file.part))
+
+
+def describe(file: ExperimentFile, checks: Validator) -> list[str]:
+    """What the run will use of the file's part and grasps (as `checks`, the file's
+    `validator`, holds them), one fact a line."""
+    part = checks.part
     spec = file.part
     lo, hi = part.visual.bounds * MM
     lines = []
@@ -51,20 +56,27 @@ def describe(file: ExperimentFile, part: PartGeometry | None = None) -> list[str
                  f'centre at ({", ".join(f"{v:.2f}" for v in centre * MM)}) mm in its frame'
                  + ('' if part.mass_frame is not None else ' (the frame origin: a built-in)'))
     hulls = [p for p in part.primitives if p.kind == 'hull']
-    lines.append(f'  collision: {len(part.primitives)} piece(s)' + (
-        f', convex hulls of {", ".join(str(len(h.vertices)) for h in hulls)} vertices, '
-        f'{sum(_hull_volume(h) for h in hulls) * 1e9:.1f} mm^3 together'
-        if hulls else ' (boxes and cylinders)'))
-    for g in file.grasps:
-        fit = grasp_fit(part, g)
+    if hulls:
+        together = sum(_hull_volume(h) for h in hulls)
+        over = 100 * (together / part.volume - 1)
+        lines.append(f'  collision: {len(hulls)} convex piece(s) of '
+                     f'{", ".join(str(len(h.vertices)) for h in hulls)} vertices, '
+                     f'{together * 1e9:.1f} mm^3 together, {over:+.1f} '
+                     f"% on the part's volume (pieces that overlap count twice)")
+        lines.append(f'    made as: {part.collision_note}')
+    else:
+        lines.append(f'  collision: {len(part.primitives)} piece(s) (boxes and cylinders)')
+    for g, fit, axis in zip(file.grasps, checks.grasp_fits, checks.free_axes, strict=True):
         what = fit.problem() or (f'closes on {fit.width * MM:.2f} mm of part '
                                  f'({-fit.span[0] * MM:.2f} and {fit.span[1] * MM:.2f} mm '
                                  f'either side of the grasp point)')
         away = np.linalg.norm(np.asarray(g.grasp_point) - centre) * MM
+        roll = (f'; round there, so it grips at any roll about {np.round(axis, 3).tolist()}'
+                if axis.any() else '; fixed to the part (not across a round body)')
         lines.append(f'  grasp {g.name!r}: jaws open {g.jaw_opening * MM:.2f} mm at '
                      f'({", ".join(f"{v * MM:.2f}" for v in g.grasp_point)}) mm, '
                      f'{away:.2f} mm from the mass centre, up {list(g.up_axis)}, closing '
-                     f'{list(g.closing_axis)}: {what}')
+                     f'{list(g.closing_axis)}: {what}{roll}')
     return lines
 
 
@@ -117,10 +129,9 @@ def _turn(vector: np.ndarray, target: np.ndarray) -> np.ndarray:
     return trimesh.transformations.rotation_matrix(angle, axis)[:3, :3]
 
 
-def write(file: ExperimentFile, path: str, part: PartGeometry | None = None) -> str:
-    """Draw the sheet into `path` (PNG); returns `path`."""
-    part = part or build_part(file.part)
-    validator = Validator(file.setup, part)
+def write(checks: Validator, path: str) -> str:
+    """Draw the sheet of the file's `validator` into `path` (PNG); returns `path`."""
+    validator, part = checks, checks.part
     grasps = validator.grasps
     rows = 1 + len(grasps)
     fig = plt.figure(figsize=(8.0, 3.4 * rows))
@@ -190,7 +201,7 @@ def write(file: ExperimentFile, path: str, part: PartGeometry | None = None) -> 
 def write_account(file: ExperimentFile, run_dir: str) -> None:
     """The part's account for a run's report: `part.json` (describe's lines) and `part.png`
     (the sheet), in the run directory."""
-    part = build_part(file.part)
+    checks = validator(file)
     with open(os.path.join(run_dir, 'part.json'), 'w', encoding='utf-8') as f:
-        json.dump(describe(file, part), f, indent=1)
-    write(file, os.path.join(run_dir, 'part.png'), part)
+        json.dump(describe(file, checks), f, indent=1)
+    write(checks, os.path.join(run_dir, 'part.png'))

@@ -6,7 +6,6 @@ import os
 import sys
 
 from pick_common.errors import InvalidArgument
-from pick_common.parts import build_part
 
 from .. import experiment_file
 from ..analysis import part_sheet
@@ -24,10 +23,10 @@ def check(paths: list[str], output: str | None) -> int:
             for e in errors:
                 print(f'run --check: {path}: {e}', file=sys.stderr)
             return 2
-        part = build_part(file.part)
+        checks = part_sheet.validator(file)
         print(f'{path}: reads as a run would')
-        print('\n'.join(part_sheet.describe(file, part)))
+        print('\n'.join(part_sheet.describe(file, checks)))
         directory = os.path.abspath(os.path.expanduser(output or file.output_dir))
-        sheet = part_sheet.write(file, os.path.join(directory, f'{file.id}_part.png'), part)
+        sheet = part_sheet.write(checks, os.path.join(directory, f'{file.id}_part.png'))
         print(f'sheet: {sheet}')
     return 0
