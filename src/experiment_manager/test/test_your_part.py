@@ -112,3 +112,32 @@ experiments:
                for line in lines), lines
     path.write_text(text.replace('POINT', '[0, 0, 0]'))
     assert run_main(['--check', str(path), '--output', str(tmp_path)]) == 2
+
+
+def test_grasps_auto_takes_the_proposals_and_check_prints_them_to_paste(tmp_path, capsys):
+    with open(EXAMPLE, encoding='utf-8') as f:
+        data = yaml.safe_load(f)
+    data['part']['mesh'] = os.path.join(os.path.dirname(os.path.abspath(EXAMPLE)),
+                                        data['part']['mesh'])
+    data['part']['grasps'] = 'auto'
+    path = tmp_path / 'auto.yaml'
+    path.write_text(yaml.safe_dump(data))
+    file = experiment_file.load(str(path))
+    assert file.auto_grasps and 'up+y_close+x' in [g.name for g in file.grasps]
+    assert run_main(['--check', str(path), '--output', str(tmp_path)]) == 0
+    printed = capsys.readouterr().out
+    pasted = printed[printed.index('    grasps:\n'):printed.index('sheet:')]
+    # what it prints, pasted in place of `auto`, reads back as the same grasps
+    data['part']['grasps'] = yaml.safe_load(pasted)['grasps']
+    path.write_text(yaml.safe_dump(data))
+    again = experiment_file.load(str(path))
+    assert not again.auto_grasps
+    assert [g.name for g in again.grasps] == [g.name for g in file.grasps]
+    for a, b in zip(again.grasps, file.grasps, strict=True):
+        assert abs(a.jaw_opening - b.jaw_opening) < 1e-5
+        assert max(abs(x - y) for x, y in zip(a.grasp_point, b.grasp_point, strict=True)) < 1e-5
+    # a mesh part with no grasps is told of auto
+    del data['part']['grasps']
+    path.write_text(yaml.safe_dump(data))
+    assert run_main(['--check', str(path), '--output', str(tmp_path)]) == 2
+    assert "or 'auto' for those proposed from its geometry" in capsys.readouterr().err

@@ -73,7 +73,7 @@ def crossings(triangles: np.ndarray, origin: np.ndarray, direction: np.ndarray) 
     return t[hit]
 
 
-def _surface(part: PartGeometry) -> np.ndarray:
+def surface(part: PartGeometry) -> np.ndarray:
     """The triangles (T, 3, 3) that bound the part's material: its own mesh when it is closed;
     else its hulls (an open mesh's missing triangle would leave one side of a closing line
     uncrossed, and a grasp through it refused), as the mass properties take them."""
@@ -88,7 +88,7 @@ def grasp_fit(part: PartGeometry, grasp: GraspPose) -> GraspFit:
     closing = np.asarray(grasp.closing_axis, dtype=np.float64)
     closing = closing / np.linalg.norm(closing)
     point = np.asarray(grasp.grasp_point, dtype=np.float64)
-    t = crossings(_surface(part), point, closing)
+    t = crossings(surface(part), point, closing)
     span = (float(t.min()), float(t.max())) if len(t) else None
     return GraspFit(grasp.name, span, float(grasp.jaw_opening))
 
@@ -109,13 +109,13 @@ def round_axis(part: PartGeometry, point: np.ndarray, closing: np.ndarray,
     through the point at right angles to it meets the part's surface at one radius on both
     sides. Jaws closing across such a body grip it at any roll about the axis, as those of a
     built-in capacitor do (`Validator.free_axes`)."""
-    surface = _surface(part)
+    triangles = surface(part)
     for axis in (np.cross(closing, up), up):
         axis = axis / np.linalg.norm(axis)
         side = np.cross(axis, closing)
         radii = []
         for angle in np.linspace(0.0, np.pi, ROUND_DIRECTIONS, endpoint=False):
-            t = crossings(surface, point, np.cos(angle) * closing + np.sin(angle) * side)
+            t = crossings(triangles, point, np.cos(angle) * closing + np.sin(angle) * side)
             if len(t) == 0 or t.min() > TOLERANCE or t.max() < -TOLERANCE:
                 break
             radii += [-float(t.min()), float(t.max())]

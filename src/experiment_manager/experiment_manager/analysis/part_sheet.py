@@ -20,6 +20,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 import numpy as np
 from pick_common.parts import build_part, states_units
 from pick_validity.geometry import part_shapes, place, Shape, support
+from pick_validity.grasp_proposals import as_yaml, JAW_MARGIN, propose
 from pick_validity.validity import Validator
 import trimesh
 
@@ -77,6 +78,12 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
                      f'({", ".join(f"{v * MM:.2f}" for v in g.grasp_point)}) mm, '
                      f'{away:.2f} mm from the mass centre, up {list(g.up_axis)}, closing '
                      f'{list(g.closing_axis)}: {what}{roll}')
+    if file.auto_grasps:
+        lines.append('  the grasps are part.grasps: auto, proposed from the geometry (across '
+                     'opposed faces and round bodies at the mass centre, jaws '
+                     f'{JAW_MARGIN * MM:g} mm wider than the part each side); to edit them, '
+                     'paste these under part: in place of grasps: auto')
+        lines += ['  ' + line for line in as_yaml(propose(part))]
     return lines
 
 

@@ -289,13 +289,18 @@ def parse(text: str, path: str = '') -> ExperimentFile:
     # The cores' own checks, under the file's names.
     if gripper is not None:
         checked(lambda: _checked(check_gripper, gripper, 'gripper'))
+    auto_grasps = grasps == part_section.AUTO
     if part is not None:
-        checked(lambda: _checked(check_grasps, list(grasps), 'part.grasps'))
         checked(lambda: _checked(check_place, place, 'part.place'))
     if check is not None:
         checked(lambda: _checked(tilts, check, 'check'))
     geometry = checked(lambda: part_section.geometry(part)) if part is not None else None
-    if geometry is not None:
+    if auto_grasps:
+        grasps = checked(lambda: part_section.proposed(geometry)) if geometry is not None \
+            else None
+    if grasps is not None:
+        checked(lambda: _checked(check_grasps, list(grasps), 'part.grasps'))
+    if geometry is not None and grasps is not None:
         checked(lambda: part_section.check_fits(geometry, grasps))
     context = None
     if None not in (top, geometry, tray, requirements, gripper, grasps):
@@ -322,7 +327,7 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         experiments=tuple(context.earlier.values()),
         sampling=Sampling(mode=s['sampling'].mode, batch=s['sampling'].batch),
         cell=Cell(pick_time=s['cell'].pick_s, image_time=s['cell'].image_s),
-        path=os.path.abspath(path) if path else '', text=text)
+        path=os.path.abspath(path) if path else '', text=text, auto_grasps=auto_grasps)
 
 
 def load(path: str) -> ExperimentFile:

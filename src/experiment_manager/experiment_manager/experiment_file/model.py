@@ -137,6 +137,7 @@ class ExperimentFile:
     cell: Cell = Cell()
     path: str = ''
     text: str = field(default='', repr=False)
+    auto_grasps: bool = False   # the grasps were proposed from the geometry (part.grasps: auto)
 
     def experiment(self, experiment_id: str) -> Experiment:
         return next(e for e in self.experiments if e.id == experiment_id)

@@ -8,9 +8,12 @@ from pick_common.errors import InvalidArgument
 from pick_common.parts import build_part, PartGeometry, PartSpec, states_units, UNITS
 from pick_validity.config import CAPACITOR_GRASPS, GraspPose, PlaceSpec
 from pick_validity.grasp_fit import check_grasps_fit
+from pick_validity.grasp_proposals import propose
 
 from . import schema
 from .model import G, MM
+
+AUTO = 'auto'       # part.grasps: proposed from the geometry
 
 
 def mesh_file(p: schema.Part, base_dir: str) -> tuple[str, float]:
@@ -38,7 +41,10 @@ def mesh_file(p: schema.Part, base_dir: str) -> tuple[str, float]:
     return mesh, UNITS[p.units] if p.units is not None else p.mesh_scale
 
 
-def read_part(p: schema.Part, base_dir: str) -> tuple[PartSpec, tuple[GraspPose, ...], PlaceSpec]:
+def read_part(p: schema.Part, base_dir: str
+              ) -> tuple[PartSpec, tuple[GraspPose, ...] | str, PlaceSpec]:
+    """The part's spec, its grasps (AUTO when the file leaves them to `proposed`) and its
+    placing, in SI units."""
     mesh, scale, mass = '', 1.0, G * p.mass_g
     if p.model == 'mesh':
         if mass == 0.0:
@@ -48,7 +54,8 @@ def read_part(p: schema.Part, base_dir: str) -> tuple[PartSpec, tuple[GraspPose,
         if p.grasps is None:
             raise InvalidArgument('part.grasps', None, 'are required for a mesh part: the '
                                   "grasp poses, each with its grasp_point_mm in the file's "
-                                  'frame')
+                                  "frame, or 'auto' for those proposed from its geometry "
+                                  '(run --check prints them, to paste and edit)')
         if 'seat_offset_mm' not in p.place.model_fields_set:
             raise InvalidArgument('part.place.seat_offset_mm', None, 'is required for a mesh '
                                   "part: how far its seating plane lies from the file's "
@@ -73,6 +80,8 @@ def read_part(p: schema.Part, base_dir: str) -> tuple[PartSpec, tuple[GraspPose,
     place = PlaceSpec(place_axis=p.place.axis, seat_offset=MM * p.place.seat_offset_mm)
     if p.grasps is None:
         return spec, CAPACITOR_GRASPS, place
+    if p.grasps == AUTO:
+        return spec, AUTO, place
     grasps = tuple(GraspPose(
         name=g.name if g.name is not None else f'grasp_{i}', up_axis=g.up_axis,
         closing_axis=g.closing_axis, jaw_opening=MM * g.jaw_opening_mm,
@@ -81,6 +90,16 @@ def read_part(p: schema.Part, base_dir: str) -> tuple[PartSpec, tuple[GraspPose,
     if len(set(names)) != len(names):
         raise InvalidArgument('part.grasps', names, 'has a grasp name twice')
     return spec, grasps, place
+
+
+def proposed(geometry: PartGeometry) -> tuple[GraspPose, ...]:
+    """`part.grasps: auto`: the grasps proposed from the part's geometry."""
+    grasps = tuple(p.grasp for p in propose(geometry))
+    if not grasps:
+        raise InvalidArgument('part.grasps', AUTO, 'found no grasp: the part has no opposed '
+                              'faces and no round body across its mass centre; write its '
+                              'grasps')
+    return grasps
 
 
 # The core's names of a mesh part's fields, and the file's keys for them; the core's other

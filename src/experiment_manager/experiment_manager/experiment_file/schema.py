@@ -15,7 +15,7 @@ from pick_common.containers import TRAY_DEFAULT_SIZE
 from pick_common.parts import BUILTIN_MODELS, PartSpec, UNITS
 from pick_common.specs import DIRECTIONS, MAX_MOVES, MAX_PARTS_PER_INSTANCE, MAX_SEED, MOVES
 from pick_validity.config import CheckConfig, Gripper
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator, WrapValidator
 
 from .model import (
     ADAPTIVE,
@@ -38,12 +38,12 @@ from .model import (
 )
 from .values import (
     fail,
+    grasp_list,
     Identifier,
     Int,
     integer,
     list_of,
     mapping,
-    non_empty_list,
     Number,
     number,
     PositiveSize,
@@ -88,7 +88,9 @@ class Part(Section):
     units: Text(*UNITS) | None = None                 # a mesh file's length unit
     mesh_scale: Number(0.0, 1000.0, low_open=True) | None = None   # or its scale to metres
     place: Place = Place()
-    grasps: Annotated[list[GraspEntry] | None, BeforeValidator(non_empty_list)] = \
+    # the grasp poses, or 'auto': those proposed from the part's geometry (grasp_proposals)
+    # (a WrapValidator, so that a list's errors are not joined by 'auto' as a union's are)
+    grasps: Annotated[list[GraspEntry] | None, WrapValidator(grasp_list)] = \
         Field(default=None, validate_default=False)
 
 

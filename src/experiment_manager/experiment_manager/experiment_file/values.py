@@ -6,7 +6,7 @@ whose context holds the rule, the value as the message shows it and what follows
 path (`[2]`): `errors.errors_of` names the key.
 """
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from functools import partial
 from typing import Annotated, Any
 
@@ -111,6 +111,16 @@ def non_empty_list(value: Any) -> list | None:
     if value is not None and (not isinstance(value, list) or not value):
         fail('must be a non-empty list', short(value))
     return value
+
+
+def grasp_list(value: Any, handler: Callable[[Any], Any]) -> list | str | None:
+    """part.grasps: 'auto' as it is, else a non-empty list read by `handler`."""
+    if value == 'auto':
+        return value
+    if value is not None and (not isinstance(value, list) or not value):
+        fail("must be a non-empty list of grasps, or 'auto' (proposed from the part's "
+             'geometry)', short(value))
+    return handler(value)
 
 
 def mapping(value: Any) -> Any:

@@ -1,0 +1,141 @@
+"""Parallel-jaw grasps proposed from a part's geometry, for a user to start from.
+
+The jaws close across the part at its mass centre, along a direction in which the part has
+two opposed parallel faces (each direction at least FACE_SHARE of the surface), or across a
+round body (a principal axis at right angles to one the part is round about at its mass
+centre, `grasp_fit.round_axis`: a cylinder has no flat faces to close on). Each closing
+direction gets one grasp per way the part can lie with it horizontal: on a face of at least
+FACE_SHARE (the up axis that face's opposite), or on a round body's side. The jaws open to the
+width measured across the mass centre plus JAW_MARGIN on each side.
+
+A proposal is a start, not a gripper design: `run --check` prints them as YAML to paste under
+`part.grasps` and edit, and `part.grasps: auto` takes them as they are.
+
+Units: metres; the part frame.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from pick_common.parts import PartGeometry
+import trimesh
+
+from .config import GraspPose
+from .grasp_fit import crossings, round_axis, surface
+
+# 3 mm on each side of the part: the margin of every grasp of the project's test case
+# (config/test_case/grippers_pth*.yaml: 11 mm over the capacitor's 5 mm body, 16 and 10.5 mm
+# over the TO-220's 10 and 4.5 mm). A chosen margin, not a datasheet's: set jaw_opening_mm to
+# what your gripper's stroke and the parts' spacing allow.
+JAW_MARGIN = 0.003
+# A face a part can lie on or be closed across: at least this share of its surface area.
+FACE_SHARE = 0.05
+AXIS_NAMES = ('x', 'y', 'z')
+
+
+@dataclass(frozen=True)
+class Proposal:
+    """A proposed grasp and the width it closes on, m."""
+
+    grasp: GraspPose
+    width: float
+
+
+def _directions(part: PartGeometry) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """(face directions: outward normals of faces of at least FACE_SHARE of the surface,
+    principal axes: both signs of the part's three), unit vectors in the part frame."""
+    mesh = trimesh.Trimesh(*_faces(part), process=True)
+    normals, areas = mesh.face_normals, mesh.area_faces
+    keys = np.round(normals, 3)
+    faces = []
+    for key in np.unique(keys, axis=0):
+        same = (keys == key).all(axis=1)
+        if areas[same].sum() >= FACE_SHARE * areas.sum():
+            n = (normals[same] * areas[same, None]).sum(axis=0)
+            faces.append(n / np.linalg.norm(n))
+    if part.mass_frame is not None:
+        x, y, z, w = part.mass_frame[1]
+        axes = trimesh.transformations.quaternion_matrix([w, x, y, z])[:3, :3].T
+    else:
+        axes = np.eye(3)
+    principal = [s * a for a in axes for s in (1.0, -1.0)]
+    return faces, principal
+
+
+def _faces(part: PartGeometry) -> tuple[np.ndarray, np.ndarray]:
+    triangles = surface(part)
+    return triangles.reshape(-1, 3), np.arange(len(triangles) * 3).reshape(-1, 3)
+
+
+def _snap(v: np.ndarray) -> np.ndarray:
+    """A direction within 1e-6 of a frame axis becomes that axis (for names and the YAML)."""
+    v = np.where(np.abs(v) < 1e-6, 0.0, v)
+    return v / np.linalg.norm(v) + 0.0        # + 0.0: no -0 in the YAML
+
+
+def _name(v: np.ndarray) -> str:
+    """+x, -z, ... for a frame axis; else the nearest axis and the angle from it, '+z9deg'."""
+    k = int(np.argmax(np.abs(v)))
+    axis = ('+' if v[k] > 0 else '-') + AXIS_NAMES[k]
+    angle = np.degrees(np.arccos(min(1.0, abs(float(v[k])))))
+    return axis if angle < 1e-6 else f'{axis}{angle:.0f}deg'
+
+
+def propose(part: PartGeometry, margin: float = JAW_MARGIN) -> tuple[Proposal, ...]:
+    """Grasps at the mass centre across opposed faces, and across a round body's axis, one per
+    way the part can lie with the closing direction horizontal."""
+    centre = part.mass_frame[0] if part.mass_frame is not None else np.zeros(3)
+    faces, principal = _directions(part)
+    # across a round body: directions at right angles to an axis it is round about (the
+    # frame's axes where they are, else the principal axes: a round body's two equal moments
+    # leave its principal axes across it at any angle)
+    across = []
+    for a in principal[::2]:
+        square = [s * e for e in np.eye(3) for s in (1.0, -1.0) if abs(e @ a) < 1e-6]
+        sides = square or [p for p in principal if abs(p @ a) < 1e-6]
+        if sides and round_axis(part, centre, sides[0], a).any():
+            across += sides
+    closings = _distinct([f for f in faces if any(f @ g < -0.999 for g in faces)] + across,
+                         signed=False)
+    triangles = surface(part)
+    found: list[Proposal] = []
+    for c in closings:
+        t = crossings(triangles, centre, c)
+        if len(t) == 0 or t.min() > 0 or t.max() < 0:
+            continue                # the mass centre lies in a hollow along this direction
+        width = float(t.max() - t.min())
+        for u in _distinct([-f for f in faces] + across, signed=True):
+            if abs(u @ c) > 1e-3:
+                continue
+            grasp = GraspPose(f'up{_name(u)}_close{_name(c)}', tuple(float(v) for v in u),
+                              tuple(float(v) for v in c), width + 2 * margin,
+                              tuple(float(v) for v in centre))
+            found.append(Proposal(grasp, width))
+    return tuple(found)
+
+
+def _distinct(directions: list[np.ndarray], signed: bool) -> list[np.ndarray]:
+    """Directions snapped to the frame's axes, each once (and, unsigned, once with its
+    opposite, pointing along its largest positive component)."""
+    kept: list[np.ndarray] = []
+    for d in directions:
+        d = _snap(d)
+        if not signed and d[np.argmax(np.abs(d))] < 0:
+            d = -d + 0.0
+        if not any((d @ k if signed else abs(d @ k)) > 0.999 for k in kept):
+            kept.append(d)
+    return kept
+
+
+def as_yaml(proposals: tuple[Proposal, ...]) -> list[str]:
+    """The proposals as the lines of `part.grasps` in an experiment file (mm)."""
+    def vector(v, digits):
+        return '[' + ', '.join(f'{x:.{digits}g}' if digits else f'{x:g}' for x in v) + ']'
+    lines = ['  grasps:']
+    for p in proposals:
+        g = p.grasp
+        lines.append(f'    - {{name: {g.name}, up_axis: {vector(g.up_axis, 4)}, closing_axis: '
+                     f'{vector(g.closing_axis, 4)}, jaw_opening_mm: {g.jaw_opening * 1000:.2f}, '
+                     f'grasp_point_mm: [{", ".join(f"{v * 1000:.2f}" for v in g.grasp_point)}]}}'
+                     f'   # closes on {p.width * 1000:.2f} mm')
+    return lines

@@ -1,0 +1,64 @@
+"""Grasps proposed from a part's geometry: they close on the part where the user would, and
+what `run --check` prints of them reads back as the same grasps."""
+
+import os
+
+import numpy as np
+from pick_common.parts import build_part, PartSpec
+from pick_validity.config import GraspPose
+from pick_validity.grasp_fit import check_grasps_fit
+from pick_validity.grasp_proposals import as_yaml, JAW_MARGIN, propose
+import pytest
+import trimesh
+import yaml
+
+STEP = os.path.join(os.path.dirname(__file__), '..', '..', 'experiment_manager', 'config',
+                    'parts', 'TO-220-3_Vertical.step')
+
+
+def test_kicads_to220_gets_grasps_across_its_width_and_thickness_at_its_mass_centre():
+    part = build_part(PartSpec(model='mesh', mesh_path=STEP, mass=0.002))
+    proposals = propose(part)
+    check_grasps_fit(part, [p.grasp for p in proposals])        # every one closes on it
+    by_name = {p.grasp.name: p for p in proposals}
+    # lying on its tab side or its back, jaws across the 10.25 mm width; on its edges,
+    # across the 4.46 mm thickness
+    for name in ('up+y_close+x', 'up-y_close+x'):
+        assert by_name[name].width == pytest.approx(0.01025, abs=1e-5)
+        assert by_name[name].grasp.jaw_opening == pytest.approx(0.01025 + 2 * JAW_MARGIN,
+                                                                abs=1e-5)
+    for name in ('up+x_close+y', 'up-x_close+y'):
+        assert by_name[name].width == pytest.approx(0.00446, abs=1e-5)
+    for p in proposals:
+        assert np.allclose(p.grasp.grasp_point, part.mass_frame[0])
+
+
+def test_a_round_body_is_closed_across_its_axis(tmp_path):
+    # a 5 x 11 mm cylinder, its axis along x, its origin 20 mm away: no flat faces to close
+    # across but its ends; the jaws close across the round body too, lying on its side (any
+    # roll: one up axis) and standing on its ends
+    body = trimesh.creation.cylinder(radius=0.0025, height=0.011, sections=32)
+    body.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [0, 1, 0]))
+    body.apply_translation([0.02, 0.0, 0.0])
+    body.export(tmp_path / 'cylinder.stl')
+    part = build_part(PartSpec(model='mesh', mesh_path=str(tmp_path / 'cylinder.stl'),
+                               mass=0.0004))
+    across = [p for p in propose(part) if abs(p.grasp.closing_axis[0]) < 1e-6]
+    assert across and all(p.width == pytest.approx(0.005, rel=0.01) for p in across)
+    ups = sorted(tuple(np.round(p.grasp.up_axis, 6)) for p in across)
+    lying = [u for u in ups if abs(u[0]) < 1e-6]
+    assert lying and sorted({u for u in ups if abs(u[0]) > 0.999}) == [(-1, 0, 0), (1, 0, 0)]
+
+
+def test_the_printed_yaml_reads_back_as_the_same_grasps():
+    part = build_part(PartSpec(model='mesh', mesh_path=STEP, mass=0.002))
+    proposals = propose(part)
+    read = yaml.safe_load('\n'.join(as_yaml(proposals)))['grasps']
+    assert [g['name'] for g in read] == [p.grasp.name for p in proposals]
+    for g, p in zip(read, proposals, strict=True):
+        back = GraspPose(g['name'], tuple(g['up_axis']), tuple(g['closing_axis']),
+                         g['jaw_opening_mm'] / 1000, tuple(v / 1000 for v in g['grasp_point_mm']))
+        assert np.allclose(back.up_axis, p.grasp.up_axis, atol=1e-4)
+        assert np.allclose(back.closing_axis, p.grasp.closing_axis, atol=1e-4)
+        assert back.jaw_opening == pytest.approx(p.grasp.jaw_opening, abs=1e-5)
+        assert np.allclose(back.grasp_point, p.grasp.grasp_point, atol=1e-5)
