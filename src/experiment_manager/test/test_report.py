@@ -11,6 +11,7 @@ from experiment_manager import experiment_file
 from experiment_manager.analysis import pictures, report, verdicts
 from experiment_manager.analysis.metrics import iterations_to_decide, rate_interval
 from experiment_manager.analysis.verdicts import FEASIBLE, NOT_ANALYSED, NOT_FEASIBLE, UNDECIDED
+from pick_validity.results import STAGE_PLACEABILITY
 import pytest
 
 
@@ -295,11 +296,26 @@ def test_against_the_paper_says_which_findings_hold_and_why_figures_differ(run_d
 def test_pictures_re_simulate_the_recorded_iteration(run_dir):
     file = experiment_file.load(os.path.join(run_dir, 'experiment.yaml'))
     captions = pictures.write(file, run_dir)
-    assert set(captions) == {'bin.png', 'tray.png'}
+    # a part stopped at each stage that stopped one: in the bin drawn, at the tray's count
+    # drawn, or (placeability, drawn without a scene) in any experiment's first iteration
+    def stops(exp, group=None):
+        return {int(r['stage']) for r in pictures._rows(run_dir, 'parts', exp)
+                if r['check'] == '0' and int(r['grasp']) >= 0
+                and (group is None or int(r['group']) == group)}
+    drawn = stops('emptying') | stops('sweep', int(captions['tray.png'].split()[0]))
+    expected = {'bin.png', 'tray.png'} | {
+        f'stopped_{name}.png' for stage, (name, _) in pictures.STOPPED.items()
+        if stage in drawn and stage != STAGE_PLACEABILITY}
+    if any(STAGE_PLACEABILITY in stops(e.id) for e in file.experiments):
+        expected.add('stopped_placeability.png')
+    assert len(expected) > 3 and set(captions) == expected, captions
     for name, caption in captions.items():
-        assert 'poses identical to the recorded ones' in caption, caption
+        if name in ('bin.png', 'tray.png'):
+            assert 'poses identical to the recorded ones' in caption, caption
         with open(os.path.join(run_dir, name), 'rb') as f:
             assert f.read(8) == b'\x89PNG\r\n\x1a\n'
+    if 'stopped_placeability.png' in captions:
+        assert 'mm past the placing surface' in captions['stopped_placeability.png']
     assert 'green: the first pick' in captions['bin.png']
     report.write(run_dir)
     text = open(os.path.join(run_dir, 'report.md')).read()

@@ -136,6 +136,46 @@ def _turn(vector: np.ndarray, target: np.ndarray) -> np.ndarray:
     return trimesh.transformations.rotation_matrix(angle, axis)[:3, :3]
 
 
+def clearance(validator: Validator, g: int, relative: np.ndarray) -> float:
+    """How far (m) the gripper of grasp `g`, holding the part at `relative` (its rotation in
+    the part frame), stays on its side of the seating plane once the part is placed: negative
+    where it reaches past it, as the placeability check decides (clear when positive)."""
+    point = validator.grasps[g].point[None]
+    return min(float(validator.seat_offset - support(shape, *place(shape, relative[None], point),
+                                                     validator.place_axis)[0])
+               for shape in validator.gripper_shapes[g])
+
+
+def draw_place(ax, validator: Validator, g: int, relatives: list[np.ndarray],
+               tilts: list[float], title: str) -> list[str]:
+    """The part turned to its place orientation (place.axis down) on the placing surface
+    (yellow), with the gripper of grasp `g` holding it at each of `relatives` (its rotations
+    in the part frame, at wrist `tilts`, rad): green where it clears the surface, red where
+    it reaches past it. Returns the words per tilt ('+0 deg hits')."""
+    part = validator.part
+    visual, grasp = part.visual, validator.grasps[g]
+    view = _turn(validator.place_axis, np.array([0.0, 0.0, -1.0]))
+    _draw(ax, visual, view, '#999999', 0.7)
+    points = [view @ visual.vertices.T]
+    words = []
+    for relative, tilt in zip(relatives, tilts, strict=True):
+        clear = clearance(validator, g, relative) > 0
+        for shape in validator.gripper_shapes[g]:
+            rot, centre = place(shape, relative[None], grasp.point[None])
+            mesh = _shape_mesh(shape, rot[0], centre[0])
+            _draw(ax, mesh, view, '#55a868' if clear else '#c44e52', 0.15)
+            points.append(view @ mesh.vertices.T)
+        words.append(f'{np.degrees(tilt):+.0f} deg {"clear" if clear else "hits"}')
+    pts = np.hstack(points).T
+    seat = (view @ (validator.place_axis * validator.seat_offset))[2]
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    plane = np.array([[lo[0], lo[1], seat], [hi[0], lo[1], seat], [hi[0], hi[1], seat],
+                      [lo[0], hi[1], seat]]) * MM
+    ax.add_collection3d(Poly3DCollection([plane], facecolor='#e8c547', alpha=0.35))
+    _frame(ax, np.vstack([pts * MM, plane]), title + 'tilt ' + ', '.join(words))
+    return words
+
+
 def write(checks: Validator, path: str) -> str:
     """Draw the sheet of the file's `validator` into `path` (PNG); returns `path`."""
     validator, part = checks, checks.part
@@ -172,32 +212,10 @@ def write(checks: Validator, path: str) -> str:
                f' mm, fingertips {validator.finger_depths[g] * MM:.1f} mm below the point')
         # place: the part turned so that place.axis points down; gripper as it picked
         ax = fig.add_subplot(rows, 2, 4 + 2 * g, projection='3d')
-        view = _turn(validator.place_axis, np.array([0.0, 0.0, -1.0]))
-        _draw(ax, visual, view, '#999999', 0.7)
-        points = [view @ visual.vertices.T]
-        words = []
-        for k in shown:
-            relative = pick.T @ trimesh.transformations.rotation_matrix(
-                tilts[k], [1, 0, 0])[:3, :3]
-            placed = [place(shape, relative[None], grasp.point[None])
-                      for shape in validator.gripper_shapes[g]]
-            # as the placeability check decides it: the gripper stays above the surface
-            clear = all(support(shape, rot, centre, validator.place_axis)[0]
-                        < validator.seat_offset for shape, (rot, centre) in
-                        zip(validator.gripper_shapes[g], placed, strict=True))
-            for shape, (rot, centre) in zip(validator.gripper_shapes[g], placed, strict=True):
-                mesh = _shape_mesh(shape, rot[0], centre[0])
-                _draw(ax, mesh, view, '#55a868' if clear else '#c44e52', 0.15)
-                points.append(view @ mesh.vertices.T)
-            words.append(f'{np.degrees(tilts[k]):+.0f} deg {"clear" if clear else "hits"}')
-        pts = np.hstack(points).T
-        seat = (view @ (validator.place_axis * validator.seat_offset))[2]
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
-        plane = np.array([[lo[0], lo[1], seat], [hi[0], lo[1], seat], [hi[0], hi[1], seat],
-                          [lo[0], hi[1], seat]]) * MM
-        ax.add_collection3d(Poly3DCollection([plane], facecolor='#e8c547', alpha=0.35))
-        _frame(ax, np.vstack([pts * MM, plane]), f'{grasp.name}: place (yellow: the surface)\n'
-               'tilt ' + ', '.join(words))
+        relatives = [pick.T @ trimesh.transformations.rotation_matrix(tilts[k], [1, 0, 0])[:3, :3]
+                     for k in shown]
+        draw_place(ax, validator, g, relatives, [tilts[k] for k in shown],
+                   f'{grasp.name}: place (yellow: the surface)\n')
     fig.tight_layout()
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     fig.savefig(path, dpi=90)

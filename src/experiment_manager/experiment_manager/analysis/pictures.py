@@ -5,7 +5,11 @@ settled poses are identical to the recorded ones, which is checked and said in t
 - `bin.png`: the first bin_emptying iteration's settled bin, with the gripper of its first pick
   (green, a valid grasp) and the gripper of a rejected part at the tilt nearest 0, the most
   vertical approach (red: it hits the bin or a neighbour);
-- `tray.png`: the first table_sweep iteration at the count nearest the optimum n*.
+- `tray.png`: the first table_sweep iteration at the count nearest the optimum n*;
+- `stopped_container.png`, `stopped_neighbour.png`: in the bin (else the tray) above, the first
+  part the stage stopped, its gripper in red at the most vertical approach;
+- `stopped_placeability.png`: the first part placeability stopped, in its place orientation on
+  the placing surface with the gripper at its best tilt (drawn as the part sheet draws it).
 """
 
 import csv
@@ -13,18 +17,23 @@ import json
 import os
 
 import matplotlib.image
+import matplotlib.pyplot as plt
 import numpy as np
 from pick_common.specs import SceneSpec
 from pick_sim_world.world import Overlay, World
 from pick_validity.geometry import BOX, Shape
-from pick_validity.results import STAGE_CONTAINER, STAGE_NEIGHBOUR
+from pick_validity.results import STAGE_CONTAINER, STAGE_NEIGHBOUR, STAGE_PLACEABILITY
 from pick_validity.validity import Validator
 from scipy.spatial.transform import Rotation
 
 from ..experiment_file import BIN_EMPTYING, ExperimentFile, TABLE_SWEEP
 from ..experiment_file.plan import plan, Unit
+from . import part_sheet
 
 SIZE = (800, 600)
+# stage: (its name in the pictures' files, what a part stopped there hits)
+STOPPED = {STAGE_PLACEABILITY: ('placeability', 'the placing surface'),
+           STAGE_CONTAINER: ('container', 'the bin'), STAGE_NEIGHBOUR: ('neighbour', 'a neighbour')}
 GREEN, RED = (0.1, 0.8, 0.1, 0.55), (0.9, 0.1, 0.1, 0.55)
 
 
@@ -73,8 +82,85 @@ def _save(path: str, image: np.ndarray) -> None:
     matplotlib.image.imsave(path, image)
 
 
-def bin_picture(file: ExperimentFile, summary: dict, run_dir: str) -> str | None:
-    """bin.png with a valid and a rejected grasp; returns its caption (None: nothing to draw)."""
+def _stopped_gripper(validator: Validator, row: dict) -> list[Overlay]:
+    """The gripper (red) of a part's row of parts.csv at the tilt nearest 0, the most vertical
+    approach, with the grasp the check chose."""
+    index = int(row['grasp'])
+    position = np.array([float(row[k]) for k in ('x', 'y', 'z')])
+    part_rotation = _rotation(row)
+    frames = validator.approach_frames(part_rotation.as_matrix()[None], np.array([index]))
+    tilt = int(np.abs(validator.tilts).argmin())
+    rotation = Rotation.from_matrix(frames[0, tilt])
+    origin = position + part_rotation.apply(validator.grasps[index].point)
+    return gripper_overlays(validator.gripper_shapes[index], (*origin, *rotation.as_quat()),
+                            RED)
+
+
+def _rotation(row: dict) -> Rotation:
+    return Rotation.from_quat([float(row[k]) for k in ('qx', 'qy', 'qz', 'qw')])
+
+
+def _first_stopped(rows: list[dict], stage: int) -> dict | None:
+    return next((r for r in rows if r['check'] == '0' and int(r['grasp']) >= 0
+                 and int(r['stage']) == stage), None)
+
+
+def stopped_in_world(world: World, validator: Validator, unit: Unit, rows: list[dict],
+                     exp_id: str, run_dir: str, captions: dict[str, str]) -> None:
+    """stopped_container.png and stopped_neighbour.png, each not yet in `captions`: the first
+    part of the settled `world` (its first check, `rows` of parts.csv) that the stage stopped,
+    with its gripper in red at the most vertical approach."""
+    for stage in (STAGE_CONTAINER, STAGE_NEIGHBOUR):
+        name, what = STOPPED[stage]
+        row = _first_stopped(rows, stage)
+        if f'stopped_{name}.png' in captions or row is None:
+            continue
+        camera = _camera(unit)
+        image = world.render(*SIZE, overlays=_stopped_gripper(validator, row), **camera)
+        _save(os.path.join(run_dir, f'stopped_{name}.png'), image)
+        captions[f'stopped_{name}.png'] = (
+            f'Stopped at {name} collision: part {row["part_id"]} of `{exp_id}` iteration 1 '
+            f'(grasp {validator.grasps[int(row["grasp"])].name}), its gripper in red at the '
+            f'most vertical approach: it hits {what}.')
+
+
+def placeability_picture(validator: Validator, rows: list[dict], exp_id: str,
+                         run_dir: str) -> str | None:
+    """stopped_placeability.png: the first part of `rows` (parts.csv, an experiment's first
+    iteration) that placeability stopped, turned to its place orientation on the placing
+    surface, with the gripper as it picked it at its best tilt (the one that reaches least
+    past the surface, among those within the approach cone); returns its caption."""
+    row = _first_stopped(rows, STAGE_PLACEABILITY)
+    if row is None:
+        return None
+    g = int(row['grasp'])
+    rotation = _rotation(row).as_matrix()
+    frames = validator.approach_frames(rotation[None], np.array([g]))[0]
+    within = np.flatnonzero(frames[:, 2, 2] >= np.cos(validator.config.approach_cone) - 1e-12)
+    relatives = {k: rotation.T @ frames[k] for k in within}
+    reach = {k: part_sheet.clearance(validator, g, r) for k, r in relatives.items()}
+    if not reach:
+        return None
+    best = max(reach, key=reach.get)
+    fig = plt.figure(figsize=(5.0, 4.2))
+    ax = fig.add_subplot(1, 1, 1, projection='3d')
+    part_sheet.draw_place(ax, validator, g, [relatives[best]], [validator.tilts[best]],
+                          f'part {row["part_id"]}, grasp {validator.grasps[g].name}\n')
+    fig.tight_layout()
+    fig.savefig(os.path.join(run_dir, 'stopped_placeability.png'), dpi=90)
+    plt.close(fig)
+    return (f'Stopped at placeability: part {row["part_id"]} of `{exp_id}` iteration 1 (grasp '
+            f'{validator.grasps[g].name}), turned to its place orientation, the gripper holding '
+            f'it as it would pick it as it lies, at its best tilt '
+            f'({np.degrees(validator.tilts[best]):+.0f} deg of {len(within)} within the '
+            f'approach cone): it reaches {-reach[best] * 1000:.1f} mm past the placing surface '
+            '(yellow).')
+
+
+def bin_picture(file: ExperimentFile, summary: dict, run_dir: str,
+                captions: dict[str, str]) -> str | None:
+    """bin.png with a valid and a rejected grasp, and the parts its bin's stages stopped
+    (`stopped_in_world`, into `captions`); returns its caption (None: nothing to draw)."""
     exp = next((e for e in file.experiments if e.type == BIN_EMPTYING), None)
     if exp is None or exp.id not in summary['experiments'] or (
             exp.bin_from and exp.bin_from not in summary['experiments']):
@@ -100,21 +186,11 @@ def bin_picture(file: ExperimentFile, summary: dict, run_dir: str) -> str | None
         rejected = next((r for r in parts if r['check'] == '0' and int(r['grasp']) >= 0
                          and int(r['stage']) in (STAGE_CONTAINER, STAGE_NEIGHBOUR)), None)
         if rejected is not None:
-            index = int(rejected['grasp'])
-            g = grasps[index]
-            position = np.array([float(rejected[k]) for k in ('x', 'y', 'z')])
-            part_rotation = Rotation.from_quat([float(rejected[k])
-                                                for k in ('qx', 'qy', 'qz', 'qw')])
-            frames = validator.approach_frames(part_rotation.as_matrix()[None],
-                                               np.array([index]))
-            tilt = int(np.abs(validator.tilts).argmin())
-            rotation = Rotation.from_matrix(frames[0, tilt])
-            origin = position + part_rotation.apply(g.point)
-            overlays += gripper_overlays(validator.gripper_shapes[index],
-                                         (*origin, *rotation.as_quat()), RED)
-            why = 'the bin' if int(rejected['stage']) == STAGE_CONTAINER else 'a neighbour'
-            notes.append(f'red: part {rejected["part_id"]} (grasp {g.name}) at the most '
-                         f'vertical approach, rejected: it hits {why}')
+            overlays += _stopped_gripper(validator, rejected)
+            notes.append(f'red: part {rejected["part_id"]} (grasp '
+                         f'{grasps[int(rejected["grasp"])].name}) at the most vertical '
+                         f'approach, rejected: it hits {STOPPED[int(rejected["stage"])][1]}')
+        stopped_in_world(world, validator, unit, parts, exp.id, run_dir, captions)
         image = world.render(*SIZE, overlays=overlays, **_camera(unit))
     _save(os.path.join(run_dir, 'bin.png'), image)
     size = ' x '.join(f'{s * 1000:g}' for s in unit.container.inner_size)
@@ -124,8 +200,10 @@ def bin_picture(file: ExperimentFile, summary: dict, run_dir: str) -> str | None
             + '; '.join(notes) + '.')
 
 
-def tray_picture(file: ExperimentFile, summary: dict, run_dir: str) -> str | None:
-    """tray.png at the count nearest n*; returns its caption (None: nothing to draw)."""
+def tray_picture(file: ExperimentFile, summary: dict, run_dir: str,
+                 captions: dict[str, str]) -> str | None:
+    """tray.png at the count nearest n*, and the parts its stages stopped that the bin did not
+    show (`stopped_in_world`); returns its caption (None: nothing to draw)."""
     exp = next((e for e in file.experiments if e.type == TABLE_SWEEP), None)
     if exp is None or 'n_star' not in summary['experiments'].get(exp.id, {}):
         return None
@@ -133,9 +211,12 @@ def tray_picture(file: ExperimentFile, summary: dict, run_dir: str) -> str | Non
     n = min(exp.counts, key=lambda c: (abs(c - n_star), c))
     unit = next(u for u in plan(file, exp, summary['experiments'])
                 if u.group == n and u.iteration == 0)
+    rows = [r for r in _rows(run_dir, 'parts', exp.id) if int(r['group']) == n]
     with _settle(file, unit) as world:
-        same = _same_as_recorded(world, _rows(run_dir, 'parts', exp.id), n)
+        same = _same_as_recorded(world, rows, n)
         image = world.render(*SIZE, **_camera(unit))
+        stopped_in_world(world, Validator(file.setup, world.part), unit, rows, exp.id, run_dir,
+                         captions)
     _save(os.path.join(run_dir, 'tray.png'), image)
     return (f'{n} parts settled on the tray (`{exp.id}`, the tested count nearest n* = '
             f'{n_star}, iteration 1, seed {unit.seed}; re-simulated: poses '
@@ -147,11 +228,19 @@ def write(file: ExperimentFile, run_dir: str) -> dict[str, str]:
     pictures.json for the report."""
     with open(os.path.join(run_dir, 'summary.json'), encoding='utf-8') as f:
         summary = json.load(f)
-    captions = {}
+    captions: dict[str, str] = {}
     for name, draw in (('bin.png', bin_picture), ('tray.png', tray_picture)):
-        caption = draw(file, summary, run_dir)
+        caption = draw(file, summary, run_dir, captions)
         if caption:
             captions[name] = caption
+    validator = Validator(file.setup)
+    for exp in file.experiments:
+        if exp.id in summary['experiments']:
+            caption = placeability_picture(validator, _rows(run_dir, 'parts', exp.id), exp.id,
+                                           run_dir)
+            if caption:
+                captions['stopped_placeability.png'] = caption
+                break
     with open(os.path.join(run_dir, 'pictures.json'), 'w', encoding='utf-8') as f:
         json.dump(captions, f, indent=2)
     return captions
