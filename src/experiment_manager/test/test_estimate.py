@@ -5,7 +5,7 @@ import os
 
 from experiment_manager import experiment_file
 from experiment_manager.experiment_file.plan import count_iterations, experiment_iterations
-from experiment_manager.running.estimate import Costs, mean_units, TYPE_WEIGHT
+from experiment_manager.running.estimate import Costs, mean_units, PRIOR
 import pytest
 
 SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
@@ -23,28 +23,33 @@ def test_the_iterations_of_each_experiment_add_up_to_the_run(small):
     assert sum(experiment_iterations(e) for e in file.experiments) == count_iterations(file)
 
 
-def test_nothing_finished_means_unknown(small):
+def test_before_anything_finished_the_measured_prior_says_it(small):
     by_id, _ = small
-    assert Costs().left([(by_id['feeder'], 1)], workers=2) == 0.0
+    feeder = by_id['feeder']
+    assert Costs().left([(feeder, 1)], workers=2) == pytest.approx(
+        PRIOR['feeder_emptying'] * feeder.parts)
+    assert Costs().left([], workers=2) == 0.0
 
 
 def test_iterations_left_are_weighed_by_their_cost_not_counted(small):
     by_id, _ = small
     sweep, feeder = by_id['sweep'], by_id['feeder']
     costs = Costs()
-    for n in sweep.counts:                  # 2..14 parts, 0.1 s per part
-        costs.add(sweep, n, 0.1 * n)
-    # A feeder run not timed yet: taken at the rate of all (0.1 s per part) times its parts,
-    # weighed as a feeder run's part (TYPE_WEIGHT).
+    for n in sweep.counts:                  # 2..14 parts, twice the sweep's PRIOR per part
+        costs.add(sweep, n, 2 * PRIOR['table_sweep'] * n)
+    # A feeder run not timed yet: its type's PRIOR, scaled as the sweep ran against its own
+    # (twice as slow here: another machine, a heavier part).
     assert costs.left([(feeder, 1)], workers=1) == pytest.approx(
-        0.1 * feeder.parts * TYPE_WEIGHT['feeder_emptying'])
-    # Once one has run (30 s for 12 parts), the other takes what it took: counting
-    # iterations would say 0.8 s, the sweep's mean.
+        2 * PRIOR['feeder_emptying'] * feeder.parts)
+    # Once one has run (30 s), the other takes what it took: counting iterations would say
+    # the sweep's mean.
     costs.add(feeder, feeder.parts, 30.0)
     assert costs.left([(feeder, 1)], workers=1) == pytest.approx(30.0)
-    # the sweep's own rate for its iterations left (mean 8 parts), spread over two workers
+    # the sweep's own rate for its iterations left (mean 8 parts), spread over two workers,
+    # but never less than the dearest iteration left: one feeder run is not split
+    sweep_left = 4 * 2 * PRIOR['table_sweep'] * mean_units(sweep)
     assert costs.left([(sweep, 4), (feeder, 1)], workers=2) == pytest.approx(
-        (4 * 0.1 * mean_units(sweep) + 30.0) / 2)
+        max((sweep_left + 30.0) / 2, 30.0))
     assert mean_units(sweep) == pytest.approx(8.0)
 
 
@@ -52,7 +57,7 @@ def test_a_gripper_sweep_costs_its_parts_times_its_grippers(small):
     by_id, _ = small
     grippers, emptying = by_id['grippers'], by_id['emptying']
     costs = Costs()
-    costs.add(emptying, emptying.parts, 3.0)          # 0.1 s per part
+    costs.add(emptying, emptying.parts, emptying.parts * PRIOR['bin_emptying'])   # as PRIOR
     assert mean_units(grippers) == grippers.parts * len(grippers.variants)
     assert costs.left([(grippers, 2)], workers=1) == pytest.approx(
-        2 * 0.1 * grippers.parts * len(grippers.variants))
+        2 * PRIOR['gripper_sweep'] * grippers.parts * len(grippers.variants))

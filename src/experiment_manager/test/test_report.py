@@ -3,13 +3,14 @@ Markdown and HTML of the same content."""
 
 import copy
 import json
+import math
 import os
 import re
 import shutil
 
 from experiment_manager import experiment_file
-from experiment_manager.analysis import pictures, report, verdicts
-from experiment_manager.analysis.metrics import iterations_to_decide, rate_interval
+from experiment_manager.analysis import decisions, pictures, report, verdicts
+from experiment_manager.analysis.metrics import rate_interval
 from experiment_manager.analysis.verdicts import FEASIBLE, NOT_ANALYSED, NOT_FEASIBLE, UNDECIDED
 from pick_validity.results import STAGE_PLACEABILITY
 import pytest
@@ -41,7 +42,7 @@ def test_a_run_gets_its_report_files(run_dir):
         assert heading in text
         assert f'<h2>{heading[3:]}' in page
     separators = [line for line in text.splitlines() if line.startswith('| --- |')]
-    assert page.count('<table>') == len(separators) == 7 and 'fig15_table.png' in page
+    assert page.count('<table>') == len(separators) == 8 and 'fig15_table.png' in page
     assert 'grippers.png' in page
     assert 'paper' not in text.split('## Verdict')[1]      # id `small`: no paper numbers
     assert 'No iteration was flagged' in text
@@ -73,43 +74,54 @@ def test_the_report_warns_where_the_optimal_range_runs_past_the_counts_tested(ru
         report.markdown(s, {}, {})
 
 
-def _rates(s: dict, emptied: int, accepted: int, n: int) -> None:
-    """Bins emptied and feeder runs accepted, k of n, with the intervals metrics gives them."""
-    s['experiments']['emptying'].update(emptied=emptied, iterations=n,
-                                        emptied_ci95=list(rate_interval(emptied, n)))
-    s['experiments']['feeder'].update(emptied=max(emptied, accepted), accepted=accepted,
-                                      iterations=n,
-                                      accepted_ci95=list(rate_interval(accepted, n)))
-    # a throughput far above any requirement here, known to 95 % once there are two runs
-    s['experiments']['feeder']['parts_per_hour'].update(n=n, mean=1000.0)
-    s['experiments']['feeder']['parts_per_hour_ci95'] = [900.0, 1100.0] if n > 1 else [None,
-                                                                                      None]
+def _rates(s: dict, emptied: int, accepted: int, n: int, spilled: int = 0,
+           seconds: float = 1000.0) -> None:
+    """Bins emptied, k of n, and feeder runs emptied in about `seconds` (spread by 1 %),
+    `accepted` of n (the others not emptied), `spilled` parts over all, with the decisions
+    metrics gives them."""
+    required = s['requirements']['success_rate']
+    s['experiments']['emptying'].update(
+        emptied=emptied, iterations=n,
+        decision=decisions.rate(emptied, n, required, 'bins emptied').as_dict())
+    runs = [{'time': seconds * (1 + 0.01 * (i % 3)) if i < accepted else math.inf,
+             'spilled': spilled if i == 0 else 0} for i in range(n)]
+    s['experiments']['feeder'].update(
+        emptied=accepted, iterations=n,
+        decision={'time': decisions.table_time(runs, 4 * 3600.0, required).as_dict(),
+                  'spills': decisions.spills(runs, 0).as_dict()})
+    s['experiments']['feeder']['physics']['spilled'] = spilled
 
 
-def test_the_table_verdict_rests_on_the_cell_s_throughput_too(run_dir):
+def test_the_table_verdict_rests_on_the_time_to_empty_and_the_spills(run_dir):
     s = _summary(run_dir)
-    s['requirements'].update(capacity=10, success_rate=0.9, parts_per_hour=120)
-    _rates(s, 40, 40, 40)
-    feeder = s['experiments']['feeder']
-
-    def table(mean, low, high):
-        feeder['parts_per_hour']['mean'] = mean
-        feeder['parts_per_hour_ci95'] = [low, high]
-        return verdicts.verdicts(s)[1]
-    fast = table(300.0, 250.0, 350.0)
-    assert fast['verdict'] == FEASIBLE
-    assert fast['reasons'][-1].startswith('the cell would pick 300 parts per hour (95 % '
-                                          'interval 250 to 350); required 120')
-    slow = table(100.0, 90.0, 110.0)    # every run emptied, but too slowly: that decides
-    assert slow['verdict'] == NOT_FEASIBLE
-    assert slow['reasons'][0].startswith('the cell would pick 100 parts per hour')
-    near = table(130.0, 100.0, 160.0)
-    assert near['verdict'] == UNDECIDED
-    assert near['reasons'][-1].startswith('not enough runs to decide: the cell would pick 130')
-    one = table(300.0, None, None)      # one run: no interval, no decision on it
-    assert one['verdict'] == UNDECIDED
-    _rates(s, 0, 0, 40)                 # not feasible on its rate: the throughput only said
-    assert table(300.0, 250.0, 350.0)['verdict'] == NOT_FEASIBLE
+    s['requirements'].update(capacity=10, success_rate=0.9)
+    _rates(s, 3, 3, 3)              # three runs in about 17 min: far inside 4 h
+    table = verdicts.verdicts(s)[1]
+    assert table['verdict'] == FEASIBLE, table
+    assert table['reasons'][0].startswith('3 runs emptied in 16.7 min to 17.0 min: 90% of '
+                                          'refills empty within ')
+    assert 'one-sided 95 % tolerance bound, lognormal' in table['reasons'][0]
+    assert table['reasons'][2] == 'grounds settled: time FEASIBLE, spills FEASIBLE'
+    assert table['grounds']['time']['interval'] == 'one-sided 95 % tolerance bound, lognormal'
+    _rates(s, 3, 3, 3, seconds=3.9 * 3600.0)   # just inside the interval: not settled
+    table = verdicts.verdicts(s)[1]
+    assert table['verdict'] == UNDECIDED
+    assert table['reasons'][2] == 'grounds settled: spills FEASIBLE; not settled: time'
+    _rates(s, 3, 2, 3)              # a run that did not empty counts as over: distribution-free
+    table = verdicts.verdicts(s)[1]
+    assert table['verdict'] == UNDECIDED and '1 of 3 runs over the interval or not emptied' \
+        in table['reasons'][0] and '(a run over the interval or not emptied)' in \
+        table['reasons'][0]
+    _rates(s, 3, 0, 30)             # none of 30 emptied
+    assert verdicts.verdicts(s)[1]['verdict'] == NOT_FEASIBLE
+    _rates(s, 3, 3, 3, spilled=1)   # one spilled part, where none may spill: that decides
+    table = verdicts.verdicts(s)[1]
+    assert table['verdict'] == NOT_FEASIBLE
+    assert table['reasons'][1].startswith("1 parts spilled over the tray's walls in 3 runs")
+    assert table['reasons'][2] == 'grounds settled: time FEASIBLE, spills NOT FEASIBLE'
+    text = report.markdown(s, {}, {})
+    assert '| vibrating table | time | time to empty the feeder, 90% of refills | FEASIBLE |' \
+        in text and '| one-sided 95 % tolerance bound, lognormal | 3 |' in text
 
 
 def test_the_exact_interval_of_a_rate():
@@ -122,12 +134,12 @@ def test_the_exact_interval_of_a_rate():
 
 
 def test_the_iterations_that_would_decide_a_rate():
-    # all succeeding: (0.025)^(1/n) >= 0.9 from n = 36 (35.01 solves it)
-    assert iterations_to_decide(1, 1, 0.9) == 36
-    assert iterations_to_decide(0, 1, 0.9) == 2     # 0 of 2: below 0.842
-    assert rate_interval(0, 2)[1] < 0.9 <= rate_interval(0, 1)[1]
-    assert iterations_to_decide(9, 10, 0.9) is None     # the rate seen is the requirement
-    assert iterations_to_decide(0, 0, 0.9) is None
+    # one-sided: all succeeding, 0.05^(1/n) >= 0.9 from n = 29 (28.4 solves it)
+    assert decisions.iterations_to_decide(1, 1, 0.9) == 29
+    assert decisions.iterations_to_decide(0, 1, 0.9) == 2     # 0 of 2: at most 0.776
+    assert decisions.binomial_bounds(2, 2)[0] > 0.1 >= decisions.binomial_bounds(1, 1)[0]
+    assert decisions.iterations_to_decide(9, 10, 0.9) is None   # the rate seen is the required
+    assert decisions.iterations_to_decide(0, 0, 0.9) is None
 
 
 def test_verdicts_rest_on_the_interval_of_the_rate_and_on_the_capacity(run_dir):
@@ -138,23 +150,16 @@ def test_verdicts_rest_on_the_interval_of_the_rate_and_on_the_capacity(run_dir):
     static, table = verdicts.verdicts(s)[:2]
     assert (static['verdict'], table['verdict']) == (UNDECIDED, UNDECIDED)
     assert static['reasons'][0] == (
-        'not enough iterations to decide: 1 of 1 bins emptied, 95 % interval 2.5 % to 100.0 %; '
-        'required 90.0 % (requirements.success_rate); 36 iterations would decide if the rate '
-        'seen held')
-    _rates(s, 40, 40, 40)       # the paper's count: 40 of 40 clears 90 %
+        '1 of 1 bins emptied: at least 5.0% and at most 100.0% (one-sided 95 % exact bounds '
+        '(Clopper-Pearson)); required 90% (requirements.success_rate); not settled: 29 '
+        'iterations would settle it if the rate seen held')
+    assert table['reasons'][0].endswith('not settled: 3 runs give the fitted bound')
+    _rates(s, 29, 29, 29)       # 29 of 29 clear 90 % one-sidedly (the two-sided interval: 36)
     assert [v['verdict'] for v in verdicts.verdicts(s)][:2] == [FEASIBLE, FEASIBLE]
-    _rates(s, 0, 0, 40)         # its static bins: 0 of 40
+    _rates(s, 0, 0, 40)         # the paper's static bins: 0 of 40
     assert [v['verdict'] for v in verdicts.verdicts(s)][:2] == [NOT_FEASIBLE, NOT_FEASIBLE]
     _rates(s, 36, 36, 40)       # 90 % seen, at the requirement itself
-    assert 'no number of iterations would decide' in verdicts.verdicts(s)[0]['reasons'][0]
-    # An emptied run that spilled more than the requirement allows is not accepted.
-    _rates(s, 40, 0, 40)
-    s['experiments']['feeder'].update(runs_spilling=40)
-    s['experiments']['feeder']['physics']['spilled'] = 40
-    table = verdicts.verdicts(s)[1]
-    assert table['verdict'] == NOT_FEASIBLE and (
-        "40 parts spilled over the tray's walls, in 40 runs; a run may spill 0 "
-        '(requirements.max_spilled_parts): 0 of the 40 emptied runs met it') in table['reasons']
+    assert 'no number of iterations would' in verdicts.verdicts(s)[0]['reasons'][0]
     # A tunnelled iteration (left out of the figures) leaves no option feasible, and says so
     # first.
     _rates(s, 40, 40, 40)
@@ -163,10 +168,9 @@ def test_verdicts_rest_on_the_interval_of_the_rate_and_on_the_capacity(run_dir):
     table = verdicts.verdicts(s)[1]
     assert table['verdict'] == NOT_FEASIBLE
     assert table['reasons'][0] == '1 iteration flagged: tunnelled 1 (see Physics health)'
-    s['experiments']['feeder'].update(emptied=0, accepted=0)
     s['experiments']['feeder']['stops'] = {'stop: empty': 1, 'stop: vibration limit': 2}
     assert 'runs ended by: feeder and table empty 1, vibration limit 2)' in \
-        verdicts.verdicts(s)[1]['reasons'][2]
+        verdicts.verdicts(s)[1]['reasons'][4]
     # 30 parts cannot last a refill interval: that decides, and is said first, whatever the
     # rate would have said (here: not enough iterations to decide)
     s['requirements']['capacity'] = 480
@@ -178,7 +182,7 @@ def test_verdicts_rest_on_the_interval_of_the_rate_and_on_the_capacity(run_dir):
     assert bin_verdict['option'] == f'static bin {x} x {y} x {z} mm'
     assert bin_verdict['reasons'][0] == ('the bin was filled with 30 parts, fewer than the 480 '
                                          'a refill interval needs')
-    assert bin_verdict['reasons'][1].startswith('not enough iterations to decide')
+    assert bin_verdict['reasons'][1].startswith('1 of 1 bins emptied')
     del s['experiments']['emptying'], s['experiments']['feeder'], s['experiments']['grippers']
     assert [v['verdict'] for v in verdicts.verdicts(s)] == [NOT_ANALYSED, NOT_ANALYSED]
 

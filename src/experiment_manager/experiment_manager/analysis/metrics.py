@@ -21,10 +21,10 @@ from ..experiment_file import (
     ExperimentFile,
     GRIPPER_KEYS,
     GRIPPER_SWEEP,
-    MAX_ITERATIONS,
     MM,
     TABLE_SWEEP,
 )
+from . import decisions
 
 # The physics faults an iteration is flagged with (procedures.faults); the first three leave it
 # out of the figures.
@@ -79,20 +79,6 @@ def rate_interval(successes, n, confidence: float = 0.95):
     return (float(low), float(high)) if not low.shape else (low, high)
 
 
-def iterations_to_decide(successes: int, n: int, rate: float, most: int = MAX_ITERATIONS
-                         ) -> int | None:
-    """The fewest iterations, more than n, whose rate_interval would lie wholly at or above
-    `rate` or wholly below it if the rate seen so far held (successes / n of them succeeding,
-    rounded); None when no count up to `most` would (a rate seen at the requirement itself)
-    or n = 0."""
-    if n == 0:
-        return None
-    m = np.arange(n + 1, most + 1)
-    low, high = rate_interval(np.round(successes / n * m), m)
-    decided = np.flatnonzero((low >= rate) | (high < rate))
-    return int(m[decided[0]]) if decided.size else None
-
-
 def _fractions(rows: list[dict]) -> dict:
     out = {}
     for stage in ('candidates', 'placeable', 'container_free', 'valid'):
@@ -116,11 +102,16 @@ def bin_static(exp: Experiment, rows: list[dict]) -> dict:
             'best_bin_mm': bins[best]['size_mm'] if best is not None else None}
 
 
-def bin_emptying(exp: Experiment, rows: list[dict], picks: list[dict]) -> dict:
-    """Table 2, with `emptied_ci95`: the 95 % interval of the share of bins emptied."""
+def bin_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
+                 picks: list[dict]) -> dict:
+    """Table 2, with `emptied_ci95`: the 95 % interval of the share of bins emptied, and
+    `decision`: that share against requirements.success_rate on its one-sided bounds
+    (decisions.rate)."""
     first = rows[0] if rows else None
     emptied = sum(bool(r['emptied']) for r in rows)
-    return {'iterations': len(rows), 'parts': exp.parts,
+    decision = decisions.rate(emptied, len(rows), file.requirements.success_rate,
+                              'bins emptied')
+    return {'iterations': len(rows), 'parts': exp.parts, 'decision': decision.as_dict(),
             'bin_mm': [round(first[k] * 1000, 6) for k in ('container_x', 'container_y',
                                                              'container_z')] if first else None,
             'emptied': emptied, 'emptied_ci95': list(rate_interval(emptied, len(rows))),
@@ -218,7 +209,10 @@ def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
     """`emptied`: runs that emptied the feeder and the table; `accepted`: of them, those that
     spilled at most requirements.max_spilled_parts over the tray's walls, and `accepted_ci95`
     the 95 % interval of that share of the runs (rate_interval); `parts_per_hour`: the cell's
-    throughput per run that picked (cell_throughput) and its 95 % interval (interval)."""
+    throughput per run that picked (cell_throughput) and its 95 % interval (interval);
+    `decision`: the table's grounds (decisions.py), `time` (the cell's time to empty a refill
+    against the refill interval) and `spills` (parts spilled per refill against
+    requirements.max_spilled_parts)."""
     emptied = [r for r in rows if r['emptied']]
     hourly = throughputs(file.cell, rows)
     tolerated = file.requirements.max_spilled
@@ -236,7 +230,18 @@ def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
                                                                             for r in rows})},
             'minutes_per_vibration_allowed': per_vibration,
             'parts_per_hour': stats(hourly), 'parts_per_hour_ci95': list(interval(hourly)),
-            'cell': {'pick_s': file.cell.pick_time, 'image_s': file.cell.image_time}}
+            'cell': {'pick_s': file.cell.pick_time, 'image_s': file.cell.image_time},
+            'decision': {name: d.as_dict() for name, d in table_grounds(file, rows).items()}}
+
+
+def table_grounds(file: ExperimentFile, rows: list[dict],
+                  confidence: float = decisions.CONFIDENCE) -> dict[str, decisions.Decision]:
+    """The vibrating table's grounds from its feeder runs (`rows`, typed, left-out ones
+    removed): the cell's time to empty a refill, and the spills."""
+    runs = decisions.feeder_runs(rows, file.cell)
+    r = file.requirements
+    return {'time': decisions.table_time(runs, r.refill_interval, r.success_rate, confidence),
+            'spills': decisions.spills(runs, r.max_spilled, confidence)}
 
 
 def throughputs(cell, rows: list[dict]) -> list[float]:
@@ -325,7 +330,7 @@ def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: li
     if exp.type == BIN_STATIC:
         out = bin_static(exp, rows)
     elif exp.type == BIN_EMPTYING:
-        out = bin_emptying(exp, rows, picks)
+        out = bin_emptying(file, exp, rows, picks)
     elif exp.type == TABLE_SWEEP:
         out = table_sweep(file, exp, rows)
     elif exp.type == GRIPPER_SWEEP:

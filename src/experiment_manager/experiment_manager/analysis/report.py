@@ -191,6 +191,15 @@ def _sizes(given: dict | None, lead: str) -> str:
     return lead + ', '.join(size(k, v) for k, v in given.items())
 
 
+def _bound(ground: dict) -> str:
+    """A ground's bound as read: a time in minutes, a share in per cent, else a number."""
+    if ground['quantity'].startswith('time'):
+        return f'{ground["bound"] / 60:.1f} min (refill interval {ground["refill_s"] / 60:g} min)'
+    if ground['quantity'].startswith('share'):
+        return pct(ground['bound'])
+    return fmt(ground['bound'])
+
+
 def markdown(summary: dict, spec: dict, figures: dict[str, bool],
              pictures: dict[str, str] | None = None, account: list[str] | None = None) -> str:
     """The report as Markdown. pictures: {image file: caption} (pictures.py); account: the
@@ -207,9 +216,18 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
              f'{fmt(r["refill_interval_h"])} h (capacity {r["capacity"]} parts), no bin longer '
              f'than {fmt(r["max_dimension_mm"])} mm in any dimension (every bin analysed '
              'meets it: the experiment file refuses others).', '', '## Verdict', '']
+    decided = verdicts(summary)
     lines += table(['option', 'verdict', 'why'],
                     [[v['option'], f'**{v["verdict"]}**', '; '.join(v['reasons'])]
-                     for v in verdicts(summary)])
+                     for v in decided])
+    grounds = [[v['option'], name, g['quantity'], g['verdict'],
+                '' if g['bound'] is None else _bound(g), g['interval'], g['runs']]
+               for v in decided for name, g in v.get('grounds', {}).items()]
+    if grounds:
+        lines += ['', 'What each verdict rests on (the bound it was decided on; a ground '
+                  'UNDECIDED is not settled by the runs so far):', '']
+        lines += table(['option', 'ground', 'quantity', 'says', 'bound', 'interval', 'runs'],
+                       grounds)
     if account:
         lines += ['', '## The part', '', 'As the run saw it (the file, its frame, what the '
                   'physics and the checks collide, what each grasp closes on):', '']

@@ -2,28 +2,31 @@
 and, for the paper's test-case files, the paper's findings checked on the run (against_paper).
 Rendering them is report.py's job.
 
-Verdicts, per option, each resting on a rate with its 95 % interval (metrics.rate_interval):
+Verdicts, per option, each resting on what its runs measure, bounded one-sidedly where the
+requirement is one-sided (decisions.py; the bounds are computed with the metrics, metrics.py,
+and kept in summary.json as each experiment's `decision`):
 - static bin: the share of `bin_emptying` iterations that emptied the bin, against
-  requirements.success_rate; and the bin must hold a refill interval's parts
-  (requirements.parts_per_hour x refill_interval_h);
-- vibrating table: the share of `feeder_emptying` runs that emptied the feeder spilling no
-  more than requirements.max_spilled_parts over the tray's walls, against
-  requirements.success_rate; the feeder must hold a refill interval's parts; and the cell's
-  throughput (its 95 % interval) must reach requirements.parts_per_hour; the report gives
-  the time per vibration the refill interval leaves;
+  requirements.success_rate (one-sided 95 % exact bounds); and the bin must hold a refill
+  interval's parts (requirements.parts_per_hour x refill_interval_h);
+- vibrating table, on two grounds: the cell's time to empty a refill (picks, images, the
+  table's simulated feeds and vibrations; a run that did not empty is over) against the
+  refill interval, for requirements.success_rate of refills at 95 % confidence (a one-sided
+  tolerance bound, lognormal, with a distribution-free one beside it); and the parts spilled
+  per refill against requirements.max_spilled_parts; the feeder must hold a refill interval's
+  parts. FEASIBLE when every ground is, NOT FEASIBLE when one is, else UNDECIDED, saying
+  which grounds are settled;
 - gripper (one per gripper_sweep): the smallest gripper of the sweep whose valid parts per
   check reach the experiment's min_valid at 95 % confidence; not feasible when every
   gripper's interval lies below min_valid.
-A rate decides only where its interval clears the requirement (feasible) or lies below it
-(not feasible); otherwise the verdict is UNDECIDED, with the iterations that would decide if
-the rate seen held. Iterations left out of the figures (a NaN state, a tunnelled or a thrown
-part) make no option feasible.
+Iterations left out of the figures (a NaN state, a tunnelled or a thrown part) make no option
+feasible.
 An option whose experiment did not run is "not analysed".
 """
 
 import numpy as np
 
-from .metrics import EXCLUDED, FAULTS, iterations_to_decide
+from . import decisions
+from .metrics import EXCLUDED, FAULTS
 from .wording import count, dims, fmt, gripper_label, of_type, pct, table
 
 # The paper's results (section 5) for its test case, by experiment-file id.
@@ -55,30 +58,39 @@ _STOPS = {'stop: empty': 'feeder and table empty', 'stop: vibration limit': 'vib
 def verdicts(summary: dict) -> list[dict]:
     """The decision per option: option, verdict, and the reasons (for people)."""
     capacity = summary['requirements']['capacity']
-    required = summary['requirements']['success_rate']
     out = []
     emptying = of_type(summary, 'bin_emptying')
     if emptying:
         _, s = emptying[-1]
-        verdict, rate = _rate_verdict(s['emptied'], s['iterations'], s['emptied_ci95'],
-                                      required, 'bins emptied')
-        reasons = [rate, f'parts removed per bin: mean {fmt(s["removed"]["mean"])}, max '
-                         f'{fmt(s["removed"]["max"])} of {s["parts"]}']
+        decision = s['decision']
+        verdict = decision['verdict']
+        reasons = [decision['reason'] + _more(decision, summary['requirements']['success_rate']),
+                   f'parts removed per bin: mean {fmt(s["removed"]["mean"])}, max '
+                   f'{fmt(s["removed"]["max"])} of {s["parts"]}']
         verdict, reasons = _decided(verdict, reasons, s, None if s['parts'] >= capacity else
                                     f'the bin was filled with {s["parts"]} parts, fewer than '
                                     f'the {capacity} a refill interval needs')
         out.append({'option': f'static bin {dims(s["bin_mm"])} mm', 'verdict': verdict,
-                    'reasons': reasons})
+                    'reasons': reasons, 'grounds': {'emptied': decision}})
     else:
         out.append({'option': 'static bin', 'verdict': NOT_ANALYSED,
                     'reasons': ['no bin_emptying experiment in the file']})
     feeder = of_type(summary, 'feeder_emptying')
     if feeder:
         _, s = feeder[-1]
+        grounds = s['decision']
+        time, spills = grounds['time'], grounds['spills']
+        verdict = (NOT_FEASIBLE if NOT_FEASIBLE in (time['verdict'], spills['verdict']) else
+                   FEASIBLE if time['verdict'] == spills['verdict'] == FEASIBLE else UNDECIDED)
+        settled = [f'{name} {g["verdict"]}' for name, g in grounds.items()
+                   if g['verdict'] != UNDECIDED]
+        open_ = [name for name, g in grounds.items() if g['verdict'] == UNDECIDED]
         v = s['vibrations_to_empty']
-        verdict, rate = _rate_verdict(s['accepted'], s['iterations'], s['accepted_ci95'],
-                                      required, 'feeder runs emptied within the spill limit')
-        reasons = [rate, f'{s["emptied"]} of {s["iterations"]} feeder runs emptied '
+        reasons = [time['reason'] + _more(time, summary['requirements']['success_rate']),
+                   spills['reason'],
+                   'grounds settled: ' + (', '.join(settled) or 'none')
+                   + ('; not settled: ' + ', '.join(open_) if open_ else ''),
+                   f'{s["emptied"]} of {s["iterations"]} feeder runs emptied '
                    f'(optimal range {s["optimal_range"][0]}-{s["optimal_range"][1]} parts on '
                    f'the table; runs ended by: '
                    f'{", ".join(f"{_STOPS.get(k, k)} {n}" for k, n in s["stops"].items())})']
@@ -86,17 +98,17 @@ def verdicts(summary: dict) -> list[dict]:
             reasons.append(f'vibrations to empty the feeder: mean {fmt(v["mean"], 4)}; the '
                            f'refill interval allows one vibration every '
                            f'{fmt(s["minutes_per_vibration_allowed"])} min')
-        verdict, reasons = _throughput(verdict, reasons, s, summary['requirements'])
-        spilled = s['physics']['spilled']
-        if spilled:
-            reasons.append(f'{count(spilled, "part")} spilled over the tray\'s walls, in '
-                           f'{s["runs_spilling"]} runs; a run may spill {s["max_spilled"]} '
-                           f'(requirements.max_spilled_parts): {s["accepted"]} of the '
-                           f'{s["emptied"]} emptied runs met it')
+        rate = s.get('parts_per_hour') or {}
+        if rate.get('mean') is not None:
+            reasons.append(f'the cell would pick {fmt(rate["mean"], 4)} parts per hour on '
+                           f'average, at {fmt(s["cell"]["pick_s"])} s per pick and '
+                           f'{fmt(s["cell"]["image_s"])} s per image (cell.pick_s, '
+                           'cell.image_s) and the simulated time of the feeds and vibrations')
         verdict, reasons = _decided(verdict, reasons, s, None if s['parts'] >= capacity else
                                     f'the feeder held {s["parts"]} parts, fewer than the '
                                     f'{capacity} a refill interval needs')
-        out.append({'option': 'vibrating table', 'verdict': verdict, 'reasons': reasons})
+        out.append({'option': 'vibrating table', 'verdict': verdict, 'reasons': reasons,
+                    'grounds': grounds})
     else:
         out.append({'option': 'vibrating table', 'verdict': NOT_ANALYSED,
                     'reasons': ['no feeder_emptying experiment in the file']})
@@ -117,49 +129,19 @@ def _decided(verdict: str, reasons: list[str], s: dict,
     return verdict, first + reasons + ([] if left_out else faults)
 
 
-def _throughput(verdict: str, reasons: list[str], s: dict,
-                requirements: dict) -> tuple[str, list[str]]:
-    """A feeder option's verdict and reasons after its cell's throughput (the parts per hour
-    that its picks, feeds and vibrations allow) against requirements.parts_per_hour: not
-    feasible where the 95 % interval lies below it (that reason first), undecided where a
-    feasible verdict's interval reaches below it or there is none (one run); said either
-    way."""
-    rate, (low, high) = s.get('parts_per_hour'), s.get('parts_per_hour_ci95', (None, None))
-    if not rate or rate['mean'] is None:
-        return verdict, reasons
-    required = requirements['parts_per_hour']
-    cell = s['cell']
-    text = (f'the cell would pick {fmt(rate["mean"], 4)} parts per hour'
-            + (f' (95 % interval {fmt(low, 4)} to {fmt(high, 4)})' if low is not None else '')
-            + f'; required {fmt(required)} (requirements.parts_per_hour), at '
-            f'{fmt(cell["pick_s"])} s per pick and {fmt(cell["image_s"])} s per image '
-            '(cell.pick_s, cell.image_s) and the simulated time of the feeds and vibrations')
-    if high is not None and high < required:
-        return NOT_FEASIBLE, [text] + reasons
-    if verdict == FEASIBLE and (low is None or low < required):
-        return UNDECIDED, reasons + [f'not enough runs to decide: {text}']
-    return verdict, reasons + [text]
-
-
-def _rate_verdict(successes: int, n: int, ci95: list, required: float,
-                  what: str) -> tuple[str, str]:
-    """The verdict a rate supports, `successes` of `n` with its 95 % interval `ci95`, against
-    the `required` share, and the sentence that says why."""
-    seen = f'{successes} of {n} {what}'
-    if not n:
-        return UNDECIDED, f'{seen}: no iteration to decide on'
-    low, high = ci95
-    evidence = (f'{seen}, 95 % interval {pct(low)} to {pct(high)}; required '
-                f'{pct(required)} (requirements.success_rate)')
-    if low >= required:
-        return FEASIBLE, evidence
-    if high < required:
-        return NOT_FEASIBLE, evidence
-    more = iterations_to_decide(successes, n, required)
-    return UNDECIDED, (f'not enough iterations to decide: {evidence}; '
-                       + (f'{more} iterations would decide if the rate seen held'
-                          if more else 'no number of iterations would decide at the rate '
-                          'seen, which is the requirement itself'))
+def _more(decision: dict, required: float) -> str:
+    """For an unsettled ground, what would settle it."""
+    if decision['verdict'] != UNDECIDED:
+        return ''
+    if 'successes' in decision:         # a rate
+        more = decisions.iterations_to_decide(decision['successes'], decision['runs'],
+                                              required)
+        return ('; not settled: ' + (f'{more} iterations would settle it if the rate seen held'
+                                     if more else 'no number of iterations would at the rate '
+                                     'seen, which is the requirement itself'))
+    if decision['runs'] < 3:
+        return '; not settled: 3 runs give the fitted bound'
+    return '; not settled: more runs narrow the bound (run --adaptive runs until it is settled)'
 
 
 def _gripper_verdict(exp_id: str, s: dict) -> dict:

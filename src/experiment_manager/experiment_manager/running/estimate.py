@@ -2,33 +2,43 @@
 
 Iterations of different experiments differ a hundredfold in cost (a 60-part sweep drop against
 a feeder run of hundreds of vibrations), so the iterations left are weighed, not counted: an
-iteration costs its cost units (its parts, times its grippers in a gripper_sweep, times its
-type's weight) at the seconds per unit that the finished iterations of its experiment took;
-before one of them has finished, at the rate of its type's finished iterations, and before any
-of its type, at the rate of all. Counting iterations instead said 0:00:00 at 44 of 46
-iterations, before two feeder runs that took 31 s (issue 23).
+iteration costs its cost units (its parts, times its grippers in a gripper_sweep) at the
+seconds per unit that the finished iterations of its experiment took; before one of them has
+finished, at its type's measured rate on this project's machine (PRIOR), scaled by how much
+faster or slower the run's finished iterations went than their own types' PRIOR said (this
+machine, this part); before any iteration has finished, at PRIOR itself. An iteration is not
+split between workers: the time left is at least the dearest iteration left. Counting
+iterations said 0:00:00 at 44 of 46 iterations, before two feeder runs that took 31 s (issue
+23); a feeder run weighed at 200 sweep parts a part (a file whose feeder vibrated to its
+limit) said 0:06:19 at 18 s into PTH2's reduced run, which ended at 1:46 (issue 43).
 """
 
 from collections.abc import Iterable
 
 import numpy as np
 
-from ..experiment_file import Experiment, FEEDER_EMPTYING, GRIPPER_SWEEP, TABLE_SWEEP
+from ..experiment_file import (
+    BIN_EMPTYING,
+    BIN_STATIC,
+    Experiment,
+    FEEDER_EMPTYING,
+    GRIPPER_SWEEP,
+    TABLE_SWEEP,
+)
 
-# A type's cost per part against the others', for an experiment whose type has no finished
-# iteration yet. The built-in file's run (2026-11-25, 2 workers, iterations.csv wall_time /
-# parts): feeder runs 1.53 s per part (they vibrate to their limit), every other type 0.007 to
-# 0.012 s. Without it, at 44 of 51 iterations the estimate said 7 s before two feeder runs of
-# 92 s each.
-TYPE_WEIGHT = {FEEDER_EMPTYING: 200.0}
+# Seconds per cost unit of each type, measured: the reduced test case (make run before issue
+# 43, pth0/1/2.yaml with one iteration each, 2 workers on the project's 2-core machine,
+# 2026-11-27), iterations.csv wall_time over parts: sweep 149 s over 15,150 parts, static bins
+# 360 s over 11,760, emptying 42 s over 1,200, feeder runs 225 s over 1,200; gripper_sweep
+# from the small test file's run (0.1 s over 28 parts x 8 grippers).
+PRIOR = {TABLE_SWEEP: 0.0098, BIN_STATIC: 0.031, BIN_EMPTYING: 0.035, FEEDER_EMPTYING: 0.19,
+         GRIPPER_SWEEP: 0.00045}
 
 
 def units(exp: Experiment, parts: float) -> float:
     """The cost units of one iteration of `exp` with `parts` parts: its parts, times its
-    grippers x grasp sets for a gripper_sweep (each checks the scene once), times its type's
-    weight."""
-    return (parts * (len(exp.variants) if exp.type == GRIPPER_SWEEP else 1)
-            * TYPE_WEIGHT.get(exp.type, 1.0))
+    grippers x grasp sets for a gripper_sweep (each checks the scene once)."""
+    return parts * (len(exp.variants) if exp.type == GRIPPER_SWEEP else 1)
 
 
 def mean_units(exp: Experiment) -> float:
@@ -47,23 +57,22 @@ class Costs:
         _, s, u = self._done.get(exp.id, (exp, 0.0, 0.0))
         self._done[exp.id] = (exp, s + seconds, u + units(exp, parts))
 
-    def _rate(self, exp: Experiment) -> float | None:
-        """Seconds per cost unit for `exp`: its own, its type's, everyone's; None if none ran."""
-        for chosen in ([v for k, v in self._done.items() if k == exp.id],
-                       [v for v in self._done.values() if v[0].type == exp.type],
-                       list(self._done.values())):
-            u = sum(v[2] for v in chosen)
+    def _rate(self, exp: Experiment) -> float:
+        """Seconds per cost unit for `exp`: its own; else its type's PRIOR times the run's
+        speed against PRIOR so far (1 before anything finished)."""
+        if exp.id in self._done:
+            _, s, u = self._done[exp.id]
             if u > 0:
-                return sum(v[1] for v in chosen) / u
-        return None
+                return s / u
+        expected = sum(u * PRIOR[e.type] for e, _, u in self._done.values())
+        taken = sum(s for _, s, _ in self._done.values())
+        return PRIOR[exp.type] * (taken / expected if expected > 0 else 1.0)
 
     def left(self, iterations: Iterable[tuple[Experiment, int]], workers: int) -> float:
         """Seconds until `iterations` (experiment, iterations left) are done on `workers`
-        workers; 0 when nothing has finished yet (unknown)."""
-        total = 0.0
-        for exp, n in iterations:
-            rate = self._rate(exp) if n else 0.0
-            if rate is None:
-                return 0.0
-            total += n * rate * mean_units(exp)
-        return total / max(1, workers)
+        workers: their cost spread over the workers, and at least the dearest one."""
+        each = [(n, self._rate(exp) * mean_units(exp)) for exp, n in iterations if n]
+        if not each:
+            return 0.0
+        spread = sum(n * cost for n, cost in each) / max(1, workers)
+        return max(spread, max(cost for _, cost in each))

@@ -10,13 +10,13 @@ first iterations of the fixed-count run of the same file, and its figures are co
 them exactly as the fixed counts' (metrics.py).
 
 What settles each decision, looked at after every batch:
-- bin_emptying, feeder_emptying: the success rate (bins emptied; runs emptied within the spill
-  limit) against requirements.success_rate, as the verdict reads it (verdicts.py): settled when
-  its exact interval lies wholly at or above the requirement, or wholly below it; for
-  feeder_emptying the cell's throughput too (metrics.throughputs against
-  requirements.parts_per_hour): settled when its interval lies wholly below (NOT FEASIBLE
-  whatever the rate), and a rate above needs the throughput's interval wholly above. An
-  iteration left out of the figures (a physics fault) settles it too: the verdict is NOT
+- bin_emptying: the share of bins emptied against requirements.success_rate, on its
+  one-sided exact bounds, as the verdict reads it (decisions.rate): settled when the lower
+  bound reaches the requirement or the upper bound lies below it.
+- feeder_emptying: the table's grounds as the verdict reads them (metrics.table_grounds): the
+  cell's time to empty a refill against the refill interval (its tolerance bound) and the
+  spills; settled when one ground is NOT FEASIBLE or every ground FEASIBLE. An iteration left
+  out of the figures (a physics fault) settles bins and feeder too: the verdict is NOT
   FEASIBLE then.
 - bin_static, a race: a bin leaves it when the interval of its mean container-free fraction lies
   wholly below the interval of the leading bin's (the highest mean). The race ends with one bin
@@ -34,14 +34,15 @@ What settles each decision, looked at after every batch:
 
 Looking again and again at the same growing sample and stopping at the first clear interval
 would make a 95 % interval wrong more often than 1 in 20. So a look before the last uses
-INTERIM_CONFIDENCE (99.9 %) intervals, and only the last look, at the most iterations, the 95 %
-ones every figure reports: the Haybittle-Peto rule of clinical trials (Haybittle 1971, Peto et
-al. 1976). With L looks the chance of a wrong early stop is at most L x 0.1 %.
+INTERIM_CONFIDENCE (99.9 %) intervals and bounds, and only the last look, at the most
+iterations, the 95 % ones every figure reports: the Haybittle-Peto rule of clinical trials
+(Haybittle 1971, Peto et al. 1976). With L looks the chance of a wrong early stop is at most
+L x 0.1 %.
 """
 
 import numpy as np
 
-from ..analysis import metrics
+from ..analysis import decisions, metrics
 from ..experiment_file import (
     BIN_EMPTYING,
     BIN_STATIC,
@@ -74,37 +75,20 @@ def unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict],
         kept_keys = {(r['group'], r['iteration']) for r in kept}
         return [] if _smallest_settled(exp, [c for c in checks if (c['group'], c['iteration'])
                                              in kept_keys]) else groups(exp)
-    required = file.requirements
     if exp.type == BIN_EMPTYING:
         successes = sum(bool(r['emptied']) for r in kept)
-        return [] if rate_settled(successes, len(kept), required.success_rate) else groups(exp)
-    successes = sum(bool(r['emptied']) and r['spilled'] <= required.max_spilled for r in kept)
-    return [] if _feeder_settled(file, successes, kept) else groups(exp)
-
-
-def _feeder_settled(file: ExperimentFile, successes: int, rows: list[dict]) -> bool:
-    """The table's verdict is known: its rate of runs emptied within the spill limit lies
-    wholly below the required share, or the interval of its throughput wholly below the
-    required parts per hour (either makes it NOT FEASIBLE), or the rate lies wholly at or above
-    the share and the throughput's interval at or above the parts per hour."""
-    required = file.requirements
-    if not rows:
-        return False
-    low, high = metrics.rate_interval(successes, len(rows), INTERIM_CONFIDENCE)
-    least, most = metrics.interval(metrics.throughputs(file.cell, rows), INTERIM_CONFIDENCE)
-    if high < required.success_rate or (most is not None and most < required.parts_per_hour):
-        return True
-    return low >= required.success_rate and least is not None and (
-        least >= required.parts_per_hour)
+        return [] if rate_settled(successes, len(kept), file.requirements.success_rate) \
+            else groups(exp)
+    grounds = metrics.table_grounds(file, kept, INTERIM_CONFIDENCE)
+    return [] if decisions.combined(list(grounds.values())) != decisions.UNDECIDED \
+        else groups(exp)
 
 
 def rate_settled(successes: int, n: int, required: float,
                  confidence: float = INTERIM_CONFIDENCE) -> bool:
-    """The rate's exact interval lies wholly at or above `required`, or wholly below it."""
-    if n == 0:
-        return False
-    low, high = metrics.rate_interval(successes, n, confidence)
-    return low >= required or high < required
+    """The rate's one-sided exact bounds at `confidence` put it at or above `required`, or
+    below it (decisions.rate)."""
+    return decisions.rate(successes, n, required, '', confidence).verdict != decisions.UNDECIDED
 
 
 def _racing(exp: Experiment, rows: list[dict]) -> list[int]:

@@ -35,7 +35,7 @@ class Progress:
     done: int
     total: int
     elapsed: float          # s
-    eta: float              # s, 0 when unknown (estimate.py: the iterations left, weighed)
+    eta: float              # s (estimate.py: the iterations left, weighed); 0 when none left
 
 
 class Sink(Protocol):

@@ -1,0 +1,117 @@
+"""The table's verdict on few feeder runs against the verdict on many (issue 43, item 3).
+
+Two steps:
+  tools/ws python -m bench.experiment.feeder_decisions files DIR
+writes DIR/feeder_pth0.yaml, feeder_pth1.yaml, feeder_pth2.yaml: the test case's parts,
+grippers and requirements (config/test_case/pth*.yaml) with one experiment, 50 feeder runs at
+the optimal range of the full-count sweeps (n* 72, 45 and 54, +-5: docs/paper-test-case.md),
+to be run through the graph:
+  tools/ws install/experiment_manager/lib/experiment_manager/run --output DIR/runs DIR/*.yaml
+and then
+  tools/ws python -m bench.experiment.feeder_decisions table RUN_DIR... [--draws 2000]
+reads each run's iterations.csv and prints, per part, the verdict on all its runs, then, for
+subsamples of 3, 5, 8 and 12 runs drawn without replacement `--draws` times, how often the
+verdict on the subsample agrees with the full data's, how often it says FEASIBLE where the
+full data does not (false FEASIBLE), and how often it is UNDECIDED; and the same for a
+borderline refill interval (the full data's 90 % tolerance bound itself), where the verdict
+should say UNDECIDED more than anything else.
+"""
+
+import argparse
+import os
+import sys
+
+from experiment_manager import experiment_file
+from experiment_manager.analysis import decisions
+from experiment_manager.analysis.results import read_csv
+import numpy as np
+import yaml
+
+from ..paper_case import TEST_CASE
+
+# the full-count sweeps' n* (docs/paper-test-case.md, "In short") and the files' margin
+N_STAR = {'pth0': 72, 'pth1': 45, 'pth2': 54}
+MARGIN = 5
+RUNS = 50
+SIZES = (3, 5, 8, 12)
+
+
+def write_files(directory: str) -> list[str]:
+    os.makedirs(directory, exist_ok=True)
+    paths = []
+    for part, n_star in N_STAR.items():
+        with open(os.path.join(TEST_CASE, f'{part}.yaml'), encoding='utf-8') as f:
+            data = yaml.safe_load(f)
+        feeder = next(e for e in data['experiments'] if e['type'] == 'feeder_emptying')
+        feeder.update(iterations=RUNS, optimal_range=[n_star - MARGIN, n_star + MARGIN])
+        data['experiments'] = [feeder]
+        data['id'] = f'feeder_{part}'
+        path = os.path.join(directory, f'feeder_{part}.yaml')
+        with open(path, 'w', encoding='utf-8') as f:
+            f.write(f'# {RUNS} feeder runs of {part} at n* {n_star} +- {MARGIN} '
+                    '(bench/experiment/feeder_decisions.py)\n')
+            yaml.safe_dump(data, f, sort_keys=False)
+        paths.append(path)
+    return paths
+
+
+def _decide(runs: list[dict], file, refill: float) -> str:
+    """The table's verdict on `runs` at a refill interval of `refill`, s, as a run's verdict
+    reads it (its time and spill grounds)."""
+    r = file.requirements
+    return decisions.combined([decisions.table_time(runs, refill, r.success_rate),
+                               decisions.spills(runs, r.max_spilled)])
+
+
+def table(run_dirs: list[str], draws: int, seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    print(f'{draws} subsamples drawn without replacement per size; false FEASIBLE: FEASIBLE '
+          'where all runs do not say FEASIBLE')
+    for run_dir in run_dirs:
+        file = experiment_file.load(os.path.join(run_dir, 'experiment.yaml'))
+        runs = decisions.feeder_runs(read_csv(os.path.join(run_dir, 'iterations.csv')),
+                                     file.cell)
+        refill = file.requirements.refill_interval
+        full = decisions.table_time(runs, refill, file.requirements.success_rate)
+        print(f'\n{file.id}: {len(runs)} runs, time to empty '
+              f'{min(r["time"] for r in runs) / 60:.1f}-{max(r["time"] for r in runs) / 60:.1f}'
+              f' min; all runs: {full.verdict} ({full.reason})')
+        # borderline: the interval at the full data's estimate of the 90 % quantile (its
+        # bound lies past it, its lower bound before it: UNDECIDED on all the runs)
+        fit = full.detail.get('lognormal')
+        border = fit['estimate'] if fit else float(np.quantile([r['time'] for r in runs], 0.9))
+        for label, interval in (('refill interval', refill), ('borderline', border)):
+            truth = _decide(runs, file, interval)
+            print(f'  {label} {interval / 60:.1f} min: all {len(runs)} runs say {truth}')
+            print('    runs | agree | false FEASIBLE | UNDECIDED | NOT FEASIBLE')
+            for size in SIZES:
+                said = [_decide([runs[i] for i in rng.choice(len(runs), size, replace=False)],
+                                file, interval) for _ in range(draws)]
+                agree = np.mean([s == truth for s in said])
+                false = np.mean([s == decisions.FEASIBLE and truth != decisions.FEASIBLE
+                                 for s in said])
+                undecided = np.mean([s == decisions.UNDECIDED for s in said])
+                infeasible = np.mean([s == decisions.NOT_FEASIBLE for s in said])
+                print(f'    {size:4d} | {agree:5.1%} | {false:14.1%} | {undecided:9.1%} | '
+                      f'{infeasible:.1%}')
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    sub = parser.add_subparsers(dest='command', required=True)
+    files = sub.add_parser('files')
+    files.add_argument('directory')
+    tab = sub.add_parser('table')
+    tab.add_argument('run_dirs', nargs='+')
+    tab.add_argument('--draws', type=int, default=2000)
+    tab.add_argument('--seed', type=int, default=43)
+    args = parser.parse_args(argv)
+    if args.command == 'files':
+        print('\n'.join(write_files(args.directory)))
+    else:
+        table(args.run_dirs, args.draws, args.seed)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

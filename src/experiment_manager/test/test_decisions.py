@@ -1,0 +1,71 @@
+"""Decisions on what the runs measure (analysis/decisions.py): the one-sided bounds against
+their published values and their own promise (coverage), on made-up data."""
+
+import math
+
+from experiment_manager.analysis import decisions
+import numpy as np
+import pytest
+
+
+def test_the_tolerance_factor_is_the_published_one():
+    # NIST/SEMATECH e-Handbook 7.2.6.3 (one-sided, 90 % coverage, 95 % confidence):
+    # n = 10: 2.355; n = 20: 1.926 (Krishnamoorthy and Mathew, Table B1: n = 3: 6.158)
+    assert decisions.k_factor(10, 0.9) == pytest.approx(2.355, abs=2e-3)
+    assert decisions.k_factor(20, 0.9) == pytest.approx(1.926, abs=2e-3)
+    assert decisions.k_factor(3, 0.9) == pytest.approx(6.158, abs=5e-3)
+
+
+def test_the_lognormal_bound_covers_the_quantile_as_often_as_it_promises():
+    """Drawn from a known lognormal, the 95 % upper bound of the 90 % quantile lies above the
+    true quantile in 95 % of samples, whatever the sample's size."""
+    rng = np.random.default_rng(43)
+    mu, sigma = math.log(1200.0), 0.3
+    quantile = math.exp(mu + 1.2815515655446004 * sigma)
+    for n in (3, 5, 12):
+        covered = []
+        for _ in range(2000):
+            runs = [{'time': t, 'spilled': 0} for t in rng.lognormal(mu, sigma, n)]
+            fit = decisions.table_time(runs, 1e9, 0.9).detail['lognormal']
+            covered.append(fit['upper'] >= quantile)
+        assert 0.93 <= np.mean(covered) <= 0.97, (n, np.mean(covered))
+
+
+def test_the_time_ground_decides_on_the_bound_and_says_which():
+    runs = [{'time': t, 'spilled': 0} for t in (1000.0, 1010.0, 1030.0)]
+    far = decisions.table_time(runs, 14400.0, 0.9)
+    assert far.verdict == decisions.FEASIBLE and far.runs == 3
+    assert far.interval == 'one-sided 95 % tolerance bound, lognormal'
+    assert 1030.0 < far.bound < 14400.0
+    assert decisions.table_time(runs, 900.0, 0.9).verdict == decisions.NOT_FEASIBLE
+    near = decisions.table_time(runs, 1040.0, 0.9)     # past the runs, inside the bound
+    assert near.verdict == decisions.UNDECIDED
+    # two runs: no fitted bound; the distribution-free one needs 29 runs all within
+    two = decisions.table_time(runs[:2], 14400.0, 0.9)
+    assert two.verdict == decisions.UNDECIDED and 'fewer than 3 runs' in two.reason
+    assert decisions.binomial_bounds(0, 29)[1] < 0.1 <= decisions.binomial_bounds(0, 28)[1]
+    # a run that did not empty: over the interval, the distribution-free bound alone
+    stuck = runs + [{'time': math.inf, 'spilled': 0}]
+    said = decisions.table_time(stuck, 14400.0, 0.9)
+    assert said.interval == 'one-sided 95 % distribution-free (binomial)'
+    assert said.verdict == decisions.UNDECIDED and said.detail['over'] == 1
+
+
+def test_spills_are_a_rate_or_a_count_that_must_be_zero():
+    clean = [{'time': 1.0, 'spilled': 0}] * 10
+    assert decisions.spills(clean, 0).verdict == decisions.FEASIBLE
+    assert decisions.spills(clean[:9] + [{'time': 1.0, 'spilled': 1}], 0).verdict == \
+        decisions.NOT_FEASIBLE
+    # at a limit of 1 per refill: none in 10 runs bounds the rate at 3.0 / 10 (Garwood)
+    rate = decisions.spills(clean, 1)
+    assert rate.verdict == decisions.FEASIBLE and rate.bound == pytest.approx(0.2996, abs=1e-3)
+    assert decisions.spills(clean[:2], 1).verdict == decisions.UNDECIDED   # 1.5 per refill
+    many = [{'time': 1.0, 'spilled': 5}] * 10
+    assert decisions.spills(many, 1).verdict == decisions.NOT_FEASIBLE
+
+
+def test_a_rate_decides_on_its_one_sided_bounds():
+    assert decisions.rate(29, 29, 0.9, 'bins emptied').verdict == decisions.FEASIBLE
+    assert decisions.rate(28, 28, 0.9, 'bins emptied').verdict == decisions.UNDECIDED
+    assert decisions.rate(0, 2, 0.9, 'bins emptied').verdict == decisions.NOT_FEASIBLE
+    assert decisions.rate(0, 1, 0.9, 'bins emptied').verdict == decisions.UNDECIDED
