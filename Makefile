@@ -13,15 +13,19 @@ SOURCES := $(shell find src vendor -type f -not -path '*/__pycache__/*' -not -na
 # vendor/ packages (COLCON_IGNORE'd) built only where the environment lacks them: vendor/README.md
 VENDORED := $(if $(wildcard $(VENV)/share/tf2_msgs/package.xml /opt/ros/jazzy/share/tf2_msgs/package.xml),,vendor/tf2_msgs)
 PYTEST_ARGS ?=
-# The paper's test case (docs/paper-test-case.md), one iteration per bin, per n and per
-# feeder run; RUN_ARGS="$(TEST_CASE)" runs the full counts, RUN_ARGS="" the built-in small file.
+# The paper's test case (docs/paper-test-case.md). `make run` decides its first part, PTH0, on
+# three iterations per bin, per n and three feeder runs (the fewest that decide both options:
+# docs/decisions.md); RUN_ARGS="--iterations 3 $(TEST_CASE)" runs all three parts so,
+# RUN_ARGS="--adaptive $(TEST_CASE)" until each decision is settled, RUN_ARGS="" the built-in
+# small file.
 TEST_CASE := $(addprefix src/experiment_manager/config/test_case/,pth0.yaml pth1.yaml pth2.yaml)
-RUN_ARGS ?= --iterations 1 $(TEST_CASE)
+DEFAULT_RUN_ARGS := --iterations 3 src/experiment_manager/config/test_case/pth0.yaml
+RUN_ARGS ?= $(DEFAULT_RUN_ARGS)
 
 .PHONY: help run test test-loaded lint bench deps build lock clean
 
 help:
-	@echo "make run    - the paper's test case, reduced, through the graph (RUN_ARGS=\"file.yaml\")"
+	@echo "make run    - the paper's PTH0 decided through the graph (RUN_ARGS=\"file.yaml\")"
 	@echo 'make test   - lint and run every test (installs and builds on first use)'
 	@echo 'make test-loaded - make test three times with every CPU kept busy by other loops'
 	@echo 'make bench  - world, validity and vibration benchmarks (figures in the READMEs)'
@@ -51,6 +55,10 @@ build: $(BUILD_STAMP)
 
 run: $(BUILD_STAMP)
 	$(WS) install/experiment_manager/lib/experiment_manager/run $(RUN_ARGS)
+	@if [ "$(RUN_ARGS)" = "$(DEFAULT_RUN_ARGS)" ]; then \
+	  echo "the test case's other parts: make run RUN_ARGS=\"--iterations 3 $(word 2,$(TEST_CASE))\" (PTH1),"; \
+	  echo "  $(word 3,$(TEST_CASE)) (PTH2); all three until settled: make run RUN_ARGS=\"--adaptive $(TEST_CASE)\""; \
+	fi
 
 lint: $(DEPS_STAMP)
 	$(WS) ruff check src tests bench tools

@@ -6,7 +6,7 @@ import os
 
 from experiment_manager import experiment_file
 from experiment_manager.analysis import part_sheet, report
-from experiment_manager.analysis.results import ResultsWriter
+from experiment_manager.analysis.results import keep_part_file, ResultsWriter
 from experiment_manager.commands.run import main as run_main
 from experiment_manager.running.local_backend import LocalBackend
 from experiment_manager.running.scheduler import Runner
@@ -61,7 +61,12 @@ def test_the_example_runs_end_to_end(tmp_path):
          'optimal_range': [10, 20], 'max_vibrations': 60}]
     file = experiment_file.parse(yaml.safe_dump(data), EXAMPLE)
     with LocalBackend() as backend, ResultsWriter(str(tmp_path), file.text, False) as writer:
+        keep_part_file(file.part.mesh_path, file.path, str(tmp_path))
         summary = Runner(file, [backend], writer).run()
+    # the run directory reads on its own (run --resume, the pictures): the STEP file is kept
+    # where its experiment.yaml names it
+    again = experiment_file.load(str(tmp_path / 'experiment.yaml'))
+    assert again.part.mesh_path == str(tmp_path / 'TO-220-3_Vertical.step')
     sweep = summary['experiments']['sweep']
     assert sweep['n_star'] is not None
     feeder = summary['experiments']['feeder']

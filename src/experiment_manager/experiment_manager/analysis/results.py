@@ -1,7 +1,8 @@
 """Results files of a run, written as iterations finish.
 
 A run directory holds:
-- `experiment.yaml`: the experiment file as it was read;
+- `experiment.yaml`: the experiment file as it was read (and a mesh part's file beside it,
+  where it names it: `keep_part_file`);
 - `iterations.csv`: one row per iteration (rows.ITERATION_COLUMNS);
 - `checks.csv`: one row per validity check (rows.CHECK_COLUMNS);
 - `parts.csv`: one row per part per check, with its pose and stage (rows.PART_COLUMNS);
@@ -18,6 +19,7 @@ from collections.abc import Callable
 import csv
 import json
 import os
+import shutil
 import tempfile
 
 from pick_common.errors import InvalidArgument
@@ -26,6 +28,23 @@ from .rows import FILES, KEY, parse_row, Record
 
 UMASK = os.umask(0o022)
 os.umask(UMASK)
+def keep_part_file(mesh_path: str, experiment_path: str, directory: str) -> str:
+    """Copy a mesh part's file (`mesh_path`, absolute) into the run `directory` where its
+    experiment.yaml names it (relative to `experiment_path`, the file read), so that the
+    directory reads on its own: `run --resume`, the pictures, a review elsewhere. Returns the
+    copy's path; '' when the file names it by an absolute path or from above its own
+    directory (`../`), where the name reads as it is."""
+    if not mesh_path or not experiment_path:
+        return ''
+    relative = os.path.relpath(mesh_path, os.path.dirname(experiment_path))
+    if relative.startswith(os.pardir):
+        return ''
+    target = os.path.join(directory, relative)
+    os.makedirs(os.path.dirname(target), exist_ok=True)
+    shutil.copyfile(mesh_path, target)
+    return target
+
+
 def read_csv(path: str) -> list[dict]:
     """The rows of a results file, typed."""
     return [parse_row(r) for r in read_text_rows(path)]

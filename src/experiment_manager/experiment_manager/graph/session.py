@@ -15,7 +15,7 @@ import traceback
 from pick_common.errors import check_inside, InvalidArgument
 
 from ..analysis import part_sheet, report
-from ..analysis.results import ResultsWriter
+from ..analysis.results import keep_part_file, ResultsWriter
 from ..experiment_file import ExperimentFile, load
 from ..running.backend import Backend
 from ..running.scheduler import Progress, Runner
@@ -70,6 +70,8 @@ class RunSession:
             run_dir = run_directory(output_dir or file.output_dir, file.id)
         check_inside('output_dir', run_dir, self._output_dirs, 'output_dirs')
         self.writer = ResultsWriter(run_dir, file.text, resume)
+        if not resume:
+            keep_part_file(file.part.mesh_path, file.path, run_dir)
         self.recorder = self._open_recording(run_dir, resume)
 
     @property
