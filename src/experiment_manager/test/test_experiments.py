@@ -296,7 +296,8 @@ def test_two_workers_give_the_results_of_one_whatever_order_they_finish_in(small
     started: list[str] = []
     runner, got, written = run_on(workers, str(tmp_path / 'two'), started)
     assert got == summary and runner.lost_workers == []
-    assert workers[0].resets >= 1 and workers[1].resets > workers[0].resets
+    # both took work (how much each took depends on the machine's load: not asserted)
+    assert workers[0].resets >= 1 and workers[1].resets >= 1
     planned = [[r['experiment'], r['group'], r['iteration']] for r in read(directory,
                                                                            'iterations')]
     assert written != planned and sorted(written) == sorted(planned)

@@ -77,7 +77,7 @@ def test_the_example_runs_end_to_end(tmp_path):
     text = open(tmp_path / 'report.md', encoding='utf-8').read()
     assert '## The part' in text and 'TO-220-3_Vertical.step' in text
     assert 'mass centre at (2.54, 1.11, 8.86) mm in its frame' in text
-    assert ('9 convex piece(s) of 8, 14, 10, 10, 14, 22, 11, 14, 13 vertices, 496.6 mm^3 '
+    assert ('9 convex piece(s) of 11, 22, 17, 16, 17, 14, 14, 14, 25 vertices, 496.8 mm^3 '
             'together, +2.0 %') in text and 'cut into convex pieces by CoACD' in text
     assert '](part.png)' in text and os.path.getsize(tmp_path / 'part.png') > 10_000
     assert '## Why parts were turned down' in text and 'stops most' in text

@@ -95,7 +95,9 @@ class PartGeometry:
     primitives: the collision compound in the part frame.
     visual: the detailed mesh in the part frame, for display and volume.
     dimensions: the model parameters used, metres (built-ins) or empty (meshes).
-    center: centre of the collision compound's bounding box in the part frame, (3,) m.
+    center: the centre of the sphere that encloses the compound, (3,) m in the part frame:
+    a built-in's bounding-box centre, a mesh's mass centre (where the file's frame is, or how
+    it is turned, does not move it; spawning spaces parts by this sphere).
     radius: radius of a sphere about `center` that encloses the compound, m.
     volume: volume of the visual mesh (or of the hulls when it is not watertight), m^3.
     mass_frame: a mesh part's mass centre (3,) m and principal axes (4,) xyzw, in the part
@@ -273,7 +275,9 @@ def _finish(spec: PartSpec, dims: Mapping[str, float], mass: float,
             volume: float, mass_frame=None, collision_note: str = '') -> PartGeometry:
     corners = np.vstack([_primitive_mesh(p).bounds for p in collision])
     low, high = corners.min(axis=0), corners.max(axis=0)
-    center = (low + high) / 2
+    # a mesh's sphere about its mass centre: its bounding box would move with the file's axes
+    # (KiCad's TO-220 turned in its file spawned in a coarser grid, and 13 % fewer were valid)
+    center = (low + high) / 2 if mass_frame is None else np.asarray(mass_frame[0], dtype=float)
     points = np.vstack([_primitive_mesh(p).vertices for p in collision])
     radius = float(np.linalg.norm(points - center, axis=1).max())
     return PartGeometry(spec=spec, dimensions=dict(dims), mass=mass,

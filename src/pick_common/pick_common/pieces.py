@@ -12,7 +12,7 @@ Its settings, and where they come from:
   (`parts.MAX_MESH_HULLS`).
 - MAX_PIECE_VERTICES 64: CoACD's decimation cap (`max_ch_vertex`, default 256) lowered, because
   a 1,090-vertex hull made table drops 4 to 7 times slower (issue 42's measurement); a small
-  part's piece rarely needs more than a few dozen (TO-220: at most 22).
+  part's piece rarely needs more than a few dozen (TO-220: at most 25).
 - SEED 0: CoACD's search is random; a fixed seed makes it give the same pieces each time
   (checked: three runs of the TO-220, the same nine pieces; their order and vertex order
   vary, so `convex_pieces` sorts both).
@@ -80,7 +80,19 @@ def _decompose(body: trimesh.Trimesh) -> list[np.ndarray]:
 
 def convex_pieces(body: trimesh.Trimesh) -> list[np.ndarray]:
     """The vertex sets (each (K, 3) float64, in the body's frame) of CoACD's convex pieces of a
-    closed body, from the cache when it holds them."""
+    closed body. CoACD cuts along planes square to the frame's axes, so the body is cut in its
+    own principal frame (its mass centre and axes of inertia) and the pieces are turned back:
+    where a file puts its origin or how it turns its axes does not change the cut (KiCad's
+    TO-220 turned in its file came out in 27 pieces, in its own frame in 9)."""
+    to_principal = body.principal_inertia_transform
+    canonical = body.copy()
+    canonical.apply_transform(to_principal)
+    back = np.linalg.inv(to_principal)
+    return [p @ back[:3, :3].T + back[:3, 3] for p in _cached_pieces(canonical)]
+
+
+def _cached_pieces(body: trimesh.Trimesh) -> list[np.ndarray]:
+    """CoACD's pieces of `body` as it lies, from the cache when it holds them."""
     directory = cache_dir()
     try:
         os.makedirs(directory, exist_ok=True)
