@@ -62,7 +62,7 @@ SETTINGS = {
     # defaults until 2026-11-25 (1 mm each), one of them at a time, and other arms
     'former-arms-1mm': {},
     'rolling-1mm': {}, 'spinning-1mm': {},
-    'rolling-0': {}, 'rolling-0.2mm': {}, 'rolling-0.5mm': {},
+    'rolling-0': {}, 'rolling-0.2mm': {}, 'rolling-0.3mm': {}, 'rolling-0.5mm': {},
     'arms-0.01mm': {},
 }
 # The parts' rolling and spinning friction arms, m, where a setting changes them. The 'former'
@@ -70,7 +70,8 @@ SETTINGS = {
 FORMER_ARMS = (1e-3, 1e-3)
 ARMS = {'former-arms-1mm': FORMER_ARMS, 'rolling-1mm': (1e-3, None),
         'spinning-1mm': (None, 1e-3), 'rolling-0': (0.0, None), 'rolling-0.2mm': (2e-4, None),
-        'rolling-0.5mm': (5e-4, None), 'arms-0.01mm': (1e-5, 1e-5)}
+        'rolling-0.3mm': (3e-4, None), 'rolling-0.5mm': (5e-4, None),
+        'arms-0.01mm': (1e-5, 1e-5)}
 
 def creep(name: str, parts: int, size: tuple[float, float, float], seed: int, cap: float,
           physics: dict, seconds: int = 1, case: str = 'pth1') -> str:
