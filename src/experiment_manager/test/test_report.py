@@ -98,7 +98,7 @@ def test_the_table_verdict_rests_on_the_time_to_empty_and_the_spills(run_dir):
     _rates(s, 3, 3, 3)              # three runs in about 17 min: far inside 4 h
     table = verdicts.verdicts(s)[1]
     assert table['verdict'] == FEASIBLE, table
-    assert table['reasons'][0].startswith('3 runs emptied in 16.7 min to 17.0 min: 90% of '
+    assert table['reasons'][0].startswith('3 runs emptied in 16.7 min to 17.0 min: 90 % of '
                                           'refills empty within ')
     assert 'one-sided 95 % tolerance bound, lognormal' in table['reasons'][0]
     assert table['reasons'][2] == 'grounds settled: time FEASIBLE, spills FEASIBLE'
@@ -120,7 +120,7 @@ def test_the_table_verdict_rests_on_the_time_to_empty_and_the_spills(run_dir):
     assert table['reasons'][1].startswith("1 parts spilled over the tray's walls in 3 runs")
     assert table['reasons'][2] == 'grounds settled: time FEASIBLE, spills NOT FEASIBLE'
     text = report.markdown(s, {}, {})
-    assert '| vibrating table | time | time to empty the feeder, 90% of refills | FEASIBLE |' \
+    assert '| vibrating table | time | time to empty the feeder, 90 % of refills | FEASIBLE |' \
         in text and '| one-sided 95 % tolerance bound, lognormal | 3 |' in text
 
 
@@ -150,8 +150,8 @@ def test_verdicts_rest_on_the_interval_of_the_rate_and_on_the_capacity(run_dir):
     static, table = verdicts.verdicts(s)[:2]
     assert (static['verdict'], table['verdict']) == (UNDECIDED, UNDECIDED)
     assert static['reasons'][0] == (
-        '1 of 1 bins emptied: at least 5.0% and at most 100.0% (one-sided 95 % exact bounds '
-        '(Clopper-Pearson)); required 90% (requirements.success_rate); not settled: 29 '
+        '1 of 1 bins emptied: at least 5 % and at most 100 % (one-sided 95 % exact bounds '
+        '(Clopper-Pearson)); required 90 % (requirements.success_rate); not settled: 29 '
         'iterations would settle it if the rate seen held')
     assert table['reasons'][0].endswith('not settled: 3 runs give the fitted bound')
     _rates(s, 29, 29, 29)       # 29 of 29 clear 90 % one-sidedly (the two-sided interval: 36)

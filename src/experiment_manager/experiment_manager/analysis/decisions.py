@@ -109,8 +109,8 @@ def rate(successes: int, n: int, required: float, what: str,
     # the share of failures, bounded: success rate >= 1 - its upper bound
     low_fail, high_fail = binomial_bounds(n - successes, n, confidence)
     low, high = 1.0 - high_fail, 1.0 - low_fail
-    said = (f'{successes} of {n} {what}: at least {low:.1%} and at most {high:.1%} '
-            f'({kind}); required {required:.0%} (requirements.success_rate)')
+    said = (f'{successes} of {n} {what}: at least {_pc(low)} and at most {_pc(high)} '
+            f'({kind}); required {_pc(required)} (requirements.success_rate)')
     verdict = FEASIBLE if low >= required else NOT_FEASIBLE if high < required else UNDECIDED
     return Decision(verdict, f'share of {what}', low if verdict != NOT_FEASIBLE else high,
                     kind, n, said, {'low': low, 'high': high, 'successes': successes})
@@ -159,15 +159,15 @@ def table_time(runs: list[dict], refill: float, coverage: float,
     `confidence` (module docstring)."""
     n = len(runs)
     times = np.array([r['time'] for r in runs], dtype=float)
-    quantity = f'time to empty the feeder, {coverage:.0%} of refills'
+    quantity = f'time to empty the feeder, {_pc(coverage)} of refills'
     if n == 0:
         return Decision(UNDECIDED, quantity, None, _one_sided(confidence), 0,
                         'no feeder run yet')
     over = int((times > refill).sum())
     b_low, b_high = binomial_bounds(over, n, confidence)
     free = (f'{over} of {n} runs over the interval or not emptied: their share at most '
-            f'{b_high:.1%} ({_one_sided(confidence)}, distribution-free), allowed '
-            f'{1 - coverage:.0%}')
+            f'{_pc(b_high)} ({_one_sided(confidence)}, distribution-free), allowed '
+            f'{_pc(1 - coverage)}')
     free_verdict = (FEASIBLE if b_high < 1 - coverage else
                     NOT_FEASIBLE if b_low > 1 - coverage else UNDECIDED)
     detail = {'over': over, 'refill_s': refill, 'coverage': coverage,
@@ -181,7 +181,7 @@ def table_time(runs: list[dict], refill: float, coverage: float,
         verdict = FEASIBLE if upper <= refill else NOT_FEASIBLE if lower > refill else UNDECIDED
         weak = '; a weak check at 3 runs' if n == 3 else ''
         words = (f'{n} runs emptied in {_min(times.min())} to {_min(times.max())}: '
-                 f'{coverage:.0%} of refills empty within {_min(upper)} '
+                 f'{_pc(coverage)} of refills empty within {_min(upper)} '
                  f'({_one_sided(confidence)} tolerance bound, lognormal, Shapiro-Wilk p = '
                  f'{fit["p"]:.2f}{weak}), against the {_min(refill)} refill interval; '
                  f'distribution-free: {free_verdict}')
@@ -209,6 +209,11 @@ def _lognormal(times: np.ndarray, coverage: float, confidence: float) -> dict:
             'k_upper': k_upper, 'k_lower': k_lower,
             'upper': math.exp(mean + k_upper * sd), 'lower': math.exp(mean + k_lower * sd),
             'estimate': math.exp(mean + stats.norm.ppf(coverage) * sd)}
+
+
+def _pc(share: float) -> str:
+    """A share as the reports write it: 90 %, 63.2 %."""
+    return f'{round(100 * share, 1):g} %'
 
 
 def _min(seconds: float) -> str:
