@@ -64,8 +64,8 @@ def _decide(runs: list[dict], file, refill: float) -> str:
     """The table's verdict on `runs` at a refill interval of `refill`, s, as a run's verdict
     reads it (its time and spill grounds)."""
     r = file.requirements
-    return decisions.combined([decisions.table_time(runs, refill, r.success_rate),
-                               decisions.spills(runs, r.max_spilled)])
+    return decisions.combined([decisions.table_time(runs, refill, r.success_rate).verdict,
+                               decisions.spills(runs, r.max_spilled).verdict])
 
 
 def table(run_dirs: list[str], draws: int, seed: int) -> None:

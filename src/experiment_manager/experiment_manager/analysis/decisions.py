@@ -18,6 +18,10 @@ confidence (`table_time`):
   count: FEASIBLE when the one-sided 95 % upper bound of their share is below 1 - success_rate
   (with none over, 29 runs at 90 %), NOT FEASIBLE when its lower bound is above it. Used alone
   when the lognormal bound cannot be (a run over the interval, or the fit rejected).
+  Where this rests on an assumption: the fitted bound takes a run that would not empty as the
+  lognormal's own far tail. A feeder that jams now and then for a reason of its own (a part
+  that wedges) is a second mode the fit cannot see in 3 runs that emptied; only the
+  distribution-free count shows it, and needs 29 runs to show it below 10 %.
 Spills are a rate: parts spilled per refill, bounded one-sidedly (Poisson, over all the runs)
 against requirements.max_spilled_parts; at a limit of 0 a spill is a count that must be zero.
 
@@ -141,9 +145,9 @@ def spills(runs: list[dict], limit: int, confidence: float = CONFIDENCE) -> Deci
                     {'spilled': total, 'low': lower, 'high': upper})
 
 
-def combined(grounds: list[Decision]) -> str:
-    """NOT FEASIBLE when a ground is; FEASIBLE when every ground is; else UNDECIDED."""
-    said = [g.verdict for g in grounds]
+def combined(said: list[str]) -> str:
+    """An option's verdict from its grounds' (`said`): NOT FEASIBLE when a ground is;
+    FEASIBLE when every ground is; else UNDECIDED."""
     return (NOT_FEASIBLE if NOT_FEASIBLE in said else
             FEASIBLE if said and all(v == FEASIBLE for v in said) else UNDECIDED)
 

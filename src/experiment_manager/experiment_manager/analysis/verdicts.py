@@ -80,8 +80,7 @@ def verdicts(summary: dict) -> list[dict]:
         _, s = feeder[-1]
         grounds = s['decision']
         time, spills = grounds['time'], grounds['spills']
-        verdict = (NOT_FEASIBLE if NOT_FEASIBLE in (time['verdict'], spills['verdict']) else
-                   FEASIBLE if time['verdict'] == spills['verdict'] == FEASIBLE else UNDECIDED)
+        verdict = decisions.combined([g['verdict'] for g in grounds.values()])
         settled = [f'{name} {g["verdict"]}' for name, g in grounds.items()
                    if g['verdict'] != UNDECIDED]
         open_ = [name for name, g in grounds.items() if g['verdict'] == UNDECIDED]

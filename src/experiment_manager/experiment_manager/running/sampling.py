@@ -80,7 +80,7 @@ def unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict],
         return [] if rate_settled(successes, len(kept), file.requirements.success_rate) \
             else groups(exp)
     grounds = metrics.table_grounds(file, kept, INTERIM_CONFIDENCE)
-    return [] if decisions.combined(list(grounds.values())) != decisions.UNDECIDED \
+    return [] if decisions.combined([g.verdict for g in grounds.values()]) != decisions.UNDECIDED \
         else groups(exp)
 
 
