@@ -395,11 +395,15 @@ def _convex_cover(mesh: trimesh.Trimesh, path: str) -> tuple[list[trimesh.Trimes
             raise MeshError('part.mesh_path', path, 'has zero volume (flat or a line)')
         return [whole], (f'one convex hull of the whole mesh: it has {len(bodies)} separate '
                          f'bodies, more than {MAX_MESH_HULLS}')
-    hulls, counts = [], {'convex': 0, 'concave': 0, 'open': 0}
+    hulls, counts, failed = [], {'convex': 0, 'concave': 0, 'open': 0}, ''
     for body in bodies:
         closed = body.is_watertight and body.volume > 0
         if closed and not pieces.is_convex(body):
-            cut = [h for h in (_hull(p) for p in pieces.convex_pieces(body)) if h is not None]
+            try:
+                cut = [h for h in (_hull(p) for p in pieces.convex_pieces(body))
+                       if h is not None]
+            except Exception as exc:    # CoACD's C++ raises what it raises: keep the hull
+                cut, failed = [], f'; CoACD could not cut a body ({exc}): it is its hull'
             if cut:
                 hulls += cut
                 counts['concave'] += 1
@@ -425,7 +429,7 @@ def _convex_cover(mesh: trimesh.Trimesh, path: str) -> tuple[list[trimesh.Trimes
     if counts['open']:
         words.append(f'{counts["open"]} open body(ies) as its hull (not closed, so not cut: '
                      'its hollows and gaps collide as filled; close the mesh to have it cut)')
-    return hulls, '; '.join(words)
+    return hulls, '; '.join(words) + failed
 
 
 def _mesh_part(spec: PartSpec) -> PartGeometry:
