@@ -67,9 +67,10 @@ def feeder_runs(rows: list[dict], cell) -> list[dict]:
     time to empty the feeder, s (inf for a run that did not empty), and `spilled`."""
     out = []
     for r in rows:
-        busy = r['picks'] * cell.pick_time + r['checks'] * cell.image_time + r['table_time']
+        picking = r['picks'] * cell.pick_time
+        busy = picking + r['checks'] * cell.image_time + r['table_time']
         out.append({'time': busy if r['emptied'] else math.inf, 'spilled': r['spilled'],
-                    'emptied': bool(r['emptied'])})
+                    'emptied': bool(r['emptied']), 'picking': picking})
     return out
 
 
@@ -177,7 +178,11 @@ def table_time(runs: list[dict], refill: float, coverage: float,
     detail = {'over': over, 'refill_s': refill, 'coverage': coverage,
               'times_s': [t if math.isfinite(t) else None for t in times.tolist()],
               'distribution_free': {'verdict': free_verdict, 'share_bounds': [b_low, b_high]}}
-    fit = _lognormal(times, coverage, confidence) if over == 0 and n >= 3 else None
+    # the robot's time is known once every part is picked (picks x cell.pick_s, the same in
+    # every emptied run): the spread is the table's and the camera's, and it is what is fitted
+    picking = max((r.get('picking', 0.0) for r in runs), default=0.0)
+    fit = (_lognormal(times, coverage, confidence, picking) if over == 0 and n >= 3
+           and (times > picking).all() else None)
     if fit is not None:
         detail['lognormal'] = fit
     if fit is not None and fit['fits']:
@@ -199,20 +204,23 @@ def table_time(runs: list[dict], refill: float, coverage: float,
                     f'{free} ({why})', detail)
 
 
-def _lognormal(times: np.ndarray, coverage: float, confidence: float) -> dict:
-    """The lognormal fit of `times` (s, all finite and > 0, n >= 3) and the bounds of its
-    `coverage` quantile: `upper` at `confidence` (the tolerance bound), `lower` at 1 -
-    `confidence`, `estimate` the quantile itself; `p` Shapiro-Wilk's on the logarithms."""
-    logs = np.log(times)
+def _lognormal(times: np.ndarray, coverage: float, confidence: float,
+               shift: float = 0.0) -> dict:
+    """The lognormal fit of `times` - `shift` (s, all finite and > `shift`, n >= 3; `shift`:
+    the part of every time that does not vary) and the bounds of the times' `coverage`
+    quantile: `upper` at `confidence` (the tolerance bound), `lower` at 1 - `confidence`,
+    `estimate` the quantile itself; `p` Shapiro-Wilk's on the logarithms."""
+    logs = np.log(times - shift)
     n = len(logs)
     mean, sd = float(logs.mean()), float(logs.std(ddof=1))
     p = float(stats.shapiro(logs).pvalue) if sd > 0 else 1.0
     k_upper = k_factor(n, coverage, confidence)
     k_lower = k_factor(n, coverage, 1 - confidence)
     return {'n': n, 'log_mean': mean, 'log_sd': sd, 'p': p, 'fits': p >= FIT_ALPHA,
-            'k_upper': k_upper, 'k_lower': k_lower,
-            'upper': math.exp(mean + k_upper * sd), 'lower': math.exp(mean + k_lower * sd),
-            'estimate': math.exp(mean + stats.norm.ppf(coverage) * sd)}
+            'shift_s': shift, 'k_upper': k_upper, 'k_lower': k_lower,
+            'upper': shift + math.exp(mean + k_upper * sd),
+            'lower': shift + math.exp(mean + k_lower * sd),
+            'estimate': shift + math.exp(mean + stats.norm.ppf(coverage) * sd)}
 
 
 def _pc(share: float) -> str:
