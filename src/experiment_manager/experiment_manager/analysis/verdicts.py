@@ -85,8 +85,13 @@ def verdicts(summary: dict) -> list[dict]:
                    if g['verdict'] != UNDECIDED]
         open_ = [name for name, g in grounds.items() if g['verdict'] == UNDECIDED]
         v = s['vibrations_to_empty']
-        reasons = [time['reason'] + _more(time, summary['requirements']['success_rate']),
-                   spills['reason'],
+        # the ground that decides first (run prints only the first reason): NOT FEASIBLE,
+        # then UNDECIDED, then FEASIBLE; the time first among equals
+        said = sorted([(time, time['reason'] + _more(time, summary['requirements']
+                                                      ['success_rate'])),
+                       (spills, spills['reason'])],
+                      key=lambda g: [NOT_FEASIBLE, UNDECIDED, FEASIBLE].index(g[0]['verdict']))
+        reasons = [said[0][1], said[1][1],
                    'grounds settled: ' + (', '.join(settled) or 'none')
                    + ('; not settled: ' + ', '.join(open_) if open_ else ''),
                    f'{s["emptied"]} of {s["iterations"]} feeder runs emptied '
