@@ -107,12 +107,6 @@ def list_of(value: Any, low: int, high: int, what: str) -> list:
     return value
 
 
-def non_empty_list(value: Any) -> list | None:
-    if value is not None and (not isinstance(value, list) or not value):
-        fail('must be a non-empty list', short(value))
-    return value
-
-
 def grasp_list(value: Any, handler: Callable[[Any], Any]) -> list | str | None:
     """part.grasps: 'auto' as it is, else a non-empty list read by `handler`."""
     if value == 'auto':
