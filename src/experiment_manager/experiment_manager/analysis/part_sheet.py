@@ -20,7 +20,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 import numpy as np
 from pick_common.parts import build_part, states_units
 from pick_validity.geometry import part_shapes, place, Shape, support
-from pick_validity.grasp_proposals import as_yaml, JAW_MARGIN, propose
+from pick_validity.grasp_proposals import as_yaml, JAW_MARGIN, Proposal
 from pick_validity.validity import Validator
 import trimesh
 
@@ -83,7 +83,9 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
                      'opposed faces and round bodies at the mass centre, jaws '
                      f'{JAW_MARGIN * MM:g} mm wider than the part each side); to edit them, '
                      'paste these under part: in place of grasps: auto')
-        lines += ['  ' + line for line in as_yaml(propose(part))]
+        used = tuple(Proposal(g, fit.width) for g, fit in zip(file.grasps, checks.grasp_fits,
+                                                              strict=True))
+        lines += ['  ' + line for line in as_yaml(used)]
     return lines
 
 
