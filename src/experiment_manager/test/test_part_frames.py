@@ -36,10 +36,16 @@ def _valid_per_check(spec: PartSpec, offset, seeds, turn=IDENTITY) -> np.ndarray
     grasp = GraspPose('flat', tuple(up), tuple(closing), 0.008, tuple(offset))
     # the seating plane: the box's bottom face, 1 mm from its centre along the place axis
     setup = Setup(spec, grasps=(grasp,), place=PlaceSpec(tuple(down), 0.001 + down @ offset))
+    return _valid_on_tray(setup, 25, seeds)
+
+
+def _valid_on_tray(setup: Setup, parts: int, seeds) -> np.ndarray:
+    """Valid parts per check of `parts` of setup.part dropped on the tray, per seed."""
     valid = []
     for seed in seeds:
-        with World(SceneSpec(ContainerSpec.tray(), spec, 1, seed), PhysicsConfig()) as world:
-            world.drop(25)
+        with World(SceneSpec(ContainerSpec.tray(), setup.part, 1, seed),
+                   PhysicsConfig()) as world:
+            world.drop(parts)
             state = world.snapshot()
             report = Validator(setup, world.part).check(ContainerSpec.tray(), state.ids,
                                                         state.poses)
@@ -94,15 +100,7 @@ def test_kicads_to220_as_step_stl_and_obj_anywhere_gives_the_same_answer(tmp_pat
                       for i, (up, closing, opening) in enumerate(grasps))
         down = turn @ np.array([0.0, 0.0, -1.0])
         setup = Setup(spec, grasps=poses, place=PlaceSpec(tuple(down), float(down @ shift)))
-        counts = []
-        for seed in seeds:
-            with World(SceneSpec(ContainerSpec.tray(), spec, 1, seed), PhysicsConfig()) as w:
-                w.drop(30)
-                state = w.snapshot()
-                report = Validator(setup, w.part).check(ContainerSpec.tray(), state.ids,
-                                                        state.poses)
-            counts.append(report.counts['valid'])
-        return np.array(counts, dtype=float)
+        return _valid_on_tray(setup, 30, seeds)
 
     answers = {'step': valid(PartSpec(model='mesh', mesh_path=step, mass=0.002), IDENTITY,
                              np.zeros(3))}
