@@ -19,6 +19,15 @@ table's decision per part in worker-minutes (the runs' wall_time, as they ran): 
 runs (fixed counts), the runs adaptive sampling took before this rule (batches of 5 until the
 share of runs emptied was settled at 99.9 %, two-sided: 73 runs when all empty, so all 50),
 and the runs it takes with this rule (sampling.unsettled after each batch of 5).
+
+  tools/ws python -m bench.experiment.feeder_decisions noise RUN_DIR... [--populations 60]
+asks how far the borderline's false-FEASIBLE rate would stray with a decision that is exact:
+it draws populations of as many runs as each part has from the lognormal fitted to them (the
+model the decision assumes, so that its 95 % holds by construction), puts each population's
+borderline where `table` puts it, and prints the spread of the same rate over the populations
+(median, 90th percentile, the share above 5 %) beside the part's own. The borderline sits on
+the quantile itself, where a one-sided 95 % bound says FEASIBLE 5 % of the time on average;
+one population of 50 scatters about that.
 """
 
 import argparse
@@ -101,6 +110,38 @@ def table(run_dirs: list[str], draws: int, seed: int) -> None:
                       f'{infeasible:.1%}')
 
 
+def _rate_at_border(runs: list[dict], file, draws: int, rng, size: int) -> float:
+    """The share of `draws` subsamples of `size` of `runs` that say FEASIBLE at the runs'
+    borderline (the lognormal estimate of their 90 % quantile, as `table` puts it)."""
+    fit = decisions.table_time(runs, file.requirements.refill_interval,
+                               file.requirements.success_rate).detail['lognormal']
+    said = [_decide([runs[i] for i in rng.choice(len(runs), size, replace=False)], file,
+                    fit['estimate']) for _ in range(draws)]
+    return float(np.mean([s == decisions.FEASIBLE for s in said]))
+
+
+def noise(run_dirs: list[str], populations: int, draws: int, seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    print(f"borderline false FEASIBLE: the part's own runs against {populations} populations "
+          f'drawn from their fitted lognormal ({draws} subsamples each)')
+    print('  part | runs | size | own | model: median | 90th percentile | share above 5 %')
+    for run_dir in run_dirs:
+        file = experiment_file.load(os.path.join(run_dir, 'experiment.yaml'))
+        runs = decisions.feeder_runs(read_csv(os.path.join(run_dir, 'iterations.csv')),
+                                     file.cell)
+        fit = decisions.table_time(runs, file.requirements.refill_interval,
+                                   file.requirements.success_rate).detail['lognormal']
+        shift, n = fit['shift_s'], len(runs)
+        for size in (k for k in SIZES if k < n):
+            own = _rate_at_border(runs, file, draws, rng, size)
+            model = np.array([_rate_at_border(
+                [{'time': shift + t, 'picking': shift, 'spilled': 0, 'emptied': True}
+                 for t in np.exp(rng.normal(fit['log_mean'], fit['log_sd'], n))],
+                file, draws, rng, size) for _ in range(populations)])
+            print(f'  {file.id} | {n} | {size} | {own:.1%} | {np.median(model):.1%} | '
+                  f'{np.quantile(model, 0.9):.1%} | {(model > 0.05).mean():.0%}')
+
+
 def cost(run_dirs: list[str]) -> None:
     print("\ntime to the table's decision, worker-minutes of feeder runs (runs taken):")
     print('  part | all runs (fixed) | adaptive, share emptied | adaptive, time to empty')
@@ -130,9 +171,16 @@ def main(argv: list[str] | None = None) -> int:
     tab.add_argument('run_dirs', nargs='+')
     tab.add_argument('--draws', type=int, default=2000)
     tab.add_argument('--seed', type=int, default=43)
+    model = sub.add_parser('noise')
+    model.add_argument('run_dirs', nargs='+')
+    model.add_argument('--populations', type=int, default=60)
+    model.add_argument('--draws', type=int, default=400)
+    model.add_argument('--seed', type=int, default=44)
     args = parser.parse_args(argv)
     if args.command == 'files':
         print('\n'.join(write_files(args.directory)))
+    elif args.command == 'noise':
+        noise(args.run_dirs, args.populations, args.draws, args.seed)
     else:
         table(args.run_dirs, args.draws, args.seed)
         cost(args.run_dirs)
