@@ -23,7 +23,9 @@ SWEEP = MINIMAL + '  - {id: g, type: gripper_sweep, iterations: 1, parts: 10, '
 def test_the_default_file_parses_into_si_units():
     f = experiment_file.load(DEFAULT)
     assert f.id == 'capacitor_demo'
-    assert [e.type for e in f.experiments] == list(experiment_file.TYPES)
+    assert [e.type for e in f.experiments if e.scenario is None] == list(experiment_file.TYPES)
+    assert [e.id for e in f.experiments if e.scenario is not None] == [
+        'feeder@part_lateral_friction_low', 'feeder@part_lateral_friction_high']
     assert f.gripper.body_diameter == pytest.approx(0.020)
     assert f.check.tolerance == pytest.approx(math.radians(45))
     assert f.tray.inner_size == pytest.approx((0.195, 0.150, 0.027))
@@ -41,7 +43,7 @@ def test_the_default_file_s_containers_hold_a_refill_interval_s_parts():
     # parts into a cell that needed 480).
     f = experiment_file.load(DEFAULT)
     loads = {e.id: e.parts for e in f.experiments
-             if e.type in ('bin_emptying', 'feeder_emptying')}
+             if e.type in ('bin_emptying', 'feeder_emptying') and e.scenario is None}
     assert len(loads) == 2 and min(loads.values()) >= f.requirements.capacity, loads
 
 
@@ -188,7 +190,8 @@ def test_a_mesh_path_is_relative_to_the_file(tmp_path):
 def test_a_reduced_copy_caps_iterations_and_keeps_the_rest(tmp_path):
     f = experiment_file.load(DEFAULT)
     small = experiment_file.parse(experiment_file.reduced(f, 1))
-    assert [e.iterations for e in small.experiments] == [1, 1, 1, 1, 1]
+    # the sensitivity experiment caps its two repeats of `feeder` at 1 too
+    assert [e.iterations for e in small.experiments] == [1] * 8
     assert small.experiment('sweep').counts == f.experiment('sweep').counts
     assert (small.part, small.gripper, small.grasps) == (f.part, f.gripper, f.grasps)
     with pytest.raises(InvalidArgument, match=r'max_iterations: 0 must be within \[1, '):

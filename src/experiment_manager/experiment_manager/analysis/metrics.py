@@ -342,10 +342,15 @@ def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: li
 
 
 def file_summary(file: ExperimentFile, summaries: dict) -> dict:
+    """The run's summary: `experiments`, the file's own by id; `repeats`, a sensitivity
+    experiment's repeats of them in its scenarios (id `<experiment>@<scenario>`), apart, so
+    that the verdicts and the report's tables are the file's experiments'."""
     r = file.requirements
+    repeats = {k: v for k, v in summaries.items() if '@' in k}
     return {'id': file.id, 'seed': file.seed,
             'requirements': {'parts_per_hour': r.parts_per_hour,
                              'refill_interval_h': r.refill_interval / 3600.0,
                              'capacity': r.capacity, 'success_rate': r.success_rate,
                              'max_dimension_mm': round(r.max_dimension * 1000, 6)},
-            'experiments': summaries}
+            'experiments': {k: v for k, v in summaries.items() if k not in repeats},
+            **({'repeats': repeats} if repeats else {})}

@@ -6,7 +6,10 @@ part_sheet.py) it writes
 `report.md` and `report.html` (the same content) and the plots `fig14_bins.png` (fractions of
 parts passing each stage per bin, paper figure 14) and `fig15_table.png` (valid parts against
 parts on the tray with the 4th-order fit, paper figure 15) and, for a gripper_sweep,
-`grippers.png` (valid parts per check per gripper with the yield required). Tables follow the
+`grippers.png` (valid parts per check per gripper with the yield required), and for a
+sensitivity experiment `sensitivity_<id>.png` (a tornado chart: each answer at each input's
+low and high against the file's values) with its section, "How far the answers move".
+Tables follow the
 paper's Tables 2 and 3. For the paper's test-case files (ids pth0, pth1, pth2) the paper's
 numbers stand beside ours, and a section "Against the paper" checks its three findings on
 this run and says where and why ours differ. The decisions themselves (the verdicts and the
@@ -26,6 +29,7 @@ import yaml
 
 from . import stages
 from .results import read_csv
+from .sensitivity import ANSWERS
 from .verdicts import (
     against_paper,
     FEASIBLE,
@@ -354,6 +358,8 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
         lines += table(['gripper', 'candidacy', 'placeability', 'container free', 'valid',
                         'valid per check', '95 % interval', 'scenes with a valid part',
                         'meets'], rows)
+    for exp_id, s in of_type(summary, 'sensitivity'):
+        lines += _sensitivity(exp_id, s, figures.get(f'sensitivity_{exp_id}'))
     if paper:
         lines += against_paper(summary, paper)
     lines += ['', '## Physics health', ''] + _physics_health(summary)
@@ -362,6 +368,70 @@ def markdown(summary: dict, spec: dict, figures: dict[str, bool],
         for name, caption in pictures.items():
             lines += ['', f'![{name}]({name})', '', caption]
     return '\n'.join(lines) + '\n'
+
+
+def _sensitivity(exp_id: str, s: dict, plotted: bool) -> list[str]:
+    """A sensitivity experiment's section: its inputs with their sources, whether each
+    verdict holds over them, the tornado chart and each scenario's answers and verdicts."""
+    lines = ['', f'## How far the answers move (`{exp_id}`)', '',
+             f'The experiments {", ".join(f"`{e}`" for e in s["of"])} repeated in '
+             f'{count(len(s["scenarios"]), "scenario")} (each input at its low and its high, '
+             "the others at the file's values; `joint_*`: all at once, a Latin hypercube), "
+             f'at most {count(s["iterations"], "iteration")} each, on the seeds of the runs '
+             'they repeat:', '']
+    lines += table(['input', "file's value", 'low', 'high', 'source of the range'],
+                   [[f'`{x["name"]}`', x['base'], x['low'], x['high'], x['source']]
+                    for x in s['inputs']])
+    lines += ['', 'Verdicts over the ranges:', '']
+    lines += [f'- {r["line"]}' for r in s['robustness']] or ['- no verdict to compare']
+    if plotted:
+        lines += ['', f'![tornado chart of {exp_id}](sensitivity_{exp_id}.png)']
+    keys = [k for k in ANSWERS if k in s['ranges']]
+    options = list(s['base']['verdicts'])
+    rows = []
+    for name, said in [("file's values", s['base'])] + [(x['name'], x) for x in s['scenarios']]:
+        values = ', '.join(f'{k} {fmt(v, 3)}' for k, v in said.get('values', {}).items())
+        rows.append([name, values or '-']
+                    + [fmt(said['answers'].get(k), 4) if k in said['answers'] else '-'
+                       for k in keys] + [said['verdicts'].get(o, '-') for o in options])
+    lines += ['', "Each scenario's answers ("
+              + '; '.join(f'{ANSWERS[k][0]}' + (f', {ANSWERS[k][1]}' if ANSWERS[k][1] else '')
+                          for k in keys) + ') and verdicts:', '']
+    lines += table(['scenario', 'inputs set'] + [ANSWERS[k][0] for k in keys] + options, rows)
+    return lines
+
+
+def plot_tornado(exp_id: str, s: dict, path: str) -> bool:
+    """Each answer of a sensitivity experiment (a panel) at each input's low and high (a bar
+    from one to the other, the low end marked), the file's values' answer a line; inputs
+    ordered by how far they move it."""
+    panels = [(k, v) for k, v in s['tornado'].items()
+              if s['base']['answers'].get(k) is not None]
+    if not panels:
+        return False
+    fig, axes = plt.subplots(len(panels), 1, figsize=(FIGSIZE[0], 1.0 + 1.6 * len(panels)),
+                             squeeze=False)
+    for ax, (key, by_input) in zip(axes[:, 0], panels, strict=True):
+        base = s['base']['answers'][key]
+        bars = sorted(((name, v['low'], v['high']) for name, v in by_input.items()),
+                      key=lambda b: max(abs((x if x is not None else base) - base)
+                                        for x in b[1:]))
+        for y, (_, low, high) in enumerate(bars):
+            ends = [x if x is not None else base for x in (low, high)]
+            ax.barh(y, ends[1] - ends[0], left=ends[0], height=0.5,
+                    color='#1f77b4' if ends[1] >= ends[0] else '#d62728')
+            if low is not None:
+                ax.plot([low], [y], 'k|', markersize=12)
+        ax.axvline(base, color='k', linewidth=1)
+        ax.margins(x=0.08)
+        ax.set_yticks(range(len(bars)), [b[0] for b in bars], fontsize=7)
+        words, unit = ANSWERS[key]
+        ax.set_title(words + (f', {unit}' if unit else ''), fontsize=9)
+    fig.suptitle(f'{exp_id}: each input from low (|) to high; blue rises, red falls', fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return True
 
 
 def to_html(text: str, title: str) -> str:
@@ -429,6 +499,9 @@ def write(run_dir: str) -> str:
     figures = {'fig14': plot_bins(summary, os.path.join(run_dir, 'fig14_bins.png')),
                'fig15': plot_sweep(summary, os.path.join(run_dir, 'fig15_table.png')),
                'grippers': plot_grippers(summary, os.path.join(run_dir, 'grippers.png'))}
+    for exp_id, s in of_type(summary, 'sensitivity'):
+        figures[f'sensitivity_{exp_id}'] = plot_tornado(
+            exp_id, s, os.path.join(run_dir, f'sensitivity_{exp_id}.png'))
     pictures = None
     if os.path.exists(os.path.join(run_dir, 'pictures.json')):
         with open(os.path.join(run_dir, 'pictures.json'), encoding='utf-8') as f:

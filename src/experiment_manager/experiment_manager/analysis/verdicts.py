@@ -18,6 +18,8 @@ and kept in summary.json as each experiment's `decision`):
 - gripper (one per gripper_sweep): the smallest gripper of the sweep whose valid parts per
   check reach the experiment's min_valid at 95 % confidence; not feasible when every
   gripper's interval lies below min_valid.
+A sensitivity experiment adds to each option's reasons whether its verdict holds over the
+inputs' ranges or which scenarios flip it (sensitivity.py).
 Iterations left out of the figures (a NaN state, a tunnelled or a thrown part) make no option
 feasible.
 An option whose experiment did not run is "not analysed".
@@ -117,7 +119,23 @@ def verdicts(summary: dict) -> list[dict]:
         out.append({'option': 'vibrating table', 'verdict': NOT_ANALYSED,
                     'reasons': ['no feeder_emptying experiment in the file']})
     out += [_gripper_verdict(exp_id, s) for exp_id, s in of_type(summary, 'gripper_sweep')]
+    for exp_id, s in of_type(summary, 'sensitivity'):     # how far each verdict moves
+        lines = {r['option']: r['said'] for r in s['robustness']}
+        for v in out:
+            if option_kind(v['option']) in lines:
+                v['reasons'].append(f'over the ranges of `{exp_id}`: '
+                                    f'{lines[option_kind(v["option"])]}')
     return out
+
+
+def option_kind(option: str) -> str:
+    """An option as scenarios compare it: 'static bin' whichever bin was best, a gripper
+    sweep's by its experiment ('gripper (`id`)') whichever gripper was smallest."""
+    if option.startswith('static bin'):
+        return 'static bin'
+    if option.startswith('gripper') and '(`' in option:
+        return 'gripper (' + option[option.index('(`') + 1:]
+    return option
 
 
 def _decided(verdict: str, reasons: list[str], s: dict,

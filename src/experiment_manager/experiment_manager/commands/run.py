@@ -176,6 +176,10 @@ def _summary_lines(summary: dict) -> list[str]:
                 f'smallest meeting {s["min_valid"]:g} valid per check: '
                 f'{gripper_label(s["variants"][found])}' if found is not None else
                 f'no gripper of {len(s["variants"])} meets {s["min_valid"]:g} valid per check'))
+        elif kind == 'sensitivity':
+            lines.append(f'  {exp_id} (sensitivity): {len(s["scenarios"])} scenarios over '
+                         + ', '.join(x['name'] for x in s['inputs']) + ':')
+            lines += [f'    {r["line"]}' for r in s['robustness']]
         else:
             v = s['vibrations_to_empty']['mean']
             rate = s['parts_per_hour']['mean']

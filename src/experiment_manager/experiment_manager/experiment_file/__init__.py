@@ -26,6 +26,7 @@ from .model import (
     Requirements,
     Sampling,
     SEARCH_ORDERS,
+    SENSITIVITY,
     TABLE_SWEEP,
     TYPES,
 )
@@ -35,5 +36,5 @@ __all__ = [
     'ADAPTIVE', 'BIN_EMPTYING', 'BIN_STATIC', 'Cell', 'Experiment', 'ExperimentFile',
     'FEEDER_EMPTYING', 'FIXED', 'GRIPPER_KEYS', 'GRIPPER_SWEEP', 'GripperVariant', 'InvalidFile',
     'load', 'MAX_ITERATIONS', 'MM', 'parse', 'reduced', 'Requirements', 'Sampling', 'SEARCH_ORDERS',
-    'TABLE_SWEEP', 'TYPES',
+    'SENSITIVITY', 'TABLE_SWEEP', 'TYPES',
 ]

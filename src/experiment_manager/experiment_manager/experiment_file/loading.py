@@ -11,6 +11,7 @@ relate were read without error. The annotated example is `config/default_experim
 """
 
 from collections.abc import Callable, Mapping
+from dataclasses import replace
 import itertools
 import math
 import os
@@ -26,7 +27,6 @@ from pick_validity.config import (
     check_gripper,
     check_place,
     CheckConfig,
-    GraspPose,
     Gripper,
     Setup,
     tilts,
@@ -34,6 +34,7 @@ from pick_validity.config import (
 import yaml
 
 from . import part as part_section
+from . import scenarios as scenario_inputs
 from . import schema
 from .errors import read as read_keys
 from .model import (
@@ -47,6 +48,7 @@ from .model import (
     FEEDER_EMPTYING,
     GRIPPER_SWEEP,
     GripperVariant,
+    Input,
     MAX_EXPERIMENTS,
     MAX_FILE_BYTES,
     MAX_ITERATIONS,
@@ -54,6 +56,7 @@ from .model import (
     MM,
     Requirements,
     Sampling,
+    SENSITIVITY,
     TABLE_SWEEP,
 )
 from .schema import GRIPPER_KEYS
@@ -122,13 +125,15 @@ def _moves(top: schema.FileKeys) -> tuple[Vibration, ...]:
 # -------------------------------------------------------------------------- experiments
 class _Context:
     """What an experiment's checks relate to: the part's geometry, the tray, the bins' wall
-    and size limit, the gripper and grasps, and the experiments read before it."""
+    and size limit, the setup (part, gripper, grasps) and table moves, the file's seed, and
+    the experiments read before it."""
 
     def __init__(self, geometry: PartGeometry, tray: ContainerSpec, bin_wall: float,
-                 max_dimension: float, gripper: Gripper,
-                 grasps: tuple[GraspPose, ...]) -> None:
+                 max_dimension: float, setup: Setup, moves: tuple[Vibration, ...],
+                 seed: int) -> None:
         self.geometry, self.tray, self.bin_wall = geometry, tray, bin_wall
-        self.max_dimension, self.gripper, self.grasps = max_dimension, gripper, grasps
+        self.max_dimension, self.setup, self.moves, self.seed = max_dimension, setup, moves, seed
+        self.gripper, self.grasps = setup.gripper, setup.grasps
         self.earlier: dict[str, Experiment] = {}
 
 
@@ -208,9 +213,53 @@ def _variants(e: schema.GripperSweepKeys, where: str, c: _Context
     return tuple(out)
 
 
-def _experiment(e: schema.ExperimentKeys, where: str, c: _Context) -> Experiment:
+def _sensitivity(e: schema.SensitivityKeys, where: str, c: _Context) -> list[Experiment]:
+    """A sensitivity experiment and, before it, its repeats of the experiments it names, one
+    per scenario (scenarios.py); a repeat takes its bin or range from the same scenario's
+    repeat of its source when that is repeated too, else from the source itself."""
+    for i, exp_id in enumerate(e.of):
+        if c.earlier.get(exp_id) is None or c.earlier[exp_id].type == SENSITIVITY:
+            raise InvalidArgument(f'{where}.of[{i}]', exp_id, 'names no earlier experiment '
+                                  '(of a type other than sensitivity)')
+    if len(set(e.of)) != len(e.of):
+        raise InvalidArgument(f'{where}.of', list(e.of), 'names an experiment twice')
+    inputs = []
+    for name, r in e.inputs.items():
+        at = f'{where}.inputs.{name}'
+        if name not in scenario_inputs.INPUTS:
+            raise InvalidArgument(at, name, 'is not an input a sensitivity experiment varies ('
+                                  + ', '.join(scenario_inputs.INPUTS) + ')')
+        low = scenario_inputs.check_input(name, r.low, f'{at}.low')
+        high = scenario_inputs.check_input(name, r.high, f'{at}.high')
+        base = scenario_inputs.base_value(name, c.setup, c.geometry.mass)
+        inputs.append(Input(name, round(base, 9), low, high, r.source.strip()))
+    inputs = tuple(inputs)
+    repeats = (2 * len(inputs) + e.joint) * len(e.of)
+    if repeats > scenario_inputs.MAX_REPEATS:
+        raise InvalidArgument(f'{where}.inputs', repeats, f'scenarios x experiments repeated '
+                              f'is over the limit of {scenario_inputs.MAX_REPEATS} (2 '
+                              'scenarios per input, plus joint, times the experiments of `of`)')
+    found = scenario_inputs.scenarios(inputs, e.joint, c.setup, c.moves, c.seed, e.id, where)
+    repeats = []
+    for scenario in found:
+        for exp_id in e.of:
+            source = c.earlier[exp_id]
+            renamed = {key: f'{value}@{scenario.name}' if value in e.of else value
+                       for key in ('bin_from', 'range_from')
+                       if (value := getattr(source, key))}
+            repeats.append(replace(source, id=f'{exp_id}@{scenario.name}',
+                                   iterations=min(source.iterations, e.iterations),
+                                   scenario=scenario, **renamed))
+    return repeats + [Experiment(id=e.id, type=SENSITIVITY, iterations=e.iterations,
+                                 of=tuple(e.of), inputs=inputs, scenarios=found)]
+
+
+def _experiment(e: schema.ExperimentKeys, where: str, c: _Context) -> list[Experiment]:
+    """The experiment read at `where` (with, for a sensitivity experiment, its repeats)."""
     if e.id in c.earlier:
         raise InvalidArgument(f'{where}.id', e.id, 'is the id of an earlier experiment')
+    if e.type == SENSITIVITY:
+        return _sensitivity(e, where, c)
     volume, tray = c.geometry.volume, c.tray
     out: dict[str, Any] = {'id': e.id, 'type': e.type, 'iterations': e.iterations}
     if e.type != TABLE_SWEEP:
@@ -245,7 +294,7 @@ def _experiment(e: schema.ExperimentKeys, where: str, c: _Context) -> Experiment
                      where)
         out['max_vibrations'] = e.max_vibrations
         check_fits(f'{where}.optimal_range (max)', high, volume, tray)
-    return Experiment(**out)
+    return [Experiment(**out)]
 
 
 # ------------------------------------------------------------------------------- the file
@@ -303,17 +352,18 @@ def parse(text: str, path: str = '') -> ExperimentFile:
     if geometry is not None and grasps is not None:
         checked(lambda: part_section.check_fits(geometry, grasps))
     context = None
-    if None not in (top, geometry, tray, requirements, gripper, grasps):
+    if None not in (top, geometry, tray, moves, requirements, gripper, grasps, check):
         context = _Context(geometry, tray, MM * top.bin_wall_mm, requirements.max_dimension,
-                           gripper, grasps)
+                           Setup(part, gripper, grasps, place, check), moves, top.seed)
     raw = data.get('experiments')
     for i, item in enumerate(raw if isinstance(raw, list) and len(raw) <= MAX_EXPERIMENTS
                              else []):
         where = f'experiments[{i}]'
         keys = read(schema.experiment_model(item), item, where)
         if keys is not None and context is not None:
-            e = checked(lambda keys=keys, where=where: _experiment(keys, where, context))
-            if e is not None:
+            read_here = checked(lambda keys=keys, where=where: _experiment(keys, where,
+                                                                            context))
+            for e in read_here or ():
                 context.earlier[e.id] = e
     # one error per field: a check that fails again on a value already refused is not news
     fields: set[str] = set()

@@ -9,9 +9,10 @@ from pick_common.parts import PartSpec
 from pick_common.specs import Vibration
 from pick_validity.config import CheckConfig, GraspPose, Gripper, PlaceSpec, Setup
 
-BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING, GRIPPER_SWEEP = (
-    'bin_static', 'bin_emptying', 'table_sweep', 'feeder_emptying', 'gripper_sweep')
-TYPES = (BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING, GRIPPER_SWEEP)
+BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING, GRIPPER_SWEEP, SENSITIVITY = (
+    'bin_static', 'bin_emptying', 'table_sweep', 'feeder_emptying', 'gripper_sweep',
+    'sensitivity')
+TYPES = (BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING, GRIPPER_SWEEP, SENSITIVITY)
 SEARCH_ORDERS = ('top_first', 'random', 'id')
 FIXED, ADAPTIVE = 'fixed', 'adaptive'
 SAMPLING_MODES = (FIXED, ADAPTIVE)
@@ -91,6 +92,30 @@ class GripperVariant:
 
 
 @dataclass(frozen=True)
+class Input:
+    """One uncertain input of a sensitivity experiment: its name (a key of
+    sensitivity.INPUTS), the file's value and the range to try, in the file's units, and where
+    the range comes from (said with every answer that moves with it)."""
+
+    name: str
+    base: float
+    low: float
+    high: float
+    source: str
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """The inputs of one sensitivity scenario (name -> value, file units) and what they make:
+    the setup (part, gripper) and table moves its experiments run with."""
+
+    name: str
+    values: tuple[tuple[str, float], ...]
+    setup: Setup
+    moves: tuple[Vibration, ...]
+
+
+@dataclass(frozen=True)
 class Experiment:
     """One experiment of the file.
 
@@ -117,6 +142,16 @@ class Experiment:
     max_vibrations: int = 500
     variants: tuple[GripperVariant, ...] = ()
     min_valid: float = 1.0
+    of: tuple[str, ...] = ()
+    inputs: tuple[Input, ...] = ()
+    scenarios: tuple[Scenario, ...] = ()
+    scenario: Scenario | None = None
+
+    @property
+    def sources(self) -> tuple[str, ...]:
+        """The experiments whose summaries this one needs before it is planned."""
+        repeats = tuple(f'{e}@{s.name}' for s in self.scenarios for e in self.of)
+        return tuple(s for s in (self.bin_from, self.range_from) if s) + repeats
 
 
 @dataclass(frozen=True)
@@ -161,6 +196,13 @@ class ExperimentFile:
     @property
     def check(self) -> CheckConfig:
         return self.setup.config
+
+    def for_experiment(self, exp: Experiment) -> 'ExperimentFile':
+        """The file an experiment's iterations run with: this one, or for a sensitivity
+        scenario's repeat this one with the scenario's setup and moves."""
+        if exp.scenario is None:
+            return self
+        return replace(self, setup=exp.scenario.setup, moves=exp.scenario.moves)
 
     def variant_setup(self, variant: GripperVariant | None) -> Setup:
         """The setup a check runs with: the file's, or a gripper_sweep variant's gripper and

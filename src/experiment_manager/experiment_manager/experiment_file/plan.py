@@ -19,6 +19,7 @@ from .model import (
     Experiment,
     ExperimentFile,
     GRIPPER_SWEEP,
+    SENSITIVITY,
     TABLE_SWEEP,
 )
 
@@ -62,7 +63,10 @@ class Unit:
 
 
 def groups(exp: Experiment) -> list[int]:
-    """The groups of `exp`'s iterations (Unit.group): its bins' indexes, its counts, or 0."""
+    """The groups of `exp`'s iterations (Unit.group): its bins' indexes, its counts, or 0;
+    none for a sensitivity experiment (its repeats are experiments of their own)."""
+    if exp.type == SENSITIVITY:
+        return []
     if exp.type == BIN_STATIC:
         return list(range(len(exp.bins)))
     if exp.type == TABLE_SWEEP:
@@ -80,13 +84,17 @@ def count_iterations(file: ExperimentFile) -> int:
 
 
 def plan(file: ExperimentFile, exp: Experiment, summary: dict) -> list[Unit]:
-    """The iterations of `exp`, given the metrics of the experiments before it."""
+    """The iterations of `exp`, given the metrics of the experiments before it. A sensitivity
+    scenario's repeat runs on the seeds of the experiment it repeats (scenarios.py)."""
     units = []
+    seeded_by = exp.id.partition('@')[0]
 
     def unit(group: int, i: int, container: ContainerSpec, parts: int, **kw) -> Unit:
-        return Unit(exp, group, i, iteration_seed(file.seed, exp.id, (group, i)), container,
-                    parts, **kw)
+        return Unit(exp, group, i, iteration_seed(file.seed, seeded_by, (group, i)),
+                    container, parts, **kw)
 
+    if exp.type == SENSITIVITY:
+        return []
     if exp.type == BIN_STATIC:
         for b, container in enumerate(exp.bins):
             units += [unit(b, i, container, exp.parts) for i in range(exp.iterations)]

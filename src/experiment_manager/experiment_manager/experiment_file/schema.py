@@ -33,6 +33,7 @@ from .model import (
     MM,
     Sampling,
     SEARCH_ORDERS,
+    SENSITIVITY,
     TABLE_SWEEP,
     TYPES,
 )
@@ -283,9 +284,44 @@ class GripperSweepKeys(ExperimentKeys):
     min_valid: Number(0.0, MAX_PARTS_PER_INSTANCE) = 1.0
 
 
+class InputRange(Section):
+    """One uncertain input of a sensitivity experiment: the range to try, in the key's units,
+    and where the range comes from (a datasheet, a measurement, a colleague's guess: said)."""
+
+    low: Number()
+    high: Number()
+    source: Annotated[str, BeforeValidator(
+        lambda v: v if isinstance(v, str) and v.strip() else fail(
+            'must say where the range comes from (a datasheet, a measurement, a guess)',
+            short(v)))]
+
+    @model_validator(mode='after')
+    def _ordered(self) -> 'InputRange':
+        if not self.low < self.high:
+            fail(f'must be above low ({self.low:g})', self.high, '.high')
+        return self
+
+
+def _inputs(value: Any) -> Any:
+    if not isinstance(value, Mapping) or not value:
+        fail('must map an input (part.lateral_friction, gripper.jaw_depth_mm, '
+             'moves.amplitude_scale, ...) to {low, high, source}', short(value))
+    return value
+
+
+class SensitivityKeys(ExperimentKeys):
+    """iterations: each repeat's most (the repeated experiment's own count if lower)."""
+
+    of: Annotated[list[Identifier], BeforeValidator(partial(
+        list_of, low=1, high=MAX_EXPERIMENTS, what='1 or more ids of earlier experiments'))]
+    inputs: Annotated[dict[str, InputRange], BeforeValidator(_inputs)]
+    joint: Int(0, 64) = 0
+
+
 EXPERIMENTS: dict[str, type[ExperimentKeys]] = {
     BIN_STATIC: BinStaticKeys, BIN_EMPTYING: BinEmptyingKeys, TABLE_SWEEP: TableSweepKeys,
-    FEEDER_EMPTYING: FeederEmptyingKeys, GRIPPER_SWEEP: GripperSweepKeys}
+    FEEDER_EMPTYING: FeederEmptyingKeys, GRIPPER_SWEEP: GripperSweepKeys,
+    SENSITIVITY: SensitivityKeys}
 
 
 def experiment_model(item: Any) -> type[Section]:

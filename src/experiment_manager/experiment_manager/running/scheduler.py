@@ -3,7 +3,10 @@ workers (backends), each iteration as soon as its experiment is ready, and hands
 iteration to the sink at once.
 
 An experiment is ready when the experiments it takes its bin or range from have finished (their
-metrics make its plan: plan.py); what one iteration does is procedures.py. With adaptive
+metrics make its plan: plan.py), a sensitivity experiment when its repeats have (it runs
+nothing of its own: its summary compares theirs); what one iteration does is procedures.py;
+a scenario's repeat runs with the scenario's setup and moves (ExperimentFile.for_experiment),
+given to a worker's backend when it changes. With adaptive
 sampling an experiment's iterations are released a batch per group at a time, while its
 decision is not settled (sampling.py). A worker that is lost gives its iteration back to the
 queue and may come back (Backend.rejoin).
@@ -17,9 +20,9 @@ import threading
 import time
 from typing import Protocol
 
-from ..analysis import metrics
+from ..analysis import metrics, sensitivity
 from ..analysis.rows import Record
-from ..experiment_file import BIN_STATIC, Experiment, ExperimentFile, GRIPPER_SWEEP
+from ..experiment_file import BIN_STATIC, Experiment, ExperimentFile, GRIPPER_SWEEP, SENSITIVITY
 from ..experiment_file.plan import count_iterations, experiment_iterations, plan, Unit
 from . import sampling
 from .backend import Backend, WorkerLost
@@ -142,8 +145,7 @@ class Runner:
         while changed:
             changed = False
             for exp in list(self._waiting):
-                sources = [s for s in (exp.bin_from, exp.range_from) if s]
-                if exp not in self._waiting or not all(s in self._summary for s in sources):
+                if exp not in self._waiting or not all(s in self._summary for s in exp.sources):
                     continue     # planned meanwhile (by the release a _finish made), or not yet
                 self._waiting.remove(exp)
                 index = self.file.experiments.index(exp)
@@ -215,9 +217,13 @@ class Runner:
         experiments waiting for it (under the lock)."""
         self.sink.reorder(self._rank)
         rows, checks = self.sink.iterations(exp.id), self.sink.checks(exp.id)
-        self._summary[exp.id] = metrics.summarise(
-            self.file, exp, rows, self.sink.picks(exp.id), self._summary, checks)
-        if self.file.sampling.adaptive:
+        if exp.type == SENSITIVITY:
+            self._summary[exp.id] = sensitivity.summarise(self.file, exp, self._summary)
+        else:
+            self._summary[exp.id] = metrics.summarise(
+                self.file.for_experiment(exp), exp, rows, self.sink.picks(exp.id),
+                self._summary, checks)
+        if self.file.sampling.adaptive and exp.type != SENSITIVITY:
             left = sampling.unsettled(self.file, exp, rows, checks)
             self._summary[exp.id]['sampling'] = {
                 'mode': self.file.sampling.mode, 'batch': self.file.sampling.batch,
@@ -233,6 +239,7 @@ class Runner:
         in flight it waits rather than leave: their end may release an experiment, and a lost
         worker's iteration comes back to the queue."""
         backend = self.backends[k]
+        scenario = None     # the scenario `backend` was last given (None: the file's own)
         while True:
             with self._cond:
                 while not self._ready and self._in_flight and not self._errors:
@@ -243,7 +250,11 @@ class Runner:
                 self._in_flight += 1
                 self._report(u.experiment, f'{u.experiment.id}: {u.label}')
             try:
-                record = run_unit(self.file, u, backend)
+                file = self.file.for_experiment(u.experiment)
+                if u.experiment.scenario is not scenario:
+                    backend.start(file)
+                    scenario = u.experiment.scenario
+                record = run_unit(file, u, backend)
             except WorkerLost as exc:
                 with self._cond:
                     heapq.heappush(self._ready, (self._rank[u.key], u))

@@ -1,0 +1,159 @@
+"""How far a run's answers and verdicts move with the inputs nobody can measure before the
+hardware is bought: a sensitivity experiment's summary (issue 44).
+
+A sensitivity experiment repeats experiments of the file in scenarios (experiment_file/
+scenarios.py: each input at its low and its high, the others at the file's values, and jointly
+in a Latin hypercube). Its summary puts side by side, per scenario, the headline answers
+(`ANSWERS`: the best bin, n* and the valid parts per check there, the cell's time to empty a
+refill and the vibrations it took, the parts removed per bin) and the verdicts (verdicts.py,
+on the scenario's repeats standing in for the experiments they repeat); per input, each
+answer at its low and its high against the file's values (a tornado chart's bars,
+report.py); and per option whether its verdict holds in every scenario or which scenarios
+flip it, with the inputs' values there.
+
+Pure: no rclpy, no files.
+"""
+
+from ..experiment_file import ExperimentFile
+from ..experiment_file.model import Experiment
+from . import metrics
+from .verdicts import NOT_ANALYSED, option_kind, UNDECIDED, verdicts
+from .wording import fmt
+
+# answer -> (its words, its unit)
+ANSWERS = {
+    'best_bin': ('best bin', 'mm'),
+    'n_star': ('n*', 'parts'),
+    'valid_at_n_star': ('valid parts per check at n*', 'parts'),
+    'time_to_empty': ("cell's time to empty a refill, 90 % bound", 'min'),
+    'vibrations': ('vibrations to empty the feeder, mean', ''),
+    'removed': ('parts removed per bin, mean', 'parts'),
+    'bins_emptied': ('bins emptied', 'share'),
+}
+
+
+def answers(experiments: dict) -> dict:
+    """The headline answers of one scenario's experiments (id -> summary, as the file names
+    them): those its experiments give, the last of each type."""
+    out = {}
+    last = {s['type']: s for s in experiments.values()}
+    if (s := last.get('bin_static')) and s.get('best_bin_mm'):
+        out['best_bin'] = 'x'.join(fmt(v) for v in s['best_bin_mm'])
+    if (s := last.get('table_sweep')) and s.get('n_star') is not None:
+        out['n_star'] = s['n_star']
+        near = min(s['per_n'], key=lambda p: abs(p['n'] - s['n_star']), default=None)
+        if near is not None:
+            out['valid_at_n_star'] = near['valid']['mean']
+    if s := last.get('feeder_emptying'):
+        bound = s['decision']['time']['bound']
+        out['time_to_empty'] = None if bound is None else bound / 60.0
+        out['vibrations'] = s['vibrations_to_empty']['mean']
+    if s := last.get('bin_emptying'):
+        out['removed'] = s['removed']['mean']
+        out['bins_emptied'] = s['emptied'] / s['iterations'] if s['iterations'] else None
+    return out
+
+
+def summarise(file: ExperimentFile, exp: Experiment, summaries: dict) -> dict:
+    """The sensitivity experiment `exp`'s summary from every experiment's (`summaries`, by
+    id; its repeats among them)."""
+    base = {k: v for k, v in summaries.items() if '@' not in k and v['type'] != exp.type}
+
+    def view(scenario: str | None) -> dict:
+        swapped = dict(base)
+        if scenario is not None:
+            swapped.update({e: summaries[f'{e}@{scenario}'] for e in exp.of})
+        return swapped
+
+    def decided(experiments: dict) -> dict:
+        said = verdicts(metrics.file_summary(file, experiments))
+        return {option_kind(v['option']): v['verdict'] for v in said
+                if v['verdict'] != NOT_ANALYSED}
+
+    def said(experiments: dict) -> dict:
+        # the answers of the experiments repeated (the others' do not move)
+        return {'answers': answers({e: experiments[e] for e in exp.of}),
+                'verdicts': decided(experiments)}
+
+    base_said = said(view(None))
+    scenarios = [{'name': sc.name, 'values': dict(sc.values), **said(view(sc.name))}
+                 for sc in exp.scenarios]
+    by_name = {s['name']: s for s in scenarios}
+    tornado = {}
+    for key in ANSWERS:
+        if key not in base_said['answers'] or key == 'best_bin':
+            continue
+        tornado[key] = {x.name: {'low': by_name[f'{_stem(x.name)}_low']['answers'].get(key),
+                                 'high': by_name[f'{_stem(x.name)}_high']['answers'].get(key)}
+                        for x in exp.inputs}
+    repeats = {f'{e}@{sc.name}': summaries[f'{e}@{sc.name}'] for sc in exp.scenarios
+               for e in exp.of}
+    return {'type': exp.type, 'of': list(exp.of), 'iterations': exp.iterations,
+            'inputs': [{'name': x.name, 'base': x.base, 'low': x.low, 'high': x.high,
+                        'source': x.source} for x in exp.inputs],
+            'base': base_said, 'scenarios': scenarios, 'tornado': tornado,
+            'ranges': _ranges(base_said, scenarios),
+            'robustness': _robustness(exp, base_said, scenarios),
+            'faults': _faults(repeats), 'physics': _physics(repeats)}
+
+
+def _stem(name: str) -> str:
+    return name.replace('.', '_')
+
+
+def _ranges(base: dict, scenarios: list[dict]) -> dict:
+    """Per answer, the values over the base and every scenario: numbers as [min, max],
+    the best bin as the bins named."""
+    out = {}
+    for key in ANSWERS:
+        values = [s['answers'].get(key) for s in [base, *scenarios]]
+        values = [v for v in values if v is not None]
+        if not values:
+            continue
+        out[key] = sorted(set(values)) if key == 'best_bin' else [min(values), max(values)]
+    return out
+
+
+def _robustness(exp: Experiment, base: dict, scenarios: list[dict]) -> list[dict]:
+    """Per option of the base verdicts: whether it holds in every scenario, and where not,
+    the scenarios that flip it (their verdict and their inputs' values), with a line for the
+    terminal."""
+    inputs = {x.name: x for x in exp.inputs}
+    out = []
+    for option, verdict in base['verdicts'].items():
+        flips = [{'scenario': s['name'], 'verdict': s['verdicts'].get(option),
+                  'values': s['values']} for s in scenarios
+                 if s['verdicts'].get(option) != verdict]
+        if not flips:
+            said = (f'{verdict} over all ranges ({len(scenarios)} scenarios: '
+                    + ', '.join(inputs) + ')')
+        else:
+            where = []
+            for f in flips:
+                values = ', '.join(f'{k} {fmt(v, 4)}' for k, v in f['values'].items())
+                where.append(f'{f["verdict"]} at {values}')
+            said = (f'{verdict} here, but ' + '; '.join(where)
+                    + f' ({len(flips)} of {len(scenarios)} scenarios)')
+            if all(f['verdict'] == UNDECIDED for f in flips):
+                said += ': the runs there do not settle it, which is not a flip to the other side'
+        out.append({'option': option, 'verdict': verdict, 'holds': not flips,
+                    'flips': flips, 'said': said, 'line': f'{option} {said}',
+                    'sources': {k: inputs[k].source for f in flips for k in f['values']}})
+    return out
+
+
+def _faults(repeats: dict) -> dict:
+    """The repeats' fault counts, added (metrics.fault_counts' keys), and their flagged
+    iterations."""
+    out = {k: sum(r['faults'][k] for r in repeats.values()) for k in metrics.FAULTS}
+    out['flagged'] = [{'experiment': exp_id, **f} for exp_id, r in repeats.items()
+                      for f in r['faults']['flagged']]
+    return out
+
+
+def _physics(repeats: dict) -> dict:
+    """The repeats' physics health (metrics.physics' keys): totals and worsts."""
+    total = ('spilled', 'tunnelled', 'thrown')
+    keys = next(iter(repeats.values()))['physics'] if repeats else {}
+    return {k: (sum if k in total else max)(r['physics'][k] for r in repeats.values())
+            for k in keys}

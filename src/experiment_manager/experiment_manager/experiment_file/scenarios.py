@@ -1,0 +1,122 @@
+"""A sensitivity experiment's scenarios: the inputs nobody can measure before the hardware is
+bought, varied one at a time and jointly, each scenario a setup and table moves for the
+repeats of the experiments it names (issue 44).
+
+The inputs (`INPUTS`), in the file's units: the part's friction, rolling and spinning arms,
+restitution and mass (part.*), the gripper's dimensions (gripper.*), and the table moves'
+amplitude, frequency and duration as factors on every move of the cycle (moves.*_scale: the
+cycle may mix moves, so one number in Hz or s would not say which). The design:
+- one at a time: a scenario at each input's low and one at its high, the others at the file's
+  values (`<input>_low`, `<input>_high`, dots as underscores);
+- joint (`joint: K`): K scenarios of a Latin hypercube over all the inputs' ranges (McKay,
+  Beckman and Conover, Technometrics 21(2), 1979): each input's range cut in K equal strata,
+  one value drawn in each, the strata paired at random; seeded by the file's seed and the
+  experiment's id (`joint_1` ... `joint_K`).
+Every repeat runs on the seeds of the experiment it repeats (plan.iteration_seed takes the
+repeated experiment's id): what differs between scenarios is the input, not the draw
+(common random numbers).
+
+Pure: no rclpy, no simulator.
+"""
+
+from dataclasses import replace
+import zlib
+
+import numpy as np
+from pick_common.errors import check_number, InvalidArgument
+from pick_common.specs import check_vibration, Vibration
+from pick_validity.config import check_gripper, Setup
+
+from .model import G, Input, MM, Scenario
+
+# name -> (section, attribute, the file unit in SI, low limit, high limit, low open)
+INPUTS = {
+    'part.lateral_friction': ('part', 'lateral_friction', 1.0, 0.0, 10.0, False),
+    'part.rolling_friction_mm': ('part', 'rolling_friction', MM, 0.0, 100.0, False),
+    'part.spinning_friction_mm': ('part', 'spinning_friction', MM, 0.0, 100.0, False),
+    'part.restitution': ('part', 'restitution', 1.0, 0.0, 1.0, False),
+    'part.mass_g': ('part', 'mass', G, 0.0, 10_000.0, True),
+    'gripper.body_diameter_mm': ('gripper', 'body_diameter', MM, 0.0, None, True),
+    'gripper.body_length_mm': ('gripper', 'body_length', MM, 0.0, None, True),
+    'gripper.jaw_height_mm': ('gripper', 'jaw_height', MM, 0.0, None, True),
+    'gripper.jaw_depth_mm': ('gripper', 'jaw_depth', MM, 0.0, None, True),
+    'gripper.finger_clearance_mm': ('gripper', 'finger_clearance', MM, 0.0, None, False),
+    'moves.amplitude_scale': ('moves', 'amplitude', 1.0, 0.0, None, True),
+    'moves.frequency_scale': ('moves', 'frequency', 1.0, 0.0, None, True),
+    'moves.duration_scale': ('moves', 'duration', 1.0, 0.0, None, True),
+}
+MAX_REPEATS = 200    # scenarios x experiments repeated, per sensitivity experiment
+
+
+def base_value(name: str, setup: Setup, mass: float) -> float:
+    """The file's value of input `name`, in the file's units (`mass`: the part's mass, kg,
+    which the file may leave to the model)."""
+    section, attr, unit = INPUTS[name][:3]
+    if section == 'moves':
+        return 1.0
+    if attr == 'mass':
+        return mass / unit
+    return getattr(getattr(setup, section), attr) / unit
+
+
+def check_input(name: str, value: float, where: str) -> float:
+    """An input's value within its key's limits (the schema's for the part's keys)."""
+    low, high, low_open = INPUTS[name][3:]
+    return check_number(where, value, low=low, high=high, low_open=low_open)
+
+
+def apply(values: dict[str, float], setup: Setup, moves: tuple[Vibration, ...], where: str
+          ) -> tuple[Setup, tuple[Vibration, ...]]:
+    """The setup and moves with `values` (input name -> file units) set, each checked by the
+    core's rules, named at `where`."""
+    part, gripper, scale = {}, {}, {}
+    for name, value in values.items():
+        section, attr, unit = INPUTS[name][:3]
+        {'part': part, 'gripper': gripper, 'moves': scale}[section][attr] = value * unit
+    new_gripper = replace(setup.gripper, **gripper)
+    try:
+        check_gripper(new_gripper)
+    except InvalidArgument as exc:
+        raise InvalidArgument(f'{where} ({exc.field})', exc.value, exc.rule) from None
+    new_moves = []
+    for i, m in enumerate(moves):
+        move = Vibration(tuple(a * scale.get('amplitude', 1.0) for a in m.amplitude),
+                         m.frequency * scale.get('frequency', 1.0),
+                         m.duration * scale.get('duration', 1.0), m.direction)
+        try:
+            new_moves.append(check_vibration(move))
+        except InvalidArgument as exc:
+            raise InvalidArgument(f'{where} (moves[{i}]: {exc.field})', exc.value,
+                                  exc.rule) from None
+    return (replace(setup, part=replace(setup.part, **part), gripper=new_gripper),
+            tuple(new_moves))
+
+
+def latin_hypercube(inputs: tuple[Input, ...], k: int, seed: int, experiment_id: str
+                    ) -> list[dict[str, float]]:
+    """k points of a Latin hypercube over the inputs' [low, high] (module docstring)."""
+    rng = np.random.default_rng([seed & 0xFFFFFFFF, seed >> 32,
+                                 zlib.crc32(experiment_id.encode())])
+    points = [{} for _ in range(k)]
+    for x in inputs:
+        strata = (rng.permutation(k) + rng.random(k)) / k
+        for point, u in zip(points, strata, strict=True):
+            point[x.name] = float(x.low + u * (x.high - x.low))
+    return points
+
+
+def scenarios(inputs: tuple[Input, ...], joint: int, setup: Setup,
+              moves: tuple[Vibration, ...], seed: int, experiment_id: str, where: str
+              ) -> tuple[Scenario, ...]:
+    """The scenarios of a sensitivity experiment (module docstring), each checked."""
+    design: list[tuple[str, dict[str, float]]] = []
+    for x in inputs:
+        stem = x.name.replace('.', '_')
+        design += [(f'{stem}_low', {x.name: x.low}), (f'{stem}_high', {x.name: x.high})]
+    design += [(f'joint_{i + 1}', point) for i, point in
+               enumerate(latin_hypercube(inputs, joint, seed, experiment_id))]
+    out = []
+    for name, values in design:
+        s, m = apply(values, setup, moves, f'{where}.inputs ({name})')
+        out.append(Scenario(name, tuple(values.items()), s, m))
+    return tuple(out)

@@ -1,0 +1,175 @@
+"""The sensitivity experiment: its scenarios as the loader builds them, the errors it names,
+and (on the small file's run on the cores) what its repeats ran with and what its summary,
+verdicts and report say."""
+
+import os
+
+from experiment_manager import experiment_file
+from experiment_manager.analysis import report
+from experiment_manager.analysis.results import read_csv
+from experiment_manager.analysis.verdicts import verdicts
+from experiment_manager.commands.run import _summary_lines
+from experiment_manager.experiment_file.plan import plan
+from experiment_manager.experiment_file.scenarios import latin_hypercube
+import numpy as np
+from pick_common.errors import InvalidArgument
+import pytest
+
+SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
+HEAD = """id: s
+seed: 3
+gripper: {body_diameter_mm: 8, jaw_depth_mm: 3}
+moves: [flip, {move: forward, duration_s: 0.2}]
+experiments:
+  - {id: bins, type: bin_static, iterations: 3, parts: 20, bins_mm: [[100, 100, 20]]}
+  - {id: emptying, type: bin_emptying, iterations: 4, parts: 20, bin: bins}
+  - {id: sweep, type: table_sweep, iterations: 1, counts: {first: 2, last: 6, step: 2}}
+"""
+
+
+def sensitivity(text: str) -> str:
+    return HEAD + '  - {id: robust, type: sensitivity, ' + text + '}\n'
+
+
+def test_each_input_gets_a_low_and_a_high_scenario_and_the_repeats_keep_their_sources():
+    f = experiment_file.parse(sensitivity(
+        'iterations: 2, of: [emptying], joint: 3, inputs: {'
+        'part.lateral_friction: {low: 0.2, high: 0.9, source: tilting-plane tests}, '
+        'gripper.jaw_depth_mm: {low: 2, high: 5, source: catalogue}, '
+        'moves.duration_scale: {low: 0.5, high: 2, source: feeder manual}}'))
+    robust = f.experiment('robust')
+    names = [s.name for s in robust.scenarios]
+    assert names == ['part_lateral_friction_low', 'part_lateral_friction_high',
+                     'gripper_jaw_depth_mm_low', 'gripper_jaw_depth_mm_high',
+                     'moves_duration_scale_low', 'moves_duration_scale_high',
+                     'joint_1', 'joint_2', 'joint_3']
+    assert [x.base for x in robust.inputs] == [0.5, 3.0, 1.0]
+    assert robust.inputs[0].source == 'tilting-plane tests'
+    # the repeats come before the sensitivity experiment, capped at its iterations, and take
+    # their bin from the file's `bins` (not repeated)
+    assert [e.id for e in f.experiments][3:] == [f'emptying@{n}' for n in names] + ['robust']
+    low = f.experiment('emptying@part_lateral_friction_low')
+    assert low.iterations == 2 and low.bin_from == 'bins'
+    assert robust.sources[-1] == 'emptying@joint_3'
+    # one input changed, the rest as in the file
+    run = f.for_experiment(low)
+    assert run.part.lateral_friction == 0.2 and run.gripper == f.gripper
+    assert run.moves == f.moves and f.for_experiment(f.experiment('emptying')) is f
+    deep = f.for_experiment(f.experiment('emptying@gripper_jaw_depth_mm_high'))
+    assert deep.gripper.jaw_depth == pytest.approx(0.005) and deep.part == f.part
+    slow = f.for_experiment(f.experiment('emptying@moves_duration_scale_high'))
+    assert [m.duration for m in slow.moves] == pytest.approx([2 * m.duration for m in f.moves])
+    assert [m.amplitude for m in slow.moves] == [m.amplitude for m in f.moves]
+    # common random numbers: a repeat's iterations have the seeds of the experiment's own
+    summary = {'bins': {'best_bin': 0}}
+    assert [u.seed for u in plan(f, low, summary)] == [
+        u.seed for u in plan(f, f.experiment('emptying'), summary)][:2]
+
+
+def test_a_repeated_source_is_taken_from_the_same_scenario():
+    f = experiment_file.parse(sensitivity(
+        'iterations: 1, of: [bins, emptying], inputs: {'
+        'part.restitution: {low: 0, high: 0.3, source: guess}}'))
+    assert f.experiment('emptying@part_restitution_high').bin_from == 'bins@part_restitution_high'
+
+
+def test_the_joint_scenarios_are_a_latin_hypercube():
+    f = experiment_file.parse(sensitivity(
+        'iterations: 1, of: [sweep], joint: 10, inputs: {'
+        'part.lateral_friction: {low: 0.2, high: 0.7, source: a}, '
+        'part.mass_g: {low: 0.5, high: 1.5, source: b}}'))
+    robust = f.experiment('robust')
+    joint = [dict(s.values) for s in robust.scenarios if s.name.startswith('joint')]
+    for x in robust.inputs:      # one value in each tenth of each range
+        strata = sorted(int((p[x.name] - x.low) / (x.high - x.low) * 10) for p in joint)
+        assert strata == list(range(10)), x.name
+    assert joint == latin_hypercube(robust.inputs, 10, 3, 'robust')   # seeded: the same again
+    mass = f.for_experiment(f.experiment('sweep@joint_1')).part.mass
+    assert mass == pytest.approx(joint[0]['part.mass_g'] / 1000)
+
+
+@pytest.mark.parametrize('text, field, rule', [
+    ('iterations: 1, of: [sweep], inputs: {part.colour: {low: 0, high: 1, source: x}}',
+     r'experiments\[3\]\.inputs\.part\.colour', 'is not an input a sensitivity experiment '
+     r'varies \(part\.lateral_friction'),
+    ('iterations: 1, of: [sweep], inputs: {part.restitution: {low: 0.5, high: 0.2, source: x}}',
+     r'experiments\[3\]\.inputs\.part\.restitution\.high', r'must be above low \(0\.5\)'),
+    ('iterations: 1, of: [sweep], inputs: {part.restitution: {low: 0.1, high: 0.2}}',
+     r'experiments\[3\]\.inputs\.part\.restitution\.source', 'is required|missing'),
+    ('iterations: 1, of: [sweep], inputs: {part.restitution: {low: 0.1, high: 1.5, source: x}}',
+     r'experiments\[3\]\.inputs\.part\.restitution\.high', r'1\.5'),
+    ('iterations: 1, of: [feeder], inputs: {part.restitution: {low: 0, high: 1, source: x}}',
+     r'experiments\[3\]\.of\[0\]', 'names no earlier experiment'),
+    ('iterations: 1, of: [sweep], inputs: {gripper.jaw_depth_mm: {low: 1, high: 1200, '
+     'source: x}}', r'experiments\[3\]\.inputs \(gripper_jaw_depth_mm_high\) '
+     r'\(gripper\.jaw_depth\)', ''),
+    ('iterations: 1, of: [sweep], inputs: {moves.amplitude_scale: {low: 1, high: 40, '
+     'source: x}}', r'experiments\[3\]\.inputs \(moves_amplitude_scale_high\) \(moves\[0\]',
+     ''),
+])
+def test_a_bad_sensitivity_experiment_is_named(text, field, rule):
+    with pytest.raises(InvalidArgument, match=field + '.*' + rule):
+        experiment_file.parse(sensitivity(text))
+
+
+def test_the_repeats_ran_with_their_scenario_and_the_summary_compares_them(small):
+    directory, summary = small
+    rows = read_csv(os.path.join(directory, 'iterations.csv'))
+    by_id = {r['experiment']: r for r in rows if r['experiment'].startswith('feeder')}
+    # the same seed in every scenario; what differs is the input
+    assert len({r['seed'] for r in by_id.values()}) == 1
+    base = by_id['feeder']
+    moved = [k for k, r in by_id.items() if k != 'feeder' and _run(r) != _run(base)]
+    assert set(moved) >= {'feeder@part_lateral_friction_low',
+                          'feeder@gripper_body_diameter_mm_high'}, moved
+    s = summary['experiments']['robust']
+    assert set(summary['repeats']) == {f'feeder@{x["name"]}' for x in s['scenarios']}
+    assert [x['name'] for x in s['inputs']] == ['part.lateral_friction',
+                                                'gripper.body_diameter_mm',
+                                                'moves.amplitude_scale']
+    assert s['inputs'][1]['base'] == 8.0 and s['inputs'][0]['source'] == 'a guess, for the tests'
+    # the answers are the repeats' own; the tornado's bars are the low and high scenarios'
+    for x in s['scenarios']:
+        repeat = summary['repeats'][f'feeder@{x["name"]}']
+        assert x['answers']['vibrations'] == repeat['vibrations_to_empty']['mean']
+    scenario = {x['name']: x['answers'] for x in s['scenarios']}
+    assert s['tornado']['vibrations']['part.lateral_friction'] == {
+        'low': scenario['part_lateral_friction_low']['vibrations'],
+        'high': scenario['part_lateral_friction_high']['vibrations']}
+    seen = [x['answers']['vibrations'] for x in [s['base'], *s['scenarios']]]
+    assert s['ranges']['vibrations'] == [min(v for v in seen if v is not None),
+                                         max(v for v in seen if v is not None)]
+    # the table's verdict in each scenario, and said with the file's verdict
+    table = next(r for r in s['robustness'] if r['option'] == 'vibrating table')
+    said = {x['verdicts']['vibrating table'] for x in s['scenarios']}
+    assert table['holds'] == (said == {table['verdict']})
+    reasons = next(v for v in verdicts(summary) if v['option'] == 'vibrating table')['reasons']
+    assert reasons[-1] == f'over the ranges of `robust`: {table["said"]}'
+    assert f'    {table["line"]}' in _summary_lines(summary)
+
+
+def test_the_report_draws_the_tornado_and_lists_the_scenarios(small, tmp_path):
+    directory, summary = small
+    text = report.markdown(summary, {}, {'sensitivity_robust': True})
+    section = text.split('## How far the answers move (`robust`)')[1].split('\n## ')[0]
+    assert '![tornado chart of robust](sensitivity_robust.png)' in section
+    assert '| `part.lateral_friction` | 0.5 | 0.3 | 0.8 | a guess, for the tests |' in section
+    assert '| part_lateral_friction_low | part.lateral_friction 0.3 |' in section
+    path = str(tmp_path / 'tornado.png')
+    assert report.plot_tornado('robust', summary['experiments']['robust'], path)
+    with open(path, 'rb') as f:
+        assert f.read(8) == b'\x89PNG\r\n\x1a\n'
+
+
+def _run(row: dict) -> tuple:
+    """What a feeder run did, as iterations.csv says it."""
+    return tuple(row[k] for k in ('picks', 'checks', 'vibrations', 'feeds', 'table_time'))
+
+
+def test_values_outside_a_range_are_not_drawn():
+    f = experiment_file.parse(sensitivity(
+        'iterations: 1, of: [sweep], joint: 64, inputs: {'
+        'part.spinning_friction_mm: {low: 0, high: 0.5, source: a}}'))
+    values = np.array([dict(s.values)['part.spinning_friction_mm']
+                       for s in f.experiment('robust').scenarios])
+    assert values.min() >= 0 and values.max() <= 0.5
