@@ -236,6 +236,40 @@ def test_the_run_s_verdicts_are_published_recorded_and_printed(graph_run):
         assert line.startswith(f'  {v["option"].replace("`", "")}: {v["verdict"]} ('), line
 
 
+SENSITIVITY = os.path.join(os.path.dirname(SMALL), 'sensitivity_experiment.yaml')
+
+
+def test_a_sensitivity_run_through_the_graph_gives_the_cores_answers_and_records_them(
+        tmp_path, private_ros_domain):
+    """A feeder run repeated in 8 scenarios (the part's friction, the gripper, the table's
+    moves) on two workers, each switched between scenarios as iterations reach it: the rows
+    are the cores', and the sensitivity's summary is in summary.json, the report, the
+    recording (an independent reader) and run's output."""
+    done = run_command(SENSITIVITY, '--output', str(tmp_path / 'out'), '--namespace',
+                       unique_namespace('sens'), '--workers', '2')
+    assert done.returncode == 0, done.stderr
+    run_dir = re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1)
+    file = experiment_file.load(SENSITIVITY)
+    cores = str(tmp_path / 'cores')
+    with LocalBackend() as backend, ResultsWriter(cores, file.text) as writer:
+        expected = Runner(file, [backend], writer).run()
+    for name in FILES:
+        assert rows(run_dir, name) == rows(cores, name), name
+    with open(os.path.join(run_dir, 'summary.json')) as f:
+        summary = json.load(f)
+    robust = summary['experiments']['robust']
+    assert robust == expected['experiments']['robust'] and len(robust['scenarios']) == 8
+    for r in robust['robustness']:
+        assert f'    {r["line"]}' in done.stdout.splitlines()
+    report = open(os.path.join(run_dir, 'report.md')).read()
+    assert '## How far the answers move (`robust`)' in report
+    assert os.path.exists(os.path.join(run_dir, 'sensitivity_robust.png'))
+    recording = re.search(r'^recording:\s+(\S+)', done.stdout, re.M).group(1)
+    with open(recording, 'rb') as f:
+        attached = {a.name: a.data for a in make_reader(f).iter_attachments()}
+    assert json.loads(attached['summary.json'])['experiments']['robust'] == robust
+
+
 def start_replay(client, recording: str, name: str, rate: str) -> tuple[subprocess.Popen, list]:
     """`replay` of worker_0's results at `rate` under the prefix `name` (one per test: no test
     hears another's replay), and the list that receives what it publishes. The replay waits

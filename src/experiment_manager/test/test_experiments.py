@@ -40,7 +40,7 @@ def test_every_type_records_its_rows_and_metrics(small):
     directory, summary = small
     rows = read(directory, 'iterations')
     by_type = {t: [r for r in rows if r['type'] == t] for t in experiment_file.TYPES}
-    assert [len(by_type[t]) for t in experiment_file.TYPES] == [4, 1, 8, 1 + 6, 2, 0]
+    assert [len(by_type[t]) for t in experiment_file.TYPES] == [4, 1, 8, 1, 2, 0]
     for r in rows:
         n = [int(r[k]) for k in ('checked', 'candidates', 'placeable', 'container_free')]
         assert n == sorted(n, reverse=True), r      # each stage passes a subset of the last
@@ -176,13 +176,12 @@ def test_runs_are_deterministic_and_independent_of_order(small, tmp_path):
         written = json.load(f)
     for exp in file.experiments:   # planned as the run plans them, then run backwards
         units += plan(file, exp, summary)
-        summary[exp.id] = {**written['experiments'], **written['repeats']}[exp.id]
+        summary[exp.id] = written['experiments'][exp.id]
     records = {}
     with LocalBackend() as backend:
-        for u in reversed(units):   # a sensitivity scenario's repeats among the others
-            scenario_file = file.for_experiment(u.experiment)
-            backend.start(scenario_file)
-            records[u.key] = run_unit(scenario_file, u, backend)
+        backend.start(file)
+        for u in reversed(units):
+            records[u.key] = run_unit(file, u, backend)
     rows = read(directory, 'iterations')
     for row in rows:
         again = records[(row['experiment'], int(row['group']), int(row['iteration']))]
@@ -355,7 +354,7 @@ def test_a_physics_fault_is_marked_left_out_of_the_figures_and_the_run_goes_on(s
     _, got, _ = run_on([Worker(nan_at=2)], str(tmp_path / 'nan'))
     rows = read(str(tmp_path / 'nan'), 'iterations')
     expected = read(directory, 'iterations')
-    assert len(rows) == len(expected) == 16 + 6      # 6: the sensitivity experiment's repeats
+    assert len(rows) == len(expected) == 16
     faulted = rows.pop(1)
     assert faulted['fault'] == 'physics_fault' and faulted['checks'] == '0'
     assert re.match(r'physics_fault: parts \[0\b.*\] got non-finite poses', faulted['stop'])

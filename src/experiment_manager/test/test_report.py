@@ -31,19 +31,19 @@ def _summary(run_dir):
 def test_a_run_gets_its_report_files(run_dir):
     path = report.write(run_dir)
     assert path == os.path.join(run_dir, 'report.html')
-    for name in ('fig14_bins.png', 'fig15_table.png', 'grippers.png', 'sensitivity_robust.png'):
+    for name in ('fig14_bins.png', 'fig15_table.png', 'grippers.png'):
         with open(os.path.join(run_dir, name), 'rb') as f:
             assert f.read(8) == b'\x89PNG\r\n\x1a\n', name
     text = open(os.path.join(run_dir, 'report.md')).read()
     page = open(path).read()
     for heading in ('## Verdict', '## Static bins', '## Bin emptying', '## Vibrating table sweep',
-                    '## Feeder emptying', '## Gripper sweep', '## How far the answers move',
-                    '## Physics health', '## Why parts were turned down'):
+                    '## Feeder emptying', '## Gripper sweep', '## Physics health',
+                    '## Why parts were turned down'):
         assert heading in text
         assert f'<h2>{heading[3:]}' in page
     separators = [line for line in text.splitlines() if line.startswith('| --- |')]
-    assert page.count('<table>') == len(separators) == 10 and 'fig15_table.png' in page
-    assert 'grippers.png' in page and 'sensitivity_robust.png' in page
+    assert page.count('<table>') == len(separators) == 8 and 'fig15_table.png' in page
+    assert 'grippers.png' in page
     assert 'paper' not in text.split('## Verdict')[1]      # id `small`: no paper numbers
     assert 'No iteration was flagged' in text
     assert re.search(r'The cell would pick [\d.]+ parts per hour \(mean of 1 run; required '

@@ -1,21 +1,25 @@
 """The sensitivity experiment: its scenarios as the loader builds them, the errors it names,
-and (on the small file's run on the cores) what its repeats ran with and what its summary,
-verdicts and report say."""
+and (sensitivity_experiment.yaml run on the cores) what its repeats ran with and what its
+summary, verdicts and report say. tests/test_experiment_graph.py runs the same file through
+the graph."""
 
 import os
 
 from experiment_manager import experiment_file
 from experiment_manager.analysis import report
-from experiment_manager.analysis.results import read_csv
+from experiment_manager.analysis.results import read_csv, read_text_rows, ResultsWriter
 from experiment_manager.analysis.verdicts import verdicts
 from experiment_manager.commands.run import _summary_lines
 from experiment_manager.experiment_file.plan import plan
 from experiment_manager.experiment_file.scenarios import latin_hypercube
+from experiment_manager.running.local_backend import LocalBackend
+from experiment_manager.running.procedures import run_unit
+from experiment_manager.running.scheduler import Runner
 import numpy as np
 from pick_common.errors import InvalidArgument
 import pytest
 
-SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
+SENSITIVITY = os.path.join(os.path.dirname(__file__), 'sensitivity_experiment.yaml')
 HEAD = """id: s
 seed: 3
 gripper: {body_diameter_mm: 8, jaw_depth_mm: 3}
@@ -25,6 +29,15 @@ experiments:
   - {id: emptying, type: bin_emptying, iterations: 4, parts: 20, bin: bins}
   - {id: sweep, type: table_sweep, iterations: 1, counts: {first: 2, last: 6, step: 2}}
 """
+
+
+@pytest.fixture(scope='module')
+def sens(tmp_path_factory) -> tuple[str, dict]:
+    """sensitivity_experiment.yaml run on the cores: (run directory, summary)."""
+    directory = str(tmp_path_factory.mktemp('sens'))
+    file = experiment_file.load(SENSITIVITY)
+    with LocalBackend() as backend, ResultsWriter(directory, file.text) as writer:
+        return directory, Runner(file, [backend], writer).run()
 
 
 def sensitivity(text: str) -> str:
@@ -112,8 +125,8 @@ def test_a_bad_sensitivity_experiment_is_named(text, field, rule):
         experiment_file.parse(sensitivity(text))
 
 
-def test_the_repeats_ran_with_their_scenario_and_the_summary_compares_them(small):
-    directory, summary = small
+def test_the_repeats_ran_with_their_scenario_and_the_summary_compares_them(sens):
+    directory, summary = sens
     rows = read_csv(os.path.join(directory, 'iterations.csv'))
     by_id = {r['experiment']: r for r in rows if r['experiment'].startswith('feeder')}
     # the same seed in every scenario; what differs is the input
@@ -148,8 +161,8 @@ def test_the_repeats_ran_with_their_scenario_and_the_summary_compares_them(small
     assert f'    {table["line"]}' in _summary_lines(summary)
 
 
-def test_the_report_draws_the_tornado_and_lists_the_scenarios(small, tmp_path):
-    directory, summary = small
+def test_the_report_draws_the_tornado_and_lists_the_scenarios(sens, tmp_path):
+    directory, summary = sens
     text = report.markdown(summary, {}, {'sensitivity_robust': True})
     section = text.split('## How far the answers move (`robust`)')[1].split('\n## ')[0]
     assert '![tornado chart of robust](sensitivity_robust.png)' in section
@@ -159,6 +172,21 @@ def test_the_report_draws_the_tornado_and_lists_the_scenarios(small, tmp_path):
     assert report.plot_tornado('robust', summary['experiments']['robust'], path)
     with open(path, 'rb') as f:
         assert f.read(8) == b'\x89PNG\r\n\x1a\n'
+
+
+def test_repeats_give_the_same_rows_in_any_order_on_a_backend_switched_between_scenarios(sens):
+    directory, _ = sens
+    file = experiment_file.load(SENSITIVITY)
+    units = [u for e in file.experiments for u in plan(file, e, {})]
+    again = {}
+    with LocalBackend() as backend:
+        for u in reversed(units):      # every unit on another scenario than the last
+            scenario_file = file.for_experiment(u.experiment)
+            backend.start(scenario_file)
+            again[u.key] = run_unit(scenario_file, u, backend).iteration
+    for row in read_text_rows(os.path.join(directory, 'iterations.csv'), drop=('wall_time',)):
+        got = again[(row['experiment'], int(row['group']), int(row['iteration']))]
+        assert {k: str(v) for k, v in got.items() if k != 'wall_time'} == row
 
 
 def _run(row: dict) -> tuple:
