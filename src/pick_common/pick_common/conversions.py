@@ -30,7 +30,7 @@ from .errors import (
     UnknownPart,
 )
 from .parts import PartSpec
-from .specs import FIXED, RANDOM, Vibration
+from .specs import CENTRE, FIXED, RANDOM, Vibration
 from .states import PartStates, Progress, SettleReport, TrayMotion
 
 # Error codes are the same in every pick_msgs service and action.
@@ -230,7 +230,8 @@ def progress_to_msg(progress: Progress) -> PhysicsProgress:
 
 
 # ----------------------------------------------------------------------------- vibrations
-_DIRECTION_NAMES = {VibrationMsg.DIRECTION_FIXED: FIXED, VibrationMsg.DIRECTION_RANDOM: RANDOM}
+_DIRECTION_NAMES = {VibrationMsg.DIRECTION_FIXED: FIXED, VibrationMsg.DIRECTION_RANDOM: RANDOM,
+                    VibrationMsg.DIRECTION_CENTRE: CENTRE}
 _DIRECTION_VALUES = {name: value for value, name in _DIRECTION_NAMES.items()}
 
 
@@ -244,7 +245,7 @@ def vibration_from_msg(msg: VibrationMsg, default: Vibration) -> Vibration:
     if msg.direction != VibrationMsg.DIRECTION_DEFAULT:
         if msg.direction not in _DIRECTION_NAMES:
             raise InvalidArgument('vibration.direction', msg.direction,
-                                  'must be 0 (default), 1 (fixed) or 2 (random)')
+                                  'must be 0 (default), 1 (fixed), 2 (random) or 3 (centre)')
         direction = _DIRECTION_NAMES[msg.direction]
     return Vibration(
         amplitude=amplitude,

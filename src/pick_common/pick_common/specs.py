@@ -37,8 +37,8 @@ class SceneSpec:
     seed: int = 0
 
 
-FIXED, RANDOM = 'fixed', 'random'
-DIRECTIONS = (FIXED, RANDOM)
+FIXED, RANDOM, CENTRE = 'fixed', 'random', 'centre'
+DIRECTIONS = (FIXED, RANDOM, CENTRE)
 
 
 @dataclass(frozen=True)
@@ -48,7 +48,12 @@ class Vibration:
     amplitude: peak displacement along the tray's x, y, z, m. frequency: Hz.
     direction: FIXED moves the tray along the amplitude as given; RANDOM turns its horizontal
     part (x, y) about the vertical by an angle drawn uniformly from the instance's generator,
-    once per vibration, so that the pile spreads with no net drift toward one wall.
+    once per vibration, so that the pile spreads with no net drift toward one wall; CENTRE
+    lays its horizontal length along the line from the parts' centroid on the tray to the
+    tray's centre, as a flexible feeder's centring vibration does (the Asycube's takes the
+    parts' centre of mass from the camera: programming guide, table 5-3), so that the parts
+    gather away from the walls; with no part, or the centroid at the centre, no horizontal
+    part.
     The default is a flip at the vertical speed of a real feeder's: 1.4 mm at 26 Hz is a peak
     vertical speed of 0.23 m/s (3.8 g), the SHOP4CF shakeit feeder's flip (26 Hz, at most
     0.23 m/s); with an equal horizontal stroke in phase, in a random direction, it throws the
@@ -62,8 +67,8 @@ class Vibration:
 
 
 # The feeder moves a cell can sequence, modelled on a flexible feeder's vibration types (the
-# Asycube's forward A, backward F, left D, right E and flip I; world README, "Feeder moves"):
-# each at the default's stroke and frequency. 'spread' is the default Vibration.
+# Asycube's forward A, backward F, left D, right E, flip I and centering; world README,
+# "Feeder moves"): each at the default's stroke and frequency. 'spread' is the default Vibration.
 _STROKE, _HZ, _S = 0.0014, 26.0, 0.5
 MOVES = {
     'spread': Vibration(),                                          # a throw, random direction
@@ -72,6 +77,7 @@ MOVES = {
     'backward': Vibration((-_STROKE, 0.0, _STROKE), _HZ, _S, FIXED),
     'left': Vibration((0.0, _STROKE, _STROKE), _HZ, _S, FIXED),     # toward +y
     'right': Vibration((0.0, -_STROKE, _STROKE), _HZ, _S, FIXED),
+    'centre': Vibration((_STROKE, 0.0, _STROKE), _HZ, _S, CENTRE),  # toward the tray's centre
 }
 
 

@@ -6,7 +6,7 @@ import numpy as np
 from pick_common import containers, conversions
 from pick_common.containers import check_fits, ContainerSpec
 from pick_common.errors import InvalidArgument, Limit
-from pick_common.specs import FIXED, RANDOM, Vibration
+from pick_common.specs import CENTRE, FIXED, RANDOM, Vibration
 from pick_common.states import SettleReport, TrayMotion
 from pick_msgs.msg import Vibration as VibrationMsg
 import pytest
@@ -40,6 +40,8 @@ def test_a_vibration_round_trips_and_zeros_take_the_defaults():
         conversions.vibration_from_msg(VibrationMsg(direction=7), Vibration())
     assert conversions.vibration_from_msg(
         VibrationMsg(direction=VibrationMsg.DIRECTION_RANDOM), v).direction == RANDOM
+    centre = Vibration(direction=CENTRE)
+    assert conversions.vibration_from_msg(conversions.vibration_to_msg(centre), v) == centre
 
 
 def test_tunnelled_points_are_in_or_under_the_floor_or_in_a_wall():

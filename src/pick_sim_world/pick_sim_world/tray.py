@@ -13,7 +13,7 @@ from collections.abc import Sequence
 import math
 
 import numpy as np
-from pick_common.specs import RANDOM, Vibration
+from pick_common.specs import CENTRE, RANDOM, Vibration
 from pick_common.states import TrayMotion
 import pybullet as pb
 
@@ -22,10 +22,19 @@ from .config import GRAVITY
 MIN_STEPS_PER_CYCLE = 8     # physics steps per vibration period; fewer and the world sub-steps
 
 
-def vibration_amplitude(vibration: Vibration, rng: np.random.Generator) -> np.ndarray:
-    """The peak displacement (3,) of one vibration, m: as given (FIXED), or with its horizontal
-    part turned about +Z by an angle drawn uniformly from `rng` (RANDOM)."""
+def vibration_amplitude(vibration: Vibration, rng: np.random.Generator,
+                        to_centre: np.ndarray | None = None) -> np.ndarray:
+    """The peak displacement (3,) of one vibration, m: as given (FIXED), with its horizontal
+    part turned about +Z by an angle drawn uniformly from `rng` (RANDOM), or (CENTRE) its
+    horizontal length laid along `to_centre`, the tray's centre less the parts' centroid (x,
+    y; none when it is None or zero)."""
     x, y, z = vibration.amplitude
+    if vibration.direction == CENTRE:
+        length = math.hypot(x, y)
+        norm = 0.0 if to_centre is None else float(np.hypot(*to_centre[:2]))
+        if norm < 1e-9:
+            return np.array([0.0, 0.0, z])
+        return np.array([length * to_centre[0] / norm, length * to_centre[1] / norm, z])
     if vibration.direction == RANDOM:
         angle = rng.uniform(0.0, 2.0 * math.pi)
         cos, sin = math.cos(angle), math.sin(angle)

@@ -189,6 +189,14 @@ class World:
         poses = bodies.part_frame_poses(base, self._part)
         return PartStates(np.array(ids, dtype=np.int64), owners, poses, inside, self._sim_time)
 
+    def _to_centre(self, k: int) -> np.ndarray | None:
+        """From the centroid of instance k's parts on its tray to the tray's centre (its frame
+        origin), x and y, m; None without parts on it (a CENTRE vibration's direction)."""
+        states = self.snapshot([k])
+        if not states.inside.any():
+            return None
+        return -states.poses[states.inside, :2].mean(axis=0)
+
     # ----------------------------------------------------------------------------- drop
     def drop_region(self, instance: int, zone: str) -> tuple[float, float, float, float]:
         """Centre x, y and half extents x, y of where parts spawn, in the instance frame, m."""
@@ -279,16 +287,16 @@ class World:
 
         With direction RANDOM, each tray's horizontal amplitude is first turned about the
         vertical by an angle drawn from its instance's generator (so a seed gives the same
-        motions). Raises InvalidArgument for a bad vibration or an instance whose container is
-        a bin.
+        motions); with CENTRE, laid toward the tray's centre from its parts' centroid. Raises
+        InvalidArgument for a bad vibration or an instance whose container is a bin.
         """
         targets = self._instance_ids(instances)
         check_vibration(vibration)
         if self._drive is None:
             raise InvalidArgument('instances', targets[0], f'is a {self._scene.container.kind}'
                                   ': only trays vibrate')
-        amplitudes = np.array([vibration_amplitude(vibration, self._instances[k].rng)
-                               for k in targets])
+        amplitudes = np.array([vibration_amplitude(vibration, self._instances[k].rng,
+                                                   self._to_centre(k)) for k in targets])
         # A period gets at least MIN_STEPS_PER_CYCLE steps: finer steps while vibrating when
         # the physics step is too coarse for the frequency.
         dt = self._physics.time_step / vibration_substeps(vibration.frequency,

@@ -25,7 +25,7 @@ from pick_common.node_runner import (
     run,
 )
 from pick_common.parts import BUILTIN_MODELS, PartSpec
-from pick_common.specs import check_vibration, FIXED, RANDOM, SceneSpec, Vibration
+from pick_common.specs import CENTRE, check_vibration, FIXED, RANDOM, SceneSpec, Vibration
 from pick_common.states import Progress, SettleReport
 from pick_msgs.action import DropParts, RemoveParts, Vibrate
 from pick_msgs.msg import PartArray, Scene
@@ -188,8 +188,10 @@ class WorldNode(Node):
             duration=get('vibration.duration', vib.duration, 'default duration, s',
                          specs.LIMITS['vibration.duration']),
             direction=get('vibration.direction', vib.direction,
-                          f'default direction: {FIXED} (the amplitude as given) or {RANDOM} '
-                          '(its horizontal part turned by a random angle per vibration)'))
+                          f'default direction: {FIXED} (the amplitude as given), {RANDOM} '
+                          '(its horizontal part turned by a random angle per vibration) or '
+                          f'{CENTRE} (its horizontal part toward the tray centre from the '
+                          "parts' centroid)"))
         self._publish_markers = get('publish_markers', True, 'publish `markers` after each '
                                     'operation')
         self._mesh_dirs = declare_mesh_dirs(self)

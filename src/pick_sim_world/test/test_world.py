@@ -9,7 +9,7 @@ from pick_common import containers
 from pick_common.containers import ContainerSpec
 from pick_common.errors import InvalidArgument, PhysicsFault, UnknownInstance, UnknownPart
 from pick_common.parts import BUILTIN_MODELS, PartSpec
-from pick_common.specs import FIXED, RANDOM, SceneSpec, Vibration
+from pick_common.specs import CENTRE, FIXED, MOVES, RANDOM, SceneSpec, Vibration
 from pick_common.states import quaternion_angles, rotate
 from pick_sim_world import spawning
 from pick_sim_world.config import PhysicsConfig
@@ -287,6 +287,39 @@ def test_a_random_direction_turns_only_the_horizontal_amplitude():
         'directions must cover every quadrant'
     again = np.random.default_rng(5)
     assert np.array_equal(vibration_amplitude(Vibration((0.001, 0.0, 0.003)), again), turned[0])
+
+
+def test_a_centring_vibration_points_its_stroke_from_the_parts_to_the_tray_centre():
+    move = Vibration((0.001, 0.0005, 0.003), direction=CENTRE)
+    rng = np.random.default_rng(0)
+    got = vibration_amplitude(move, rng, np.array([-0.03, -0.04]))
+    assert got == pytest.approx([-0.6 * math.hypot(0.001, 0.0005),
+                                 -0.8 * math.hypot(0.001, 0.0005), 0.003])
+    assert vibration_amplitude(move, rng, None).tolist() == [0.0, 0.0, 0.003]   # no parts
+    assert vibration_amplitude(move, rng, np.zeros(2)).tolist() == [0.0, 0.0, 0.003]
+
+
+def test_centring_carries_parts_off_centre_toward_the_middle_where_a_flip_does_not():
+    """Three capacitors lying 50 mm toward the tray's +x wall, far from it and each other: one
+    `centre` move conveys them toward the middle (at the full 1.4 mm stroke, 90-odd mm: past
+    it, as `backward` would); `flip`, vertical only, hardly moves them (a pile by a wall would
+    spread away from it under either, so lone parts)."""
+    def centroid_after(move: Vibration) -> tuple[float, float]:
+        with _world(ContainerSpec.tray(), seed=3) as world:
+            ids, _ = world.drop(3, zone='feeder')
+            for pid, y in zip(ids, (-0.03, 0.0, 0.03), strict=True):
+                pb.resetBasePositionAndOrientation(world._bodies[pid], [0.05, y, 0.004],
+                                                   [0.0, 0.7071068, 0.0, 0.7071068],
+                                                   physicsClientId=world._client)
+            world.settle()
+            before = world.snapshot().poses[:, 0].mean()
+            world.vibrate(move)
+            return before, world.snapshot().poses[:, 0].mean()
+    before, centred = centroid_after(MOVES['centre'])
+    _, flipped = centroid_after(MOVES['flip'])
+    assert before == pytest.approx(0.05, abs=0.005)
+    assert centred < before - 0.01 and abs(flipped - before) < abs(centred - before) / 3, \
+        (before, centred, flipped)
 
 
 def test_random_vibrations_repeat_with_the_seed():
