@@ -8,6 +8,7 @@ import os
 from experiment_manager import experiment_file
 from experiment_manager.analysis import report
 from experiment_manager.analysis.results import read_csv, read_text_rows, ResultsWriter
+from experiment_manager.analysis.sensitivity import _robustness
 from experiment_manager.analysis.verdicts import verdicts
 from experiment_manager.commands.run import _summary_lines
 from experiment_manager.experiment_file.plan import plan
@@ -201,3 +202,26 @@ def test_values_outside_a_range_are_not_drawn():
     values = np.array([dict(s.values)['part.spinning_friction_mm']
                        for s in f.experiment('robust').scenarios])
     assert values.min() >= 0 and values.max() <= 0.5
+
+
+def test_a_flip_names_the_scenario_and_its_values_and_undecided_is_not_called_a_flip():
+    robust = experiment_file.parse(sensitivity(
+        'iterations: 1, of: [emptying], inputs: {'
+        'gripper.jaw_depth_mm: {low: 2, high: 6, source: catalogue}}')).experiment('robust')
+    base = {'verdicts': {'static bin': 'FEASIBLE', 'vibrating table': 'FEASIBLE'}}
+    scenarios = [
+        {'name': 'gripper_jaw_depth_mm_low', 'values': {'gripper.jaw_depth_mm': 2.0},
+         'verdicts': {'static bin': 'FEASIBLE', 'vibrating table': 'FEASIBLE'}},
+        {'name': 'gripper_jaw_depth_mm_high', 'values': {'gripper.jaw_depth_mm': 6.0},
+         'verdicts': {'static bin': 'NOT FEASIBLE', 'vibrating table': 'UNDECIDED'}}]
+    bin_, table = _robustness(robust, base, scenarios)
+    assert not bin_['holds'] and bin_['flips'][0]['scenario'] == 'gripper_jaw_depth_mm_high'
+    assert bin_['line'] == ('static bin FEASIBLE here, but NOT FEASIBLE at gripper.jaw_depth_mm '
+                            '6 (1 of 2 scenarios)')
+    assert bin_['sources'] == {'gripper.jaw_depth_mm': 'catalogue'}
+    assert table['line'].endswith('the runs there do not settle it, which is not a flip to '
+                                  'the other side')
+    same = [dict(s, verdicts=base['verdicts']) for s in scenarios]
+    assert [r['line'] for r in _robustness(robust, base, same)] == [
+        'static bin FEASIBLE over all ranges (2 scenarios: gripper.jaw_depth_mm)',
+        'vibrating table FEASIBLE over all ranges (2 scenarios: gripper.jaw_depth_mm)']
