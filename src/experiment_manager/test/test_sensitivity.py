@@ -8,7 +8,7 @@ import os
 from experiment_manager import experiment_file
 from experiment_manager.analysis import report
 from experiment_manager.analysis.results import read_csv, read_text_rows, ResultsWriter
-from experiment_manager.analysis.sensitivity import _robustness
+from experiment_manager.analysis.sensitivity import _map, _robustness
 from experiment_manager.analysis.verdicts import verdicts
 from experiment_manager.commands.run import _summary_lines
 from experiment_manager.experiment_file.plan import plan
@@ -225,3 +225,36 @@ def test_a_flip_names_the_scenario_and_its_values_and_undecided_is_not_called_a_
     assert [r['line'] for r in _robustness(robust, base, same)] == [
         'static bin FEASIBLE over all ranges (2 scenarios: gripper.jaw_depth_mm)',
         'vibrating table FEASIBLE over all ranges (2 scenarios: gripper.jaw_depth_mm)']
+
+
+def test_a_grid_maps_the_verdicts_over_two_inputs():
+    f = experiment_file.parse(sensitivity(
+        'iterations: 1, of: [emptying], grid: 3, inputs: {'
+        'gripper.body_diameter_mm: {low: 12, high: 30, source: a}, '
+        'gripper.jaw_depth_mm: {low: 3, high: 6, source: b}}'))
+    robust = f.experiment('robust')
+    cells = [dict(s.values) for s in robust.scenarios if s.name.startswith('grid_')]
+    assert cells == [{'gripper.body_diameter_mm': d, 'gripper.jaw_depth_mm': w}
+                     for d in (12.0, 21.0, 30.0) for w in (3.0, 4.5, 6.0)]
+    assert len(robust.scenarios) == 4 + 9
+    said = {(12.0, 3.0): 'FEASIBLE', (30.0, 6.0): 'NOT FEASIBLE'}
+    scenarios = [{'name': s.name, 'values': dict(s.values),
+                  'verdicts': {'static bin': said.get(tuple(dict(s.values).values()),
+                                                      'UNDECIDED')}}
+                 for s in robust.scenarios]
+    m = _map(robust, scenarios)
+    assert m['rows'] == {'input': 'gripper.body_diameter_mm', 'values': [12.0, 21.0, 30.0]}
+    assert m['columns']['values'] == [3.0, 4.5, 6.0]
+    assert m['verdicts']['static bin'][0][0] == 'FEASIBLE'
+    assert m['verdicts']['static bin'][2][2] == 'NOT FEASIBLE'
+    assert m['verdicts']['static bin'][1][1] == 'UNDECIDED'
+    text = report._sensitivity('robust', {
+        'of': ['emptying'], 'scenarios': [], 'iterations': 1, 'inputs': [], 'robustness': [],
+        'ranges': {}, 'base': {'answers': {}, 'verdicts': {}}, 'map': m}, False)
+    assert '| 12 | **FEASIBLE** | **UNDECIDED** | **UNDECIDED** |' in text
+    with pytest.raises(InvalidArgument, match=r'over the limit of 200'):
+        experiment_file.parse(sensitivity(
+            'iterations: 1, of: [emptying], grid: 9, inputs: {'
+            'gripper.body_diameter_mm: {low: 12, high: 30, source: a}, '
+            'gripper.jaw_depth_mm: {low: 3, high: 6, source: b}, '
+            'part.restitution: {low: 0, high: 0.2, source: c}}'))

@@ -386,6 +386,17 @@ def _sensitivity(exp_id: str, s: dict, plotted: bool) -> list[str]:
     lines += [f'- {r["line"]}' for r in s['robustness']] or ['- no verdict to compare']
     if plotted:
         lines += ['', f'![tornado chart of {exp_id}](sensitivity_{exp_id}.png)']
+    if 'map' in s:
+        m = s['map']
+        rows, columns = m['rows'], m['columns']
+        for option, grid in m['verdicts'].items():
+            lines += ['', f'{option}: the verdict over `{rows["input"]}` (rows) and '
+                      f'`{columns["input"]}` (columns), the other inputs at the file\'s values:',
+                      '']
+            lines += table([f'{rows["input"]} \\ {columns["input"]}']
+                           + [fmt(c, 4) for c in columns['values']],
+                           [[fmt(r, 4)] + [f'**{v}**' if v else '-' for v in row]
+                            for r, row in zip(rows['values'], grid, strict=True)])
     keys = [k for k in ANSWERS if k in s['ranges']]
     options = list(s['base']['verdicts'])
     rows = []

@@ -94,7 +94,25 @@ def summarise(file: ExperimentFile, exp: Experiment, summaries: dict) -> dict:
             'base': base_said, 'scenarios': scenarios, 'tornado': tornado,
             'ranges': _ranges(base_said, scenarios),
             'robustness': _robustness(exp, base_said, scenarios),
+            **({'map': m} if (m := _map(exp, scenarios)) else {}),
             'faults': _faults(repeats), 'physics': _physics(repeats)}
+
+
+def _map(exp: Experiment, scenarios: list[dict]) -> dict | None:
+    """With two inputs on a grid: each option's verdict at each pair of their levels (rows the
+    first input's, columns the second's), a map over them; None otherwise."""
+    cells = [s for s in scenarios if s['name'].startswith('grid_')]
+    if not cells or len(exp.inputs) != 2:
+        return None
+    first, second = (x.name for x in exp.inputs)
+    rows = sorted({s['values'][first] for s in cells})
+    columns = sorted({s['values'][second] for s in cells})
+    at = {(s['values'][first], s['values'][second]): s['verdicts'] for s in cells}
+    options = list(cells[0]['verdicts'])
+    return {'rows': {'input': first, 'values': rows},
+            'columns': {'input': second, 'values': columns},
+            'verdicts': {o: [[at[(r, c)].get(o) for c in columns] for r in rows]
+                         for o in options}}
 
 
 def _stem(name: str) -> str:

@@ -234,12 +234,14 @@ def _sensitivity(e: schema.SensitivityKeys, where: str, c: _Context) -> list[Exp
         base = scenario_inputs.base_value(name, c.setup, c.geometry.mass)
         inputs.append(Input(name, round(base, 9), low, high, r.source.strip()))
     inputs = tuple(inputs)
-    repeats = (2 * len(inputs) + e.joint) * len(e.of)
+    repeats = (2 * len(inputs) + e.joint + (e.grid ** len(inputs) if e.grid else 0)) * len(e.of)
     if repeats > scenario_inputs.MAX_REPEATS:
         raise InvalidArgument(f'{where}.inputs', repeats, f'scenarios x experiments repeated '
                               f'is over the limit of {scenario_inputs.MAX_REPEATS} (2 '
-                              'scenarios per input, plus joint, times the experiments of `of`)')
-    found = scenario_inputs.scenarios(inputs, e.joint, c.setup, c.moves, c.seed, e.id, where)
+                              'scenarios per input, plus joint, plus grid ** inputs, times the '
+                              'experiments of `of`)')
+    found = scenario_inputs.scenarios(inputs, e.joint, c.setup, c.moves, c.seed, e.id, where,
+                                      e.grid)
     repeats = []
     for scenario in found:
         for exp_id in e.of:

@@ -11,7 +11,10 @@ cycle may mix moves, so one number in Hz or s would not say which). The design:
 - joint (`joint: K`): K scenarios of a Latin hypercube over all the inputs' ranges (McKay,
   Beckman and Conover, Technometrics 21(2), 1979): each input's range cut in K equal strata,
   one value drawn in each, the strata paired at random; seeded by the file's seed and the
-  experiment's id (`joint_1` ... `joint_K`).
+  experiment's id (`joint_1` ... `joint_K`);
+- grid (`grid: L`): every combination of each input at L levels evenly from its low to its
+  high (`grid_1` ... in the order of itertools.product, the last input varying fastest): with
+  two inputs, a map of the verdicts over them (the report draws it).
 Every repeat runs on the seeds of the experiment it repeats (plan.iteration_seed takes the
 repeated experiment's id): what differs between scenarios is the input, not the draw
 (common random numbers).
@@ -20,6 +23,7 @@ Pure: no rclpy, no simulator.
 """
 
 from dataclasses import replace
+import itertools
 import zlib
 
 import numpy as np
@@ -105,9 +109,18 @@ def latin_hypercube(inputs: tuple[Input, ...], k: int, seed: int, experiment_id:
     return points
 
 
+def grid(inputs: tuple[Input, ...], levels: int) -> list[dict[str, float]]:
+    """Every combination of each input at `levels` values evenly from its low to its high
+    (none for 0 levels)."""
+    if not levels:
+        return []
+    axes = [[(x.name, float(v)) for v in np.linspace(x.low, x.high, levels)] for x in inputs]
+    return [dict(point) for point in itertools.product(*axes)]
+
+
 def scenarios(inputs: tuple[Input, ...], joint: int, setup: Setup,
-              moves: tuple[Vibration, ...], seed: int, experiment_id: str, where: str
-              ) -> tuple[Scenario, ...]:
+              moves: tuple[Vibration, ...], seed: int, experiment_id: str, where: str,
+              levels: int = 0) -> tuple[Scenario, ...]:
     """The scenarios of a sensitivity experiment (module docstring), each checked."""
     design: list[tuple[str, dict[str, float]]] = []
     for x in inputs:
@@ -115,6 +128,7 @@ def scenarios(inputs: tuple[Input, ...], joint: int, setup: Setup,
         design += [(f'{stem}_low', {x.name: x.low}), (f'{stem}_high', {x.name: x.high})]
     design += [(f'joint_{i + 1}', point) for i, point in
                enumerate(latin_hypercube(inputs, joint, seed, experiment_id))]
+    design += [(f'grid_{i + 1}', point) for i, point in enumerate(grid(inputs, levels))]
     out = []
     for name, values in design:
         s, m = apply(values, setup, moves, f'{where}.inputs ({name})')

@@ -316,6 +316,7 @@ class SensitivityKeys(ExperimentKeys):
         list_of, low=1, high=MAX_EXPERIMENTS, what='1 or more ids of earlier experiments'))]
     inputs: Annotated[dict[str, InputRange], BeforeValidator(_inputs)]
     joint: Int(0, 64) = 0
+    grid: Int(0, 9) = 0
 
 
 EXPERIMENTS: dict[str, type[ExperimentKeys]] = {
