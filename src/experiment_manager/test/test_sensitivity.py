@@ -9,6 +9,7 @@ from experiment_manager import experiment_file
 from experiment_manager.analysis import report
 from experiment_manager.analysis.results import read_csv, read_text_rows, ResultsWriter
 from experiment_manager.analysis.sensitivity import _map, _robustness
+from experiment_manager.analysis.sensitivity import summarise as sensitivity_summary
 from experiment_manager.analysis.verdicts import verdicts
 from experiment_manager.commands.run import _summary_lines
 from experiment_manager.experiment_file.plan import plan
@@ -258,3 +259,21 @@ def test_a_grid_maps_the_verdicts_over_two_inputs():
             'gripper.body_diameter_mm: {low: 12, high: 30, source: a}, '
             'gripper.jaw_depth_mm: {low: 3, high: 6, source: b}, '
             'part.restitution: {low: 0, high: 0.2, source: c}}'))
+
+
+def test_only_the_options_whose_runs_are_repeated_are_said_to_hold(small):
+    # the small file's bin, table and gripper verdicts; only the feeder's runs repeated (here
+    # as copies of the file's own): the bin and the gripper were not tried on the ranges
+    _, summary = small
+    with open(os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')) as f:
+        text = f.read()
+    file = experiment_file.parse(text + (
+        '  - {id: robust, type: sensitivity, iterations: 1, of: [feeder], inputs: '
+        '{part.restitution: {low: 0, high: 0.2, source: a}}}\n'))
+    robust = file.experiment('robust')
+    summaries = {**summary['experiments'], **{
+        f'feeder@{s.name}': summary['experiments']['feeder'] for s in robust.scenarios}}
+    said = sensitivity_summary(file, robust, summaries)
+    assert list(said['base']['verdicts']) == ['vibrating table']
+    assert [r['option'] for r in said['robustness']] == ['vibrating table']
+    assert said['robustness'][0]['holds']       # the same runs: the same verdict

@@ -6,7 +6,9 @@ scenarios.py: each input at its low and its high, the others at the file's value
 in a Latin hypercube). Its summary puts side by side, per scenario, the headline answers
 (`ANSWERS`: the best bin, n* and the valid parts per check there, the cell's time to empty a
 refill and the vibrations it took, the parts removed per bin) and the verdicts (verdicts.py,
-on the scenario's repeats standing in for the experiments they repeat); per input, each
+on the scenario's repeats standing in for the experiments they repeat; only the options
+whose deciding experiment is repeated: the static bin's bin_emptying, the table's
+feeder_emptying, a gripper_sweep); per input, each
 answer at its low and its high against the file's values (a tornado chart's bars,
 report.py); and per option whether its verdict holds in every scenario or which scenarios
 flip it, with the inputs' values there.
@@ -65,10 +67,17 @@ def summarise(file: ExperimentFile, exp: Experiment, summaries: dict) -> dict:
             swapped.update({e: summaries[f'{e}@{scenario}'] for e in exp.of})
         return swapped
 
+    # the options whose deciding experiment is repeated (an option whose runs are the file's
+    # in every scenario would hold over all ranges without having been tried on them)
+    last = {v['type']: k for k, v in base.items()}
+    moved = ({'static bin'} if last.get('bin_emptying') in exp.of else set()) | (
+        {'vibrating table'} if last.get('feeder_emptying') in exp.of else set()) | {
+        f'gripper (`{e}`)' for e in exp.of if base[e]['type'] == 'gripper_sweep'}
+
     def decided(experiments: dict) -> dict:
         said = verdicts(metrics.file_summary(file, experiments))
         return {option_kind(v['option']): v['verdict'] for v in said
-                if v['verdict'] != NOT_ANALYSED}
+                if v['verdict'] != NOT_ANALYSED and option_kind(v['option']) in moved}
 
     def said(experiments: dict) -> dict:
         # the answers of the experiments repeated (the others' do not move)
