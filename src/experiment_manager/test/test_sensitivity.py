@@ -277,3 +277,15 @@ def test_only_the_options_whose_runs_are_repeated_are_said_to_hold(small):
     assert list(said['base']['verdicts']) == ['vibrating table']
     assert [r['option'] for r in said['robustness']] == ['vibrating table']
     assert said['robustness'][0]['holds']       # the same runs: the same verdict
+
+
+def test_a_gripper_input_is_refused_for_a_gripper_sweep_whose_grippers_are_its_own():
+    text = HEAD + ('  - {id: g, type: gripper_sweep, iterations: 1, parts: 10, '
+                   'grippers: {body_diameter_mm: [8, 12]}}\n'
+                   '  - {id: robust, type: sensitivity, iterations: 1, of: [g], inputs: '
+                   '{gripper.jaw_depth_mm: {low: 2, high: 4, source: a}}}\n')
+    with pytest.raises(InvalidArgument, match=r'experiments\[4\]\.inputs\.gripper\.jaw_depth_mm'
+                       r'.*cannot reach the gripper_sweep g'):
+        experiment_file.parse(text)
+    assert experiment_file.parse(text.replace('gripper.jaw_depth_mm: {low: 2, high: 4',
+                                              'part.restitution: {low: 0, high: 0.2'))

@@ -229,6 +229,11 @@ def _sensitivity(e: schema.SensitivityKeys, where: str, c: _Context) -> list[Exp
         if name not in scenario_inputs.INPUTS:
             raise InvalidArgument(at, name, 'is not an input a sensitivity experiment varies ('
                                   + ', '.join(scenario_inputs.INPUTS) + ')')
+        sweeps = [x for x in e.of if c.earlier[x].type == GRIPPER_SWEEP]
+        if name.startswith('gripper.') and sweeps:
+            raise InvalidArgument(at, name, f'cannot reach the gripper_sweep {sweeps[0]}, whose '
+                                  'grippers are its own: vary the gripper there, or leave it '
+                                  'out of `of`')
         low = scenario_inputs.check_input(name, r.low, f'{at}.low')
         high = scenario_inputs.check_input(name, r.high, f'{at}.high')
         base = scenario_inputs.base_value(name, c.setup, c.geometry.mass)

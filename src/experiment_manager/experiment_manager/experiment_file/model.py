@@ -94,7 +94,7 @@ class GripperVariant:
 @dataclass(frozen=True)
 class Input:
     """One uncertain input of a sensitivity experiment: its name (a key of
-    sensitivity.INPUTS), the file's value and the range to try, in the file's units, and where
+    scenarios.INPUTS), the file's value and the range to try, in the file's units, and where
     the range comes from (said with every answer that moves with it)."""
 
     name: str
