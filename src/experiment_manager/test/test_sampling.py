@@ -116,14 +116,37 @@ def test_a_sweep_is_settled_when_the_optimum_s_interval_lies_inside_its_range():
     assert sampling.unsettled(file, exp, faulted) == list(exp.counts)
 
 
+def test_a_sweep_with_a_flat_top_is_settled_when_any_n_star_of_its_interval_yields_the_same():
+    # Valid parts rise to 20 at n = 40 and stay there: n* may be anywhere in 40-100, so its
+    # interval never lies within +-5, but every range in it yields within 5 % of the best.
+    file = small()
+    exp = replace(file.experiment('sweep'), counts=tuple(range(10, 101, 10)), margin=5)
+    rng = np.random.default_rng(2)
+    flat = [row(c, i, valid=min(20.0, c / 2) + rng.normal(0, 3.0))
+            for c in exp.counts for i in range(5)]
+    fitted = metrics.fit_optimum([r['group'] for r in flat], [r['valid'] for r in flat],
+                                 10, 100, 5)
+    low, high = metrics.n_star_interval(exp.counts, [[r['valid'] for r in flat
+                                                      if r['group'] == c] for c in exp.counts],
+                                        fitted['order'], 10, 100, sampling.INTERIM_CONFIDENCE,
+                                        np.random.default_rng([file.seed, len(flat)]))
+    assert high - low > 2 * exp.margin          # the margin alone would not settle it
+    assert sampling.unsettled(file, exp, flat) == []
+    # a broad hump is no flat top: 25 % lower 30 parts from its peak, with noise to match
+    hump = [row(c, i, valid=20 - (c - 70) ** 2 / 180 + rng.normal(0, 4.0))
+            for c in exp.counts for i in range(3)]
+    assert sampling.unsettled(file, exp, hump) == list(exp.counts)
+
+
 def test_a_sweep_places_its_next_drops_where_they_narrow_n_star_most():
-    """Looks as the scheduler makes them, on rows drawn from a known curve (n* = 50): the
-    placed batches settle n* with fewer parts dropped than a batch at every count, never drop
-    more at a look, and never ask for a count that has no iterations left."""
+    """Looks as the scheduler makes them, on rows drawn from a known curve (n* = 50; 20 %
+    lower 20 parts away, so that it is no flat top, and noisy): the placed batches settle n* with
+    fewer parts dropped than a batch at every count, never drop more at a look, and never ask
+    for a count that has no iterations left."""
     file = small(mode='adaptive', batch=5)
     exp = replace(file.experiment('sweep'), counts=tuple(range(10, 101, 10)), margin=5,
                   iterations=40)
-    drawn = {c: 20 - (c - 50) ** 2 / 100 + np.random.default_rng(c).normal(0, 3, 40)
+    drawn = {c: 8 - (c - 50) ** 2 / 250 + np.random.default_rng(c).normal(0, 3, 40)
              for c in exp.counts}
 
     def sweep(everywhere: bool) -> tuple[int, int]:

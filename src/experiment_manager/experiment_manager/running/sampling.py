@@ -23,7 +23,12 @@ What settles each decision, looked at after every batch:
   left (the best bin) or at the most iterations.
 - table_sweep: the optimum n* of the fit, bootstrapped (metrics.n_star_interval: iterations
   resampled within each count, a seed of the file's): settled when the interval of n* lies
-  inside the optimal range n* +- margin, so the feeder runs' range holds the optimum. Every
+  inside the optimal range n* +- margin, so the feeder runs' range holds the optimum; or when
+  the top is flat: the fit across the whole interval of n* stays within FLAT_TOP (5 %) of its
+  peak, so wherever in it the optimum lies, the range at n* gives the feeder runs at least
+  95 % of the best valid parts per check (a feeder's checks to empty grow about as their
+  inverse: at most about 5 % more). 5 % is our choice, not a source's; on PTH0's flat top
+  (n* 72, its interval 70-100 on all 4,000 drops) the margin alone never settles. Every
   count gets the first batch (the fit needs its whole curve); each later look places as many
   parts' worth of drops as a batch at every count would, where they narrow n* most
   (_sweep_batches), so a sweep takes about as many looks as with a batch at every count.
@@ -55,6 +60,7 @@ from ..experiment_file import (
 from ..experiment_file.plan import groups
 
 INTERIM_CONFIDENCE = 0.999
+FLAT_TOP = 0.05     # a sweep's top is flat when its fit over n*'s interval is within this
 
 
 def unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict],
@@ -110,8 +116,8 @@ def _racing(exp: Experiment, rows: list[dict]) -> list[int]:
 
 def _sweep_unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> list[int]:
     """[] when the sweep's n* is settled (its bootstrap interval at INTERIM_CONFIDENCE lies
-    inside n* +- margin), else where the next look's drops go (_sweep_batches). The counts'
-    rows and the fit are made once for both."""
+    inside n* +- margin, or the fit is flat across it: FLAT_TOP), else where the next look's
+    drops go (_sweep_batches). The counts' rows and the fit are made once for both."""
     by_count = [np.array([r['valid'] for r in rows if r['group'] == n], dtype=float)
                 for n in exp.counts]
     if any(len(v) < 2 for v in by_count):      # also every row left out: nothing to fit
@@ -127,6 +133,10 @@ def _sweep_unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict]) ->
                                         np.random.default_rng([file.seed, len(rows)]))
     if best - exp.margin <= low and high <= best + exp.margin:
         return []
+    peak = fitted['fit_max']
+    if peak > 0 and np.polyval(fitted['coefficients'], np.arange(low, high + 1)).min() \
+            >= (1.0 - FLAT_TOP) * peak:
+        return []           # a flat top: any n* of its interval yields within FLAT_TOP
     return _sweep_batches(file, exp, by_count, fitted)
 
 
