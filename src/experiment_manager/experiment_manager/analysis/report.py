@@ -405,6 +405,10 @@ def _sensitivity(exp_id: str, s: dict, plotted: bool) -> list[str]:
         rows.append([name, values or '-']
                     + [fmt(said['answers'].get(k), 4) if k in said['answers'] else '-'
                        for k in keys] + [said['verdicts'].get(o, '-') for o in options])
+    lines += ['', f"Each scenario's answers are from at most {count(s['iterations'], 'iteration')}"
+              ' of each experiment: a difference between scenarios within the spread of '
+              "their runs is the draw's, not the input's (a low or high equal to the file's "
+              "value repeats the file's runs exactly)."]
     lines += ['', "Each scenario's answers ("
               + '; '.join(f'{ANSWERS[k][0]}' + (f', {ANSWERS[k][1]}' if ANSWERS[k][1] else '')
                           for k in keys) + ') and verdicts:', '']
@@ -416,8 +420,11 @@ def plot_tornado(exp_id: str, s: dict, path: str) -> bool:
     """Each answer of a sensitivity experiment (a panel) at each input's low and high (a bar
     from one to the other, the low end marked), the file's values' answer a line; inputs
     ordered by how far they move it."""
-    panels = [(k, v) for k, v in s['tornado'].items()
-              if s['base']['answers'].get(k) is not None]
+    # an answer no input moved has no bars to draw (the scenarios' table says so)
+    base_answers = s['base']['answers']
+    panels = [(k, v) for k, v in s['tornado'].items() if base_answers.get(k) is not None
+              and any(x is not None and x != base_answers[k]
+                      for ends in v.values() for x in ends.values())]
     if not panels:
         return False
     fig, axes = plt.subplots(len(panels), 1, figsize=(FIGSIZE[0], 1.0 + 1.6 * len(panels)),
@@ -434,7 +441,9 @@ def plot_tornado(exp_id: str, s: dict, path: str) -> bool:
             if low is not None:
                 ax.plot([low], [y], 'k|', markersize=12)
         ax.axvline(base, color='k', linewidth=1)
-        ax.margins(x=0.08)
+        seen = [base] + [x for b in bars for x in b[1:] if x is not None]
+        pad = 0.06 * (max(seen) - min(seen)) or 1.0
+        ax.set_xlim(min(seen) - pad, max(seen) + pad)    # the low ends' marks clear of the frame
         ax.set_yticks(range(len(bars)), [b[0] for b in bars], fontsize=7)
         words, unit = ANSWERS[key]
         ax.set_title(words + (f', {unit}' if unit else ''), fontsize=9)
