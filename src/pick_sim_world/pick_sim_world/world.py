@@ -31,6 +31,7 @@ from pick_common.errors import (
 )
 from pick_common.parts import build_part, PartGeometry
 from pick_common.specs import (
+    CENTRE,
     check_scene,
     check_vibration,
     MAX_PARTS_PER_INSTANCE,
@@ -295,8 +296,10 @@ class World:
         if self._drive is None:
             raise InvalidArgument('instances', targets[0], f'is a {self._scene.container.kind}'
                                   ': only trays vibrate')
+        centring = vibration.direction == CENTRE
         amplitudes = np.array([vibration_amplitude(vibration, self._instances[k].rng,
-                                                   self._to_centre(k)) for k in targets])
+                                                   self._to_centre(k) if centring else None)
+                               for k in targets])
         # A period gets at least MIN_STEPS_PER_CYCLE steps: finer steps while vibrating when
         # the physics step is too coarse for the frequency.
         dt = self._physics.time_step / vibration_substeps(vibration.frequency,
