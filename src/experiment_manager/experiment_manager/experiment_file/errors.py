@@ -1,10 +1,11 @@
 """pydantic's errors of an experiment file as the workspace's: an `InvalidArgument` per error,
 naming the key by its path in the file (`experiments[1].bins_mm[0][2]`), the value and the
 rule; an unknown key with the nearest known one and the keys known there; a required key
-that is missing beside an unknown one close to it as one error, the typo.
+that is missing beside an unknown one close to it as one error, the typo. And a core's check
+run under the file's key (`checked`).
 """
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 import difflib
 import types
 from typing import Annotated, Any, get_args, get_origin, Union
@@ -13,6 +14,15 @@ from pick_common.errors import InvalidArgument
 from pydantic import BaseModel, ValidationError
 
 from .values import RULE, short
+
+
+def checked(check: Callable, value: Any, where: str) -> Any:
+    """Run a core check, naming the field in the file that held the value (`where`) before
+    the core's own."""
+    try:
+        return check(value)
+    except InvalidArgument as exc:
+        raise InvalidArgument(f'{where} ({exc.field})', exc.value, exc.rule) from None
 
 
 def read(model: type[BaseModel], value: Any, where: str

@@ -36,6 +36,7 @@ import yaml
 from . import part as part_section
 from . import scenarios as scenario_inputs
 from . import schema
+from .errors import checked as checked_as
 from .errors import read as read_keys
 from .model import (
     ADAPTIVE,
@@ -75,14 +76,6 @@ class InvalidFile(InvalidArgument):
             self.args = (f'{len(errors)} errors:\n' + '\n'.join(f'  {e}' for e in errors),)
 
 
-def _checked(check: Callable, value: Any, where: str) -> Any:
-    """Run a core check, naming the field in the file that held the value."""
-    try:
-        return check(value)
-    except InvalidArgument as exc:
-        raise InvalidArgument(f'{where} ({exc.field})', exc.value, exc.rule) from None
-
-
 # ---------------------------------------------------------------- sections, to SI units
 def _gripper(g: schema.GripperSection) -> Gripper:
     return Gripper(**{attr: MM * getattr(g, key) for key, attr in GRIPPER_KEYS})
@@ -104,7 +97,7 @@ def _requirements(r: schema.RequirementsSection) -> Requirements:
 
 def _tray(top: schema.FileKeys) -> ContainerSpec:
     tray = ContainerSpec.tray(tuple(MM * s for s in top.tray_mm))
-    _checked(check_container, tray, 'tray_mm')
+    checked_as(check_container, tray, 'tray_mm')
     return tray
 
 
@@ -118,7 +111,7 @@ def _moves(top: schema.FileKeys) -> tuple[Vibration, ...]:
             frequency=m.frequency_hz if m.frequency_hz is not None else float(base.frequency),
             duration=m.duration_s if m.duration_s is not None else float(base.duration),
             direction=m.direction if m.direction is not None else base.direction)
-        out.append(_checked(check_vibration, move, f'moves[{i}]'))
+        out.append(checked_as(check_vibration, move, f'moves[{i}]'))
     return tuple(out)
 
 
@@ -145,7 +138,7 @@ def _bin(size_mm: tuple[float, ...], where: str, c: _Context) -> ContainerSpec:
                                   f'mm is over the size limit requirements.max_dimension_mm '
                                   f'= {c.max_dimension / MM:g}')
     spec = ContainerSpec(inner_size=size, wall_thickness=c.bin_wall)
-    _checked(check_container, spec, where)
+    checked_as(check_container, spec, where)
     return spec
 
 
@@ -207,7 +200,7 @@ def _variants(e: schema.GripperSweepKeys, where: str, c: _Context
     out = []
     for combination in itertools.product(*axes):
         g = Gripper(**dict(combination))
-        _checked(check_gripper, g, f'{where}.grippers (' + ', '.join(
+        checked_as(check_gripper, g, f'{where}.grippers (' + ', '.join(
             f'{key} {getattr(g, attr) / MM:g}' for key, attr in GRIPPER_KEYS) + ')')
         out += [GripperVariant(g, name, members) for name, members in sets]
     return tuple(out)
@@ -297,7 +290,7 @@ def _experiment(e: schema.ExperimentKeys, where: str, c: _Context) -> list[Exper
         else:
             out['optimal_range'] = e.optimal_range
             high = e.optimal_range[1]
-            _checked(check_feeder, FeederConfig(e.parts, *e.optimal_range, e.max_vibrations),
+            checked_as(check_feeder, FeederConfig(e.parts, *e.optimal_range, e.max_vibrations),
                      where)
         out['max_vibrations'] = e.max_vibrations
         check_fits(f'{where}.optimal_range (max)', high, volume, tray)
@@ -344,18 +337,18 @@ def parse(text: str, path: str = '') -> ExperimentFile:
     moves = checked(lambda: _moves(top)) if top else None
     # The cores' own checks, under the file's names.
     if gripper is not None:
-        checked(lambda: _checked(check_gripper, gripper, 'gripper'))
+        checked(lambda: checked_as(check_gripper, gripper, 'gripper'))
     auto_grasps = grasps == part_section.AUTO
     if part is not None:
-        checked(lambda: _checked(check_place, place, 'part.place'))
+        checked(lambda: checked_as(check_place, place, 'part.place'))
     if check is not None:
-        checked(lambda: _checked(tilts, check, 'check'))
+        checked(lambda: checked_as(tilts, check, 'check'))
     geometry = checked(lambda: part_section.geometry(part)) if part is not None else None
     if auto_grasps:
         grasps = checked(lambda: part_section.proposed(geometry)) if geometry is not None \
             else None
     if grasps is not None:
-        checked(lambda: _checked(check_grasps, list(grasps), 'part.grasps'))
+        checked(lambda: checked_as(check_grasps, list(grasps), 'part.grasps'))
     if geometry is not None and grasps is not None:
         checked(lambda: part_section.check_fits(geometry, grasps))
     context = None

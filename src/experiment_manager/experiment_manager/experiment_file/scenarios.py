@@ -27,10 +27,11 @@ import itertools
 import zlib
 
 import numpy as np
-from pick_common.errors import check_number, InvalidArgument
+from pick_common.errors import check_number
 from pick_common.specs import check_vibration, Vibration
 from pick_validity.config import check_gripper, Setup
 
+from .errors import checked
 from .model import G, Input, MM, Scenario
 
 # name -> (section, attribute, the file unit in SI, low limit, high limit, low open)
@@ -77,21 +78,11 @@ def apply(values: dict[str, float], setup: Setup, moves: tuple[Vibration, ...], 
     for name, value in values.items():
         section, attr, unit = INPUTS[name][:3]
         {'part': part, 'gripper': gripper, 'moves': scale}[section][attr] = value * unit
-    new_gripper = replace(setup.gripper, **gripper)
-    try:
-        check_gripper(new_gripper)
-    except InvalidArgument as exc:
-        raise InvalidArgument(f'{where} ({exc.field})', exc.value, exc.rule) from None
-    new_moves = []
-    for i, m in enumerate(moves):
-        move = Vibration(tuple(a * scale.get('amplitude', 1.0) for a in m.amplitude),
-                         m.frequency * scale.get('frequency', 1.0),
-                         m.duration * scale.get('duration', 1.0), m.direction)
-        try:
-            new_moves.append(check_vibration(move))
-        except InvalidArgument as exc:
-            raise InvalidArgument(f'{where} (moves[{i}]: {exc.field})', exc.value,
-                                  exc.rule) from None
+    new_gripper = checked(check_gripper, replace(setup.gripper, **gripper), where)
+    new_moves = [checked(check_vibration, Vibration(
+        tuple(a * scale.get('amplitude', 1.0) for a in m.amplitude),
+        m.frequency * scale.get('frequency', 1.0), m.duration * scale.get('duration', 1.0),
+        m.direction), f'{where} (moves[{i}])') for i, m in enumerate(moves)]
     return (replace(setup, part=replace(setup.part, **part), gripper=new_gripper),
             tuple(new_moves))
 
