@@ -1,5 +1,6 @@
 """`run --check FILE...`: read each experiment file as a run would, without starting the graph,
-print what the run will use of its part and grasps, and draw the part sheet
+print what the run will use of its part and grasps and what it will run (each experiment's
+iterations, a sensitivity's scenarios and the repeats they add), and draw the part sheet
 (analysis/part_sheet.py) beside it, so that a wrong file is seen before it runs."""
 
 import os
@@ -9,15 +10,22 @@ from pick_common.errors import InvalidArgument
 
 from .. import experiment_file
 from ..analysis import part_sheet
+from ..experiment_file.model import ExperimentFile, SENSITIVITY
+from ..experiment_file.plan import count_iterations, experiment_iterations
 
 
-def check(paths: list[str], output: str | None) -> int:
+def check(paths: list[str], output: str | None, iterations: int | None = None,
+          adaptive: bool = False) -> int:
     """0 when every file reads and its sheet is drawn; 2 at the first file that does not (its
-    errors printed, each naming the file, the key, the value and the rule)."""
+    errors printed, each naming the file, the key, the value and the rule). `iterations` and
+    `adaptive` as the run's options: the plan printed is the one the run would follow."""
     for given in paths:
         path = os.path.abspath(given)
         try:
             file = experiment_file.load(path)
+            if iterations is not None or adaptive:
+                file = experiment_file.parse(
+                    experiment_file.reduced(file, iterations, adaptive), path)
         except InvalidArgument as exc:
             errors = exc.errors if isinstance(exc, experiment_file.InvalidFile) else [exc]
             for e in errors:
@@ -29,4 +37,35 @@ def check(paths: list[str], output: str | None) -> int:
         directory = os.path.abspath(os.path.expanduser(output or file.output_dir))
         sheet = part_sheet.write(checks, os.path.join(directory, f'{file.id}_part.png'))
         print(f'sheet: {sheet}')
+        print('\n'.join(describe_plan(file)))
     return 0
+
+
+def describe_plan(file: ExperimentFile) -> list[str]:
+    """What the run will do, one experiment a line, in the order it runs them: its iterations
+    (at most, when sampling is adaptive); a sensitivity's inputs and scenarios, and the repeats
+    they add (each an experiment of its own, `<id>@<scenario>`, listed under it)."""
+    adaptive = file.sampling.mode == experiment_file.ADAPTIVE
+    at_most = 'at most ' if adaptive else ''
+    repeats = {e.id for e in file.experiments if '@' in e.id}
+    lines = [f'plan: {len(file.experiments) - len(repeats)} experiment(s), '
+             f'{at_most}{count_iterations(file)} iterations'
+             + (' (sampling adaptive: each stops once its decision is settled)' if adaptive
+                else '')]
+    for exp in file.experiments:
+        if exp.id in repeats:
+            continue
+        if exp.type != SENSITIVITY:
+            lines.append(f'  {exp.id} ({exp.type}): {at_most}{experiment_iterations(exp)} '
+                         'iterations')
+            continue
+        added = [e for e in file.experiments if e.id.partition('@')[0] in exp.of
+                 and e.id.partition('@')[2] in {s.name for s in exp.scenarios}]
+        lines.append(f'  {exp.id} (sensitivity of {", ".join(exp.of)}): '
+                     f'{len(exp.inputs)} input(s), {len(exp.scenarios)} scenario(s), '
+                     f'{len(added)} repeat(s) of {at_most}'
+                     f'{sum(experiment_iterations(e) for e in added)} iterations')
+        for s in exp.scenarios:
+            values = ', '.join(f'{name} {value:g}' for name, value in s.values)
+            lines.append(f'    {s.name}: {values}')
+    return lines

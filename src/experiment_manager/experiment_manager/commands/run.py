@@ -129,9 +129,11 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     parser.add_argument('--logs', help="directory for the nodes' logs (default: a temporary "
                         'directory, printed)')
     parser.add_argument('--check', action='store_true',
-                        help="only read each file and draw its part sheet (its part, mass "
+                        help="only read each file, draw its part sheet (its part, mass "
                         "centre, collision pieces, and the gripper at each grasp's pick and "
-                        "place) into --output or the file's output_dir; no graph is started")
+                        "place) into --output or the file's output_dir, and print what the "
+                        "run would run (with --iterations and --adaptive as given); no graph "
+                        "is started")
     args = parser.parse_args(argv)
     if args.check and (args.resume or not args.experiment_files):
         parser.error('--check reads the experiment files given: give one or more')
@@ -228,7 +230,7 @@ def main(argv: list[str] | None = None) -> int:
     args = _parse(sys.argv[1:] if argv is None else argv)
     if args.check:
         from .check import check  # the sheet's drawing is loaded only to draw it
-        return check(args.experiment_files, args.output)
+        return check(args.experiment_files, args.output, args.iterations, args.adaptive)
     temporary: list[str] = []
     try:
         return _main(args, temporary)
