@@ -12,8 +12,9 @@ from experiment_manager.analysis.sensitivity import _map, _robustness
 from experiment_manager.analysis.sensitivity import summarise as sensitivity_summary
 from experiment_manager.analysis.verdicts import verdicts
 from experiment_manager.commands.run import _summary_lines
+from experiment_manager.commands.run import main as run_main
 from experiment_manager.experiment_file.plan import plan
-from experiment_manager.experiment_file.scenarios import latin_hypercube
+from experiment_manager.experiment_file.scenarios import latin_hypercube, point_key
 from experiment_manager.running.local_backend import LocalBackend
 from experiment_manager.running.procedures import run_unit
 from experiment_manager.running.scheduler import Runner
@@ -235,24 +236,37 @@ def test_a_grid_maps_the_verdicts_over_two_inputs():
         'gripper.jaw_depth_mm: {low: 3, high: 6, source: b}}'))
     robust = f.experiment('robust')
     cells = [dict(s.values) for s in robust.scenarios if s.name.startswith('grid_')]
+    # (12, 3) and (30, 3) are the body's low and high at the file's 3 mm jaws: not run twice
     assert cells == [{'gripper.body_diameter_mm': d, 'gripper.jaw_depth_mm': w}
-                     for d in (12.0, 21.0, 30.0) for w in (3.0, 4.5, 6.0)]
-    assert len(robust.scenarios) == 4 + 9
+                     for d in (12.0, 21.0, 30.0) for w in (3.0, 4.5, 6.0)
+                     if (d, w) not in {(12.0, 3.0), (30.0, 3.0)}]
+    assert len(robust.scenarios) == 3 + 7          # the jaws' low is the file's 3 mm
     said = {(12.0, 3.0): 'FEASIBLE', (30.0, 6.0): 'NOT FEASIBLE'}
     scenarios = [{'name': s.name, 'values': dict(s.values),
-                  'verdicts': {'static bin': said.get(tuple(dict(s.values).values()),
+                  'verdicts': {'static bin': said.get(point_key(robust.inputs, dict(s.values)),
                                                       'UNDECIDED')}}
                  for s in robust.scenarios]
-    m = _map(robust, scenarios)
+    m = _map(robust, {'verdicts': {'static bin': 'UNDECIDED'}}, scenarios)
     assert m['rows'] == {'input': 'gripper.body_diameter_mm', 'values': [12.0, 21.0, 30.0]}
     assert m['columns']['values'] == [3.0, 4.5, 6.0]
-    assert m['verdicts']['static bin'][0][0] == 'FEASIBLE'
+    assert m['verdicts']['static bin'][0][0] == 'FEASIBLE'      # the body's low scenario
     assert m['verdicts']['static bin'][2][2] == 'NOT FEASIBLE'
     assert m['verdicts']['static bin'][1][1] == 'UNDECIDED'
     text = report._sensitivity('robust', {
         'of': ['emptying'], 'scenarios': [], 'iterations': 1, 'inputs': [], 'robustness': [],
         'ranges': {}, 'base': {'answers': {}, 'verdicts': {}}, 'map': m}, False)
     assert '| 12 | **FEASIBLE** | **UNDECIDED** | **UNDECIDED** |' in text
+    # a level at the file's value: that grid point is the file's own run
+    centred = experiment_file.parse(sensitivity(
+        'iterations: 1, of: [emptying], grid: 3, inputs: {'
+        'gripper.body_diameter_mm: {low: 4, high: 12, source: a}, '
+        'gripper.jaw_depth_mm: {low: 1, high: 5, source: b}}')).experiment('robust')
+    assert len(centred.scenarios) == 4 + 4         # 9 points less the file's and 4 ends
+    m = _map(centred, {'verdicts': {'static bin': 'FEASIBLE'}},
+             [{'name': s.name, 'values': dict(s.values),
+               'verdicts': {'static bin': 'NOT FEASIBLE'}} for s in centred.scenarios])
+    assert [row[1] for row in m['verdicts']['static bin']] == [
+        'NOT FEASIBLE', 'FEASIBLE', 'NOT FEASIBLE']
     with pytest.raises(InvalidArgument, match=r'over the limit of 200'):
         experiment_file.parse(sensitivity(
             'iterations: 1, of: [emptying], grid: 9, inputs: {'
@@ -289,3 +303,21 @@ def test_a_gripper_input_is_refused_for_a_gripper_sweep_whose_grippers_are_its_o
         experiment_file.parse(text)
     assert experiment_file.parse(text.replace('gripper.jaw_depth_mm: {low: 2, high: 4',
                                               'part.restitution: {low: 0, high: 0.2'))
+
+
+def test_run_check_says_what_the_scenarios_add(tmp_path, capsys):
+    """`run --check` prints the plan: the repeats a sensitivity adds and their scenarios, with
+    --iterations applied as the run would."""
+    assert run_main(['--check', '--iterations', '1', SENSITIVITY,
+                     '--output', str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    # feeder: 1; the sensitivity: 3 inputs x (low, high) + 2 joint = 8 repeats of 1
+    assert 'plan: 2 experiment(s), 9 iterations\n' in out
+    assert '  feeder (feeder_emptying): 1 iterations\n' in out
+    assert '  robust (sensitivity of feeder): 3 input(s), 8 scenario(s), 8 repeat(s) of 8 ' \
+        'iterations\n' in out
+    assert '    part_lateral_friction_low: part.lateral_friction 0.3\n' in out
+    assert out.count('    joint_') == 2
+    assert run_main(['--check', '--adaptive', SENSITIVITY, '--output', str(tmp_path)]) == 0
+    assert 'plan: 2 experiment(s), at most 9 iterations (sampling adaptive' \
+        in capsys.readouterr().out

@@ -16,8 +16,11 @@ flip it, with the inputs' values there.
 Pure: no rclpy, no files.
 """
 
+import numpy as np
+
 from ..experiment_file import ExperimentFile
 from ..experiment_file.model import Experiment
+from ..experiment_file.scenarios import point_key
 from . import metrics
 from .verdicts import NOT_ANALYSED, option_kind, UNDECIDED, verdicts
 from .wording import fmt
@@ -92,9 +95,9 @@ def summarise(file: ExperimentFile, exp: Experiment, summaries: dict) -> dict:
     for key in ANSWERS:
         if key not in base_said['answers'] or key == 'best_bin':
             continue
-        tornado[key] = {x.name: {'low': by_name[f'{_stem(x.name)}_low']['answers'].get(key),
-                                 'high': by_name[f'{_stem(x.name)}_high']['answers'].get(key)}
-                        for x in exp.inputs}
+        # an end at the file's value was not run again (scenarios.scenarios): the file's
+        tornado[key] = {x.name: {end: by_name.get(f'{_stem(x.name)}_{end}', base_said)[
+            'answers'].get(key) for end in ('low', 'high')} for x in exp.inputs}
     repeats = {f'{e}@{sc.name}': summaries[f'{e}@{sc.name}'] for sc in exp.scenarios
                for e in exp.of}
     return {'type': exp.type, 'of': list(exp.of), 'iterations': exp.iterations,
@@ -103,25 +106,28 @@ def summarise(file: ExperimentFile, exp: Experiment, summaries: dict) -> dict:
             'base': base_said, 'scenarios': scenarios, 'tornado': tornado,
             'ranges': _ranges(base_said, scenarios),
             'robustness': _robustness(exp, base_said, scenarios),
-            **({'map': m} if (m := _map(exp, scenarios)) else {}),
+            **({'map': m} if (m := _map(exp, base_said, scenarios)) else {}),
             'faults': _faults(repeats), 'physics': _physics(repeats)}
 
 
-def _map(exp: Experiment, scenarios: list[dict]) -> dict | None:
+def _map(exp: Experiment, base: dict, scenarios: list[dict]) -> dict | None:
     """With two inputs on a grid: each option's verdict at each pair of their levels (rows the
-    first input's, columns the second's), a map over them; None otherwise."""
-    cells = [s for s in scenarios if s['name'].startswith('grid_')]
-    if not cells or len(exp.inputs) != 2:
+    first input's, columns the second's), a map over them; None otherwise. A grid point that
+    was not run on its own takes the answers of the scenario (or the file) with its inputs
+    (scenarios.scenarios leaves such points out)."""
+    if not exp.grid or len(exp.inputs) != 2:
         return None
-    first, second = (x.name for x in exp.inputs)
-    rows = sorted({s['values'][first] for s in cells})
-    columns = sorted({s['values'][second] for s in cells})
-    at = {(s['values'][first], s['values'][second]): s['verdicts'] for s in cells}
-    options = list(cells[0]['verdicts'])
-    return {'rows': {'input': first, 'values': rows},
-            'columns': {'input': second, 'values': columns},
+    first, second = exp.inputs
+    by_point = {point_key(exp.inputs, s['values']): s['verdicts'] for s in scenarios}
+    by_point.setdefault(point_key(exp.inputs, {}), base['verdicts'])
+    rows = np.linspace(first.low, first.high, exp.grid).tolist()
+    columns = np.linspace(second.low, second.high, exp.grid).tolist()
+    at = {(r, c): by_point[point_key(exp.inputs, {first.name: r, second.name: c})]
+          for r in rows for c in columns}
+    return {'rows': {'input': first.name, 'values': rows},
+            'columns': {'input': second.name, 'values': columns},
             'verdicts': {o: [[at[(r, c)].get(o) for c in columns] for r in rows]
-                         for o in options}}
+                         for o in base['verdicts']}}
 
 
 def _stem(name: str) -> str:

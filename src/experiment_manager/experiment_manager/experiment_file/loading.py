@@ -251,7 +251,8 @@ def _sensitivity(e: schema.SensitivityKeys, where: str, c: _Context) -> list[Exp
                                    iterations=min(source.iterations, e.iterations),
                                    scenario=scenario, **renamed))
     return repeats + [Experiment(id=e.id, type=SENSITIVITY, iterations=e.iterations,
-                                 of=tuple(e.of), inputs=inputs, scenarios=found)]
+                                 of=tuple(e.of), inputs=inputs, scenarios=found,
+                                 grid=e.grid)]
 
 
 def _experiment(e: schema.ExperimentKeys, where: str, c: _Context) -> list[Experiment]:

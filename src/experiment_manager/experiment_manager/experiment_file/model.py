@@ -125,7 +125,9 @@ class Experiment:
     feeder_emptying's [min*, max*], or None when `range_from` names the table_sweep whose
     optimum is used. variants: gripper_sweep's grippers and grasp sets, checked on the same
     scenes; min_valid: the valid parts per check a gripper must give (its 95 % interval's low
-    end at least this).
+    end at least this). of, inputs, scenarios, grid: a sensitivity's experiments repeated,
+    uncertain inputs, scenarios and grid levels per input (0: no grid); scenario: the one a
+    repeat (`<id>@<scenario>`) runs in.
     """
 
     id: str
@@ -146,6 +148,7 @@ class Experiment:
     inputs: tuple[Input, ...] = ()
     scenarios: tuple[Scenario, ...] = ()
     scenario: Scenario | None = None
+    grid: int = 0
 
     @property
     def sources(self) -> tuple[str, ...]:

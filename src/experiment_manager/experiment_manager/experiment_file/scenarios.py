@@ -109,10 +109,19 @@ def grid(inputs: tuple[Input, ...], levels: int) -> list[dict[str, float]]:
     return [dict(point) for point in itertools.product(*axes)]
 
 
+def point_key(inputs: tuple[Input, ...], values: dict[str, float]) -> tuple[float, ...]:
+    """Every input's value in a scenario of `values` (the file's where not given), rounded as
+    the file's values are: equal keys, the same inputs."""
+    return tuple(round(float(values.get(x.name, x.base)), 9) for x in inputs)
+
+
 def scenarios(inputs: tuple[Input, ...], joint: int, setup: Setup,
               moves: tuple[Vibration, ...], seed: int, experiment_id: str, where: str,
               levels: int = 0) -> tuple[Scenario, ...]:
-    """The scenarios of a sensitivity experiment (module docstring), each checked."""
+    """The scenarios of a sensitivity experiment (module docstring), each checked. A point
+    whose inputs are all the file's or an earlier scenario's is left out: on the same seeds it
+    would give the same answers (an input's low at the file's value; a grid holds each input's
+    ends with the others at the file's values when those are among its levels)."""
     design: list[tuple[str, dict[str, float]]] = []
     for x in inputs:
         stem = x.name.replace('.', '_')
@@ -120,8 +129,14 @@ def scenarios(inputs: tuple[Input, ...], joint: int, setup: Setup,
     design += [(f'joint_{i + 1}', point) for i, point in
                enumerate(latin_hypercube(inputs, joint, seed, experiment_id))]
     design += [(f'grid_{i + 1}', point) for i, point in enumerate(grid(inputs, levels))]
-    out = []
+    seen = {point_key(inputs, {})}
+    kept = []
     for name, values in design:
+        if (key := point_key(inputs, values)) not in seen:
+            seen.add(key)
+            kept.append((name, values))
+    out = []
+    for name, values in kept:
         s, m = apply(values, setup, moves, f'{where}.inputs ({name})')
         out.append(Scenario(name, tuple(values.items()), s, m))
     return tuple(out)
