@@ -3,6 +3,7 @@
 import math
 import time
 
+from action_msgs.msg import GoalStatus, GoalStatusArray
 from geometry_msgs.msg import Vector3
 from graph import NodeProcess, stop_all, unique_namespace
 from pick_common.node_runner import LATCHED
@@ -11,6 +12,7 @@ from pick_msgs.action import FeedCycle, RemoveParts
 from pick_msgs.msg import FeederState, Vibration
 from pick_msgs.srv import GetParts
 import pytest
+from rclpy.qos import qos_profile_action_status_default
 
 pytestmark = pytest.mark.graph
 NS = unique_namespace('cell_f')
@@ -115,11 +117,19 @@ def test_a_world_that_dies_mid_cycle_gets_an_error_answer_not_a_hang(client, res
     try:
         cycle = LockedActionClient(client.node, FeedCycle, f'{ns}/feed_cycle')
         assert client.wait_for_servers(cycle, nodes=(world, feeder))
-        # A big feed: the world is still dropping when it is killed.
+        # A big feed, killed while the world drops it (its drop_parts goal is executing: a
+        # world killed before the feeder's goal reached it is another case, the one below)
+        executing = []
+        client.node.create_subscription(
+            GoalStatusArray, f'{ns}/drop_parts/_action/status',
+            lambda m: executing.extend(s for s in m.status_list
+                                       if s.status == GoalStatus.STATUS_EXECUTING),
+            qos_profile_action_status_default)
         handle = client.result(cycle.send_goal_async(FeedCycle.Goal(
             restart=True, feeder_parts=1000, min_count=700, max_count=700)))
         result_future = handle.get_result_async()
-        assert not client.wait(result_future.done, 1.0)
+        assert client.wait(lambda: executing, 60.0)
+        assert not result_future.done()
         world.process.kill()
         killed = time.monotonic()
         if restarted:

@@ -6,6 +6,7 @@ namespace it commands that worker's world. One goal at a time: another is answer
 """
 
 import threading
+import time
 
 from pick_common.conversions import ERROR_INTERNAL, ERROR_NONE
 from pick_common.errors import CodedError, InvalidArgument
@@ -13,10 +14,12 @@ from pick_common.node_runner import (
     answer_error,
     declare,
     LATCHED,
+    probe,
+    PROBE_WAIT,
     RESULT_KEEP,
     run,
+    server_ids,
     ServerWatch,
-    serving,
 )
 from pick_common.rclpy_adapter import LockedActionClient
 from pick_common.specs import MAX_MOVES
@@ -48,6 +51,9 @@ STATES = {-1: FeederStateMsg.STATE_IDLE, PICK: FeederStateMsg.STATE_PICKING,
           STOP_VIBRATION_LIMIT: FeederStateMsg.STATE_DONE_VIBRATION_LIMIT}
 SERVER_WAIT = 5.0   # s to wait for the world's action server before answering an error
 WATCH_PERIOD = 0.5  # s between checks that it is still there
+# s for a dead world's server to leave the graph while a new one serves the name (Fast DDS's
+# lease: 20 s), and for a new server to answer a probe, before an error answer
+LEASE_WAIT = 30.0
 
 
 class FeederControllerNode(Node):
@@ -68,7 +74,7 @@ class FeederControllerNode(Node):
                                'vibrations before a run stops'))
         self._policy = FeederPolicy(self._defaults)
         self._lock = threading.Lock()
-        group = ReentrantCallbackGroup()
+        self._group = group = ReentrantCallbackGroup()
         self._state_pub = self.create_publisher(FeederStateMsg, 'feeder/state', LATCHED)
         self._drop = LockedActionClient(self, DropParts, 'drop_parts', callback_group=group)
         self._vibrate = LockedActionClient(self, Vibrate, 'vibrate', callback_group=group)
@@ -76,6 +82,8 @@ class FeederControllerNode(Node):
                      callback_group=group, result_timeout=RESULT_KEEP)
         # the call to the world in flight and the watch on the server that took it
         self._in_flight: tuple[Future, ServerWatch, str] | None = None
+        # world action name -> the ids of the server that last answered a probe
+        self._answered: dict[str, frozenset[bytes]] = {}
         self.create_timer(WATCH_PERIOD, self._watch, callback_group=group)
         self._publish_state()
 
@@ -93,22 +101,72 @@ class FeederControllerNode(Node):
     async def _world(self, client: LockedActionClient, goal, name: str):
         """Send a goal to the world's action `name` and await its result. Raises CodedError
         with the world's own error code, or INTERNAL when it is not there or leaves."""
-        if not client.wait_for_server(timeout_sec=SERVER_WAIT):
-            raise CodedError(ERROR_INTERNAL, (
-                f'the world action {name!r} in namespace {self.get_namespace()!r} did not '
-                f'answer within {SERVER_WAIT:g} s: is the world node running there?'))
-        handle = await self._watched(client.send_goal_async(goal), client, name)
+        ids = await self._answering(client, name)
+        handle = await self._watched(client.send_goal_async(goal), {client: ids}, name)
         if not handle.accepted:
             raise CodedError(ERROR_INTERNAL, f'the world rejected {name}')
-        result = (await self._watched(handle.get_result_async(), client, name)).result
+        result = (await self._watched(handle.get_result_async(), {client: ids}, name)).result
         if result.error_code != ERROR_NONE:
             raise CodedError(result.error_code, f'world {name}: {result.error_msg}')
         return result
 
-    def _watched(self, future: Future, client: LockedActionClient, name: str) -> Future:
-        """`future`, failed by _watch with CodedError if the world's server that took it leaves
-        the graph before it completes (a world that died never answers)."""
-        self._in_flight = (future, ServerWatch(self, serving(self, [client])), name)
+    async def _answering(self, client: LockedActionClient, name: str) -> frozenset[bytes]:
+        """The DDS id of the world's one server of `name`, once the graph has it and, when it
+        is new (the first call, or a world started again), once it has answered a probe: a
+        server that has not matched this node's reply readers drops its answers, and a goal
+        sent to it then waits for ever (node_runner.probe). While two servers serve the name
+        (a world that died lingers in the graph until its lease ends), a goal would go to both:
+        it waits for one. Raises CodedError (INTERNAL) when there is none within SERVER_WAIT,
+        or not one alone, or a new one does not answer, within LEASE_WAIT. Waits without
+        blocking the executor."""
+        where = f'the world action {name!r} in namespace {self.get_namespace()!r}'
+        start = time.monotonic()
+        while len(ids := server_ids(self, client) if client.server_is_ready()
+                  else frozenset()) != 1:
+            waited = time.monotonic() - start
+            if not ids and waited > SERVER_WAIT:
+                raise CodedError(ERROR_INTERNAL, f'{where} did not answer within '
+                                 f'{SERVER_WAIT:g} s: is the world node running there?')
+            if len(ids) > 1 and waited > LEASE_WAIT:
+                raise CodedError(ERROR_INTERNAL, (
+                    f'{where} has {len(ids)} servers after {LEASE_WAIT:g} s: does another '
+                    'world node run there?'))
+            await self._within(Future(), WATCH_PERIOD)
+        if self._answered.get(name) == ids:
+            return ids
+        service, request = probe(self, client)
+        try:
+            start = time.monotonic()
+            while not await self._within(answer := service.call_async(request), PROBE_WAIT):
+                service.remove_pending_request(answer)
+                if time.monotonic() - start > LEASE_WAIT:
+                    raise CodedError(ERROR_INTERNAL, f'{where} is served but did not answer a '
+                                     f'probe within {LEASE_WAIT:g} s')
+        finally:
+            self.destroy_client(service)
+        self._answered[name] = ids
+        return ids
+
+    async def _within(self, future: Future, timeout: float) -> bool:
+        """Await `future` for at most `timeout` s: whether it completed."""
+        waiter = Future()
+
+        def finish(done: bool) -> None:
+            if not waiter.done():
+                waiter.set_result(done)
+
+        future.add_done_callback(lambda _: finish(True))
+        timer = self.create_timer(timeout, lambda: finish(False), callback_group=self._group)
+        try:
+            return await waiter
+        finally:
+            self.destroy_timer(timer)
+
+    def _watched(self, future: Future, serving: dict, name: str) -> Future:
+        """`future`, failed by _watch with CodedError if the world's server that took it
+        (`serving`: client -> its ids) leaves the graph before it completes (a world that died
+        never answers)."""
+        self._in_flight = (future, ServerWatch(self, serving), name)
         return future
 
     def _watch(self) -> None:
