@@ -99,6 +99,24 @@ def test_bins_leave_the_race_when_they_are_clearly_behind_the_leader():
     assert sampling.unsettled(file, one, rows([90], 1)) == []
 
 
+def test_a_race_between_bins_that_tie_within_bin_tie_ends_in_the_tie(monkeypatch):
+    file = small()
+    exp = replace(file.experiment('bins'), bins=file.experiment('bins').bins * 2)  # 4 bins
+    rng = np.random.default_rng(2)
+
+    def rows(means, n):
+        return [row(g, i, checked=100, container_free=int(m + rng.integers(-2, 3)))
+                for g, m in enumerate(means) for i in range(n)]
+
+    close = [60, 89, 90, 30]        # bins 1 and 2 a point apart, of 100 parts
+    assert sampling.race(exp, rows(close, 6)) == ([1, 2], [])     # not yet known to tie
+    tied = rows(close, 30)
+    assert sampling.race(exp, tied) == ([], [2, 1])             # the leader first
+    assert sampling.unsettled(file, exp, tied) == []
+    monkeypatch.setattr(sampling, 'BIN_TIE', 0.0)               # no tie: they race on
+    assert sampling.unsettled(file, exp, tied) == [1, 2]
+
+
 def test_a_sweep_is_settled_when_the_optimum_s_interval_lies_inside_its_range():
     file = small()
     exp = replace(file.experiment('sweep'), counts=tuple(range(10, 101, 10)), margin=5)

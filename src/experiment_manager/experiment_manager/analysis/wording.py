@@ -16,17 +16,25 @@ def dims(values) -> str:
 
 
 def sampling_end(experiment: dict) -> str:
-    """How an adaptive experiment's sampling ended, from its summary: 'settled', or 'not
-    settled', for bins with the ones whose intervals still reached the leader's."""
+    """How an adaptive experiment's sampling ended, from its summary: 'settled' (for bins that
+    tie, with them), or 'not settled', for bins with the ones whose intervals still reached
+    the leader's."""
     a = experiment['sampling']
     if a['settled']:
-        return 'settled'
+        if not a.get('tie'):
+            return 'settled'
+        return (f'settled: bins {_bins(experiment, a["tie"])} mm tie within '
+                f'{pct(a["tie_within"])} at 99.9 % (the first has the highest mean)')
     if not a.get('tied_bins'):
         return 'not settled'
+    return f'not settled: bins {_bins(experiment, a["tied_bins"])} mm could not be told apart ' \
+        'at 99.9 %'
+
+
+def _bins(experiment: dict, indices: list[int]) -> str:
     sizes = {b['index']: dims(b['size_mm']) for b in experiment['bins']}
-    tied = [sizes[g] for g in a['tied_bins']]
-    listed = ' and '.join(filter(None, (', '.join(tied[:-1]), tied[-1])))
-    return f'not settled: bins {listed} mm could not be told apart at 99.9 %'
+    named = [sizes[g] for g in indices]
+    return ' and '.join(filter(None, (', '.join(named[:-1]), named[-1])))
 
 
 def count(n: int, noun: str) -> str:

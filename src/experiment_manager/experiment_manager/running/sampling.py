@@ -20,7 +20,12 @@ What settles each decision, looked at after every batch:
   FEASIBLE then.
 - bin_static, a race: a bin leaves it when the interval of its mean container-free fraction lies
   wholly below the interval of the leading bin's (the highest mean). The race ends with one bin
-  left (the best bin) or at the most iterations.
+  left (the best bin), or with a tie: every bin left is known to lie within BIN_TIE (5 %) of
+  the leader (the leader's upper bound less its lower bound at most 5 % of the leader's lower
+  bound), so whichever of them is taken gives at least 95 % of the best bin's container-free
+  parts (the leader is named best; the summary lists the tie); or at the most iterations.
+  5 % is our choice, the same as FLAT_TOP's: PTH1's three widest bins lie within 1 % of each
+  other on 40 drops each and no race could part them.
 - table_sweep: the optimum n* of the fit, bootstrapped (metrics.n_star_interval: iterations
   resampled within each count, a seed of the file's): settled when the interval of n* lies
   inside the optimal range n* +- margin, so the feeder runs' range holds the optimum; or when
@@ -61,6 +66,7 @@ from ..experiment_file.plan import groups
 
 INTERIM_CONFIDENCE = 0.999
 FLAT_TOP = 0.05     # a sweep's top is flat when its fit over n*'s interval is within this
+BIN_TIE = 0.05      # bins tie when each is known to lie within this share of the leader
 
 
 def unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict],
@@ -98,20 +104,30 @@ def rate_settled(successes: int, n: int, required: float,
 
 
 def _racing(exp: Experiment, rows: list[dict]) -> list[int]:
-    """The bins still in the race: every bin whose interval of the mean container-free
-    fraction reaches the leader's; all of them while any has fewer than two iterations; none
-    when there is one bin (it is the best)."""
+    """The bins still in the race (race)."""
+    return race(exp, rows)[0]
+
+
+def race(exp: Experiment, rows: list[dict]) -> tuple[list[int], list[int]]:
+    """(the bins still in the race, the bins of a tie that ended it). Racing: every bin whose
+    interval of the mean container-free fraction reaches the leader's; all of them while any
+    has fewer than two iterations; none when one is left (it is the best) or when those left
+    tie within BIN_TIE of the leader (they are then the tie, the leader first)."""
     if len(groups(exp)) == 1:
-        return []
+        return [], []
     fractions = {g: [r['container_free'] / r['checked'] for r in rows
                      if r['group'] == g and r['checked']] for g in groups(exp)}
     intervals = {g: metrics.interval(v, INTERIM_CONFIDENCE) for g, v in fractions.items()}
     if any(low is None for low, _ in intervals.values()):
-        return groups(exp)
+        return groups(exp), []
     leader = max(groups(exp), key=lambda g: (np.mean(fractions[g]), -g))
-    floor = intervals[leader][0]
+    floor, top = intervals[leader]
     racing = [g for g in groups(exp) if intervals[g][1] >= floor]
-    return racing if len(racing) > 1 else []
+    if len(racing) == 1:
+        return [], []
+    if all(top - intervals[g][0] <= BIN_TIE * floor for g in racing):
+        return [], [leader] + [g for g in racing if g != leader]
+    return racing, []
 
 
 def _sweep_unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> list[int]:

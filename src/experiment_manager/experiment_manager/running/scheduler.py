@@ -231,6 +231,8 @@ class Runner:
                 'most': experiment_iterations(exp), 'settled': not left}
             if left and exp.type == BIN_STATIC:     # the bins that could not be told apart
                 self._summary[exp.id]['sampling']['tied_bins'] = left
+            elif exp.type == BIN_STATIC and (tie := sampling.race(exp, rows)[1]):
+                self._summary[exp.id]['sampling'].update(tie=tie, tie_within=sampling.BIN_TIE)
         self.sink.write_summary(metrics.file_summary(self.file, self._ordered_summary()))
         self._release()
 
