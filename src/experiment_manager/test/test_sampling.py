@@ -9,6 +9,7 @@ from experiment_manager import experiment_file
 from experiment_manager.analysis import metrics, report
 from experiment_manager.analysis.results import read_text_rows, ResultsWriter
 from experiment_manager.analysis.verdicts import NOT_FEASIBLE, verdicts
+from experiment_manager.analysis.wording import sampling_end
 from experiment_manager.commands.run import _summary_lines
 from experiment_manager.running import sampling
 from experiment_manager.running.local_backend import LocalBackend
@@ -306,3 +307,15 @@ def test_an_adaptive_race_that_runs_out_names_the_bins_it_could_not_tell_apart(t
     said = 'not settled: bins 100 x 100 x 20 and 120 x 80 x 20 mm could not be told apart'
     assert said in _summary_lines(summary)[0]
     assert f'at the most iterations, {said}' in report.markdown(summary, {}, {})
+
+
+def test_a_tie_is_said_with_its_bins():
+    experiment = {'bins': [{'index': 0, 'size_mm': [100, 100, 20]},
+                           {'index': 1, 'size_mm': [120, 80, 20]},
+                           {'index': 2, 'size_mm': [75, 75, 40]}],
+                  'sampling': {'settled': True, 'tie': [1, 0], 'tie_within': 0.05}}
+    assert sampling_end(experiment) == ('settled: bins 120 x 80 x 20 and 100 x 100 x 20 mm tie '
+                                        'within 5.0 % at 99.9 % (the first has the highest '
+                                        'mean)')
+    del experiment['sampling']['tie']
+    assert sampling_end(experiment) == 'settled'
