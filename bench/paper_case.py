@@ -43,13 +43,22 @@ def run_on_cores(part_file: str, experiments: list[dict], physics: PhysicsConfig
                  **sections) -> tuple[list[dict], float]:
     """Run variant(part_file, experiments, **sections) on the cores with `physics` (the
     world's defaults when None); the rows of iterations.csv and the wall time of the run, s."""
+    rows, _, wall = summarise_on_cores(part_file, experiments, physics, **sections)
+    return rows, wall
+
+
+def summarise_on_cores(part_file: str, experiments: list[dict],
+                       physics: PhysicsConfig | None = None,
+                       **sections) -> tuple[list[dict], dict, float]:
+    """run_on_cores with the run's summary too (summary.json's, per experiment id): the rows,
+    the summary and the wall time, s."""
     file = variant(part_file, experiments, **sections)
     with tempfile.TemporaryDirectory() as out:
         start = time.perf_counter()
         with LocalBackend(physics) as backend, ResultsWriter(out, file.text) as writer:
-            Runner(file, [backend], writer).run()
+            summary = Runner(file, [backend], writer).run()
         wall = time.perf_counter() - start
-        return read_csv(os.path.join(out, 'iterations.csv')), wall
+        return read_csv(os.path.join(out, 'iterations.csv')), summary, wall
 
 
 @contextlib.contextmanager

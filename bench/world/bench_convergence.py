@@ -125,8 +125,8 @@ WORKLOADS = {
 # docs/paper-test-case.md, "Which gripper"). Chosen on 2026-11-25, when with the test case's
 # 20 mm one (issue 21's validity) every PTH0 feeder run stopped at its vibration limit; since
 # round bodies are gripped at any roll (2026-11-26) they empty (PTH0: 50 of 50, 33 vibrations
-# on average), so that reason no longer holds, and the study has not been run with the test
-# case's gripper yet (issue 44).
+# on average), so that reason no longer holds: bench_answers.py checks the answers as reported
+# with the test case's own gripper and loads (issue 44).
 GRIPPER = {'body_diameter_mm': 8, 'body_length_mm': 60, 'jaw_height_mm': 15, 'jaw_depth_mm': 3}
 
 
