@@ -8,7 +8,7 @@ import os
 from experiment_manager import experiment_file
 from experiment_manager.analysis import report
 from experiment_manager.analysis.results import read_csv, read_text_rows, ResultsWriter
-from experiment_manager.analysis.sensitivity import _map, _robustness
+from experiment_manager.analysis.sensitivity import _held_said, _map, _robustness
 from experiment_manager.analysis.sensitivity import summarise as sensitivity_summary
 from experiment_manager.analysis.verdicts import verdicts
 from experiment_manager.commands.run import _summary_lines
@@ -291,6 +291,14 @@ def test_only_the_options_whose_runs_are_repeated_are_said_to_hold(small):
     assert list(said['base']['verdicts']) == ['vibrating table']
     assert [r['option'] for r in said['robustness']] == ['vibrating table']
     assert said['robustness'][0]['holds']       # the same runs: the same verdict
+    # the feeder's range came from the sweep, not repeated: said with the section and a flip
+    assert said['held'] == {'feeder': {'what': 'range', 'from': 'sweep'}}
+    assert '`feeder` ran at the range of `sweep`' in '\n'.join(
+        report._sensitivity('robust', said, False))
+    flipped = _held_said([{**said['robustness'][0], 'holds': False, 'flips': [{}],
+                           'line': 'vibrating table FEASIBLE here, but NOT FEASIBLE at x 1'}],
+                         said['held'])
+    assert flipped[0]['line'].endswith('at x 1 (`feeder` at the range of `sweep`, not repeated)')
 
 
 def test_a_gripper_input_is_refused_for_a_gripper_sweep_whose_grippers_are_its_own():

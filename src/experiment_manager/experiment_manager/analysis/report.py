@@ -382,6 +382,12 @@ def _sensitivity(exp_id: str, s: dict, plotted: bool) -> list[str]:
     lines += table(['input', "file's value", 'low', 'high', 'source of the range'],
                    [[f'`{x["name"]}`', x['base'], x['low'], x['high'], x['source']]
                     for x in s['inputs']])
+    if s.get('held'):
+        lines += ['', 'Not repeated, so the same in every scenario: '
+                  + '; '.join(f'`{e}` ran at the {h["what"]} of `{h["from"]}`'
+                              for e, h in s['held'].items())
+                  + '. A verdict that flips may flip for that: repeat it too (add it to `of`) '
+                  'for a range or bin that follows the inputs.']
     lines += ['', 'Verdicts over the ranges:', '']
     lines += [f'- {r["line"]}' for r in s['robustness']] or ['- no verdict to compare']
     if plotted:
@@ -407,8 +413,8 @@ def _sensitivity(exp_id: str, s: dict, plotted: bool) -> list[str]:
                        for k in keys] + [said['verdicts'].get(o, '-') for o in options])
     lines += ['', f"Each scenario's answers are from at most {count(s['iterations'], 'iteration')}"
               ' of each experiment: a difference between scenarios within the spread of '
-              "their runs is the draw's, not the input's (a low or high equal to the file's "
-              "value repeats the file's runs exactly)."]
+              "their runs is the draw's, not the input's (a scenario whose inputs are the "
+              "file's, or an earlier scenario's, is not run again)."]
     lines += ['', "Each scenario's answers ("
               + '; '.join(f'{ANSWERS[k][0]}' + (f', {ANSWERS[k][1]}' if ANSWERS[k][1] else '')
                           for k in keys) + ') and verdicts:', '']

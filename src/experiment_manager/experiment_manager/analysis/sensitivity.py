@@ -100,12 +100,17 @@ def summarise(file: ExperimentFile, exp: Experiment, summaries: dict) -> dict:
             'answers'].get(key) for end in ('low', 'high')} for x in exp.inputs}
     repeats = {f'{e}@{sc.name}': summaries[f'{e}@{sc.name}'] for sc in exp.scenarios
                for e in exp.of}
-    return {'type': exp.type, 'of': list(exp.of), 'iterations': exp.iterations,
+    # a repeat whose bin or range comes from an experiment not repeated ran at the file's
+    held = {e: {'what': what, 'from': source} for e in exp.of
+            for what, source in (('range', file.experiment(e).range_from),
+                                 ('bin', file.experiment(e).bin_from))
+            if source and source not in exp.of}
+    return {'type': exp.type, 'of': list(exp.of), 'iterations': exp.iterations, 'held': held,
             'inputs': [{'name': x.name, 'base': x.base, 'low': x.low, 'high': x.high,
                         'source': x.source} for x in exp.inputs],
             'base': base_said, 'scenarios': scenarios, 'tornado': tornado,
             'ranges': _ranges(base_said, scenarios),
-            'robustness': _robustness(exp, base_said, scenarios),
+            'robustness': _held_said(_robustness(exp, base_said, scenarios), held),
             **({'map': m} if (m := _map(exp, base_said, scenarios)) else {}),
             'faults': _faults(repeats), 'physics': _physics(repeats)}
 
@@ -128,6 +133,17 @@ def _map(exp: Experiment, base: dict, scenarios: list[dict]) -> dict | None:
             'columns': {'input': second.name, 'values': columns},
             'verdicts': {o: [[at[(r, c)].get(o) for c in columns] for r in rows]
                          for o in base['verdicts']}}
+
+
+def _held_said(robustness: list[dict], held: dict) -> list[dict]:
+    """A flip's words end with what was not repeated and so ran at the file's (a range or bin
+    chosen for the file's inputs may be why it flips)."""
+    if not held:
+        return robustness
+    words = '; '.join(f'`{e}` at the {h["what"]} of `{h["from"]}`, not repeated'
+                      for e, h in held.items())
+    return [{**r, 'said': f'{r["said"]} ({words})', 'line': f'{r["line"]} ({words})'}
+            if r['flips'] else r for r in robustness]
 
 
 def _stem(name: str) -> str:
