@@ -376,7 +376,8 @@ def _sensitivity(exp_id: str, s: dict, plotted: bool) -> list[str]:
     lines = ['', f'## How far the answers move (`{exp_id}`)', '',
              f'The experiments {", ".join(f"`{e}`" for e in s["of"])} repeated in '
              f'{count(len(s["scenarios"]), "scenario")} (each input at its low and its high, '
-             "the others at the file's values; `joint_*`: all at once, a Latin hypercube), "
+             "the others at the file's values; `joint_*`: all at once, a Latin hypercube; "
+             "`grid_*`: every combination of the grid's levels), "
              f'at most {count(s["iterations"], "iteration")} each, on the seeds of the runs '
              'they repeat:', '']
     lines += table(['input', "file's value", 'low', 'high', 'source of the range'],
