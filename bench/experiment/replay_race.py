@@ -1,6 +1,6 @@
 """Replay the bins' race of finished adaptive runs with a given BIN_TIE, on their recorded drops:
 the same batches (5 per bin, then 5 per bin still racing), each look deciding with
-running/sampling.race as a run does, until the race ends or the recorded drops run out. With
+running/sampling.ended as a run does, until the race ends or the recorded drops run out. With
 --tie 0 it gives back the race the runs ran before the tie rule.
 
     tools/ws python -m bench.experiment.replay_race [--tie 0.05] RUN_DIR...
@@ -10,28 +10,26 @@ bin_static experiment `bins`.
 """
 
 import argparse
-import csv
 import os
 
 from experiment_manager import experiment_file
+from experiment_manager.analysis.results import read_csv
 from experiment_manager.running import sampling
 
 
 def replay(run_dir: str, batch: int) -> str:
     file = experiment_file.load(os.path.join(run_dir, 'experiment.yaml'))
     exp = file.experiment('bins')
-    with open(os.path.join(run_dir, 'iterations.csv'), encoding='utf-8') as f:
-        rows = [{'group': int(r['group']), 'iteration': int(r['iteration']),
-                 'checked': int(r['checked']), 'container_free': int(r['container_free']),
-                 'wall': float(r['wall_time'])}
-                for r in csv.DictReader(f) if r['experiment'] == 'bins']
+    rows = [r for r in read_csv(os.path.join(run_dir, 'iterations.csv'))
+            if r['experiment'] == 'bins']
     recorded = {}
     for r in rows:
         recorded[r['group']] = max(recorded.get(r['group'], 0), r['iteration'] + 1)
     given = dict.fromkeys(range(len(exp.bins)), batch)
     looks, end = 1, 'one bin left'
     while True:
-        racing, tie = sampling.race(exp, [r for r in rows if r['iteration'] < given[r['group']]])
+        racing, tie = sampling.ended(file, exp, [r for r in rows
+                                                 if r['iteration'] < given[r['group']]])
         if tie:
             end = f'a tie of bins {tie}'
         if not racing:
@@ -44,7 +42,8 @@ def replay(run_dir: str, batch: int) -> str:
         looks += 1
     used = [r for r in rows if r['iteration'] < given[r['group']]]
     return (f'{os.path.basename(os.path.normpath(run_dir))}: {len(used)} of {len(rows)} drops, '
-            f'{sum(r["wall"] for r in used) / 60:.1f} of {sum(r["wall"] for r in rows) / 60:.1f} '
+            f'{sum(r["wall_time"] for r in used) / 60:.1f} of '
+            f'{sum(r["wall_time"] for r in rows) / 60:.1f} '
             f'worker-min, {looks} looks, ended by {end}')
 
 

@@ -84,36 +84,36 @@ def test_feeder_runs_settle_on_their_time_to_empty_and_their_spills():
     assert sampling.unsettled(file, exp, tunnelled) == []
 
 
-def test_bins_leave_the_race_when_they_are_clearly_behind_the_leader():
+def four_bins() -> tuple:
+    """The small file and its bins experiment with 4 bins."""
     file = small()
-    exp = replace(file.experiment('bins'), bins=file.experiment('bins').bins * 2)  # 4 bins
+    return file, replace(file.experiment('bins'), bins=file.experiment('bins').bins * 2)
+
+
+def bin_rows(rng, means: list[int], n: int) -> list[dict]:
+    """n drops per bin of 100 parts checked, container-free around each bin's mean (+-2)."""
+    return [row(g, i, checked=100, container_free=int(m + rng.integers(-2, 3)))
+            for g, m in enumerate(means) for i in range(n)]
+
+
+def test_bins_leave_the_race_when_they_are_clearly_behind_the_leader():
+    file, exp = four_bins()
     rng = np.random.default_rng(0)
-
-    def rows(means, n):
-        return [row(g, i, checked=100, container_free=int(m + rng.integers(-2, 3)))
-                for g, m in enumerate(means) for i in range(n)]
-
-    assert sampling.unsettled(file, exp, rows([90, 89, 60, 30], 6)) == [0, 1]
-    assert sampling.unsettled(file, exp, rows([90, 50, 60, 30], 6)) == []   # one left: best
-    assert sampling.unsettled(file, exp, rows([90, 50, 60, 30], 1)) == [0, 1, 2, 3]
+    assert sampling.unsettled(file, exp, bin_rows(rng, [90, 89, 60, 30], 6)) == [0, 1]
+    assert sampling.unsettled(file, exp, bin_rows(rng, [90, 50, 60, 30], 6)) == []  # one: best
+    assert sampling.unsettled(file, exp, bin_rows(rng, [90, 50, 60, 30], 1)) == [0, 1, 2, 3]
     one = replace(exp, bins=exp.bins[:1])        # nothing to race: the one bin is the best
-    assert sampling.unsettled(file, one, rows([90], 1)) == []
+    assert sampling.unsettled(file, one, bin_rows(rng, [90], 1)) == []
 
 
 def test_a_race_between_bins_that_tie_within_bin_tie_ends_in_the_tie(monkeypatch):
-    file = small()
-    exp = replace(file.experiment('bins'), bins=file.experiment('bins').bins * 2)  # 4 bins
+    file, exp = four_bins()
     rng = np.random.default_rng(2)
-
-    def rows(means, n):
-        return [row(g, i, checked=100, container_free=int(m + rng.integers(-2, 3)))
-                for g, m in enumerate(means) for i in range(n)]
-
     close = [60, 89, 90, 30]        # bins 1 and 2 a point apart, of 100 parts
-    assert sampling.race(exp, rows(close, 6)) == ([1, 2], [])     # not yet known to tie
-    tied = rows(close, 30)
+    assert sampling.race(exp, bin_rows(rng, close, 6)) == ([1, 2], [])   # not yet known to tie
+    tied = bin_rows(rng, close, 30)
     assert sampling.race(exp, tied) == ([], [2, 1])             # the leader first
-    assert sampling.unsettled(file, exp, tied) == []
+    assert sampling.ended(file, exp, tied) == ([], [2, 1])
     monkeypatch.setattr(sampling, 'BIN_TIE', 0.0)               # no tie: they race on
     assert sampling.unsettled(file, exp, tied) == [1, 2]
 

@@ -16,11 +16,9 @@ flip it, with the inputs' values there.
 Pure: no rclpy, no files.
 """
 
-import numpy as np
-
 from ..experiment_file import ExperimentFile
 from ..experiment_file.model import Experiment
-from ..experiment_file.scenarios import point_key
+from ..experiment_file.scenarios import grid_levels, point_key
 from . import metrics
 from .verdicts import NOT_ANALYSED, option_kind, UNDECIDED, verdicts
 from .wording import fmt
@@ -125,8 +123,7 @@ def _map(exp: Experiment, base: dict, scenarios: list[dict]) -> dict | None:
     first, second = exp.inputs
     by_point = {point_key(exp.inputs, s['values']): s['verdicts'] for s in scenarios}
     by_point.setdefault(point_key(exp.inputs, {}), base['verdicts'])
-    rows = np.linspace(first.low, first.high, exp.grid).tolist()
-    columns = np.linspace(second.low, second.high, exp.grid).tolist()
+    rows, columns = grid_levels(first, exp.grid), grid_levels(second, exp.grid)
     at = {(r, c): by_point[point_key(exp.inputs, {first.name: r, second.name: c})]
           for r in rows for c in columns}
     return {'rows': {'input': first.name, 'values': rows},

@@ -47,20 +47,17 @@ def describe_plan(file: ExperimentFile) -> list[str]:
     they add (each an experiment of its own, `<id>@<scenario>`, listed under it)."""
     adaptive = file.sampling.mode == experiment_file.ADAPTIVE
     at_most = 'at most ' if adaptive else ''
-    repeats = {e.id for e in file.experiments if '@' in e.id}
-    lines = [f'plan: {len(file.experiments) - len(repeats)} experiment(s), '
+    own = [e for e in file.experiments if e.scenario is None]     # not a sensitivity's repeat
+    lines = [f'plan: {len(own)} experiment(s), '
              f'{at_most}{count_iterations(file)} iterations'
              + (' (sampling adaptive: each stops once its decision is settled)' if adaptive
                 else '')]
-    for exp in file.experiments:
-        if exp.id in repeats:
-            continue
+    for exp in own:
         if exp.type != SENSITIVITY:
             lines.append(f'  {exp.id} ({exp.type}): {at_most}{experiment_iterations(exp)} '
                          'iterations')
             continue
-        added = [e for e in file.experiments if e.id.partition('@')[0] in exp.of
-                 and e.id.partition('@')[2] in {s.name for s in exp.scenarios}]
+        added = [file.experiment(f'{e}@{s.name}') for s in exp.scenarios for e in exp.of]
         lines.append(f'  {exp.id} (sensitivity of {", ".join(exp.of)}): '
                      f'{len(exp.inputs)} input(s), {len(exp.scenarios)} scenario(s), '
                      f'{len(added)} repeat(s) of {at_most}'

@@ -100,12 +100,17 @@ def latin_hypercube(inputs: tuple[Input, ...], k: int, seed: int, experiment_id:
     return points
 
 
+def grid_levels(x: Input, levels: int) -> list[float]:
+    """`levels` values of `x` evenly from its low to its high."""
+    return np.linspace(x.low, x.high, levels).tolist()
+
+
 def grid(inputs: tuple[Input, ...], levels: int) -> list[dict[str, float]]:
     """Every combination of each input at `levels` values evenly from its low to its high
     (none for 0 levels)."""
     if not levels:
         return []
-    axes = [[(x.name, float(v)) for v in np.linspace(x.low, x.high, levels)] for x in inputs]
+    axes = [[(x.name, v) for v in grid_levels(x, levels)] for x in inputs]
     return [dict(point) for point in itertools.product(*axes)]
 
 
@@ -130,13 +135,11 @@ def scenarios(inputs: tuple[Input, ...], joint: int, setup: Setup,
                enumerate(latin_hypercube(inputs, joint, seed, experiment_id))]
     design += [(f'grid_{i + 1}', point) for i, point in enumerate(grid(inputs, levels))]
     seen = {point_key(inputs, {})}
-    kept = []
-    for name, values in design:
-        if (key := point_key(inputs, values)) not in seen:
-            seen.add(key)
-            kept.append((name, values))
     out = []
-    for name, values in kept:
+    for name, values in design:
+        if (key := point_key(inputs, values)) in seen:
+            continue
+        seen.add(key)
         s, m = apply(values, setup, moves, f'{where}.inputs ({name})')
         out.append(Scenario(name, tuple(values.items()), s, m))
     return tuple(out)

@@ -74,26 +74,32 @@ def unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict],
     """The groups of `exp` that need more iterations for its decision, from `rows` (its
     iterations written so far, any order) and `checks` (its rows of checks.csv, for a
     gripper_sweep), at INTERIM_CONFIDENCE; [] when the decision is settled."""
+    return ended(file, exp, rows, checks)[0]
+
+
+def ended(file: ExperimentFile, exp: Experiment, rows: list[dict],
+          checks: list[dict] = ()) -> tuple[list[int], list[int]]:
+    """(unsettled's groups, the bins of a tie that settled a bin_static race: race)."""
     rows = sorted(rows, key=lambda r: (r['group'], r['iteration']))
     out = metrics.left_out(rows)
     if out and exp.type in (BIN_EMPTYING, FEEDER_EMPTYING):
-        return []           # a left-out iteration makes the option NOT FEASIBLE: settled
+        return [], []       # a left-out iteration makes the option NOT FEASIBLE: settled
     kept = [r for r in rows if (r['group'], r['iteration']) not in out]
     if exp.type == BIN_STATIC:
-        return _racing(exp, kept)
+        return race(exp, kept)
     if exp.type == TABLE_SWEEP:
-        return _sweep_unsettled(file, exp, kept)
+        return _sweep_unsettled(file, exp, kept), []
     if exp.type == GRIPPER_SWEEP:
         kept_keys = {(r['group'], r['iteration']) for r in kept}
-        return [] if _smallest_settled(exp, [c for c in checks if (c['group'], c['iteration'])
-                                             in kept_keys]) else groups(exp)
+        return ([] if _smallest_settled(exp, [c for c in checks if (c['group'], c['iteration'])
+                                              in kept_keys]) else groups(exp)), []
     if exp.type == BIN_EMPTYING:
         successes = sum(bool(r['emptied']) for r in kept)
-        return [] if rate_settled(successes, len(kept), file.requirements.success_rate) \
-            else groups(exp)
+        return ([] if rate_settled(successes, len(kept), file.requirements.success_rate)
+                else groups(exp)), []
     grounds = metrics.table_grounds(file, kept, INTERIM_CONFIDENCE)
-    return [] if decisions.combined([g.verdict for g in grounds.values()]) != decisions.UNDECIDED \
-        else groups(exp)
+    return ([] if decisions.combined([g.verdict for g in grounds.values()])
+            != decisions.UNDECIDED else groups(exp)), []
 
 
 def rate_settled(successes: int, n: int, required: float,
@@ -101,11 +107,6 @@ def rate_settled(successes: int, n: int, required: float,
     """The rate's one-sided exact bounds at `confidence` put it at or above `required`, or
     below it (decisions.rate)."""
     return decisions.rate(successes, n, required, '', confidence).verdict != decisions.UNDECIDED
-
-
-def _racing(exp: Experiment, rows: list[dict]) -> list[int]:
-    """The bins still in the race (race)."""
-    return race(exp, rows)[0]
 
 
 def race(exp: Experiment, rows: list[dict]) -> tuple[list[int], list[int]]:

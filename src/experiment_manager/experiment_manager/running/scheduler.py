@@ -224,14 +224,14 @@ class Runner:
                 self.file.for_experiment(exp), exp, rows, self.sink.picks(exp.id),
                 self._summary, checks)
         if self.file.sampling.adaptive and exp.type != SENSITIVITY:
-            left = sampling.unsettled(self.file, exp, rows, checks)
+            left, tie = sampling.ended(self.file, exp, rows, checks)
             self._summary[exp.id]['sampling'] = {
                 'mode': self.file.sampling.mode, 'batch': self.file.sampling.batch,
                 'batches': self._looks[exp.id], 'iterations_run': len(rows),
                 'most': experiment_iterations(exp), 'settled': not left}
             if left and exp.type == BIN_STATIC:     # the bins that could not be told apart
                 self._summary[exp.id]['sampling']['tied_bins'] = left
-            elif exp.type == BIN_STATIC and (tie := sampling.race(exp, rows)[1]):
+            elif tie:                               # bins known to tie within BIN_TIE
                 self._summary[exp.id]['sampling'].update(tie=tie, tie_within=sampling.BIN_TIE)
         self.sink.write_summary(metrics.file_summary(self.file, self._ordered_summary()))
         self._release()
