@@ -234,21 +234,24 @@ def test_the_installed_share_holds_the_paper_test_case():
     # A user of an installed workspace runs the test case by its share path.
     share = os.path.join(get_package_share_directory('experiment_manager'), 'config')
     for name in ('pth0.yaml', 'pth1.yaml', 'pth2.yaml', 'grippers_pth0.yaml',
-                 'pth0_robustness.yaml', 'pth0_gripper_map.yaml'):
+                 'pth0_robustness.yaml', 'pth1_robustness.yaml', 'pth2_robustness.yaml',
+                 'pth0_gripper_map.yaml'):
         assert experiment_file.load(os.path.join(share, 'test_case', name)).experiments
 
 
-@pytest.mark.parametrize('name', ['pth0_robustness.yaml', 'pth0_gripper_map.yaml'])
-def test_the_robustness_files_are_pth0_with_a_sensitivity_experiment(name):
-    # a copy that drifted from pth0.yaml would answer for another part or cell
+@pytest.mark.parametrize('name', ['pth0_robustness.yaml', 'pth1_robustness.yaml',
+                                  'pth2_robustness.yaml', 'pth0_gripper_map.yaml'])
+def test_the_robustness_files_are_their_part_with_a_sensitivity_experiment(name):
+    # a copy that drifted from its pthN.yaml would answer for another part or cell
     case = os.path.join(HERE, '..', 'config', 'test_case')
-    pth0 = experiment_file.load(os.path.join(case, 'pth0.yaml'))
+    part = experiment_file.load(os.path.join(case, name.split('_')[0] + '.yaml'))
     robust = experiment_file.load(os.path.join(case, name))
     own = [e for e in robust.experiments if e.scenario is None and e.type != 'sensitivity']
-    assert own == list(pth0.experiments)
-    assert (robust.id, robust.seed, robust.setup, robust.moves, robust.requirements,
-            robust.cell, robust.tray) == (pth0.id, pth0.seed, pth0.setup, pth0.moves,
-                                          pth0.requirements, pth0.cell, pth0.tray)
+    assert own == list(part.experiments)
+    assert (robust.id, robust.seed, robust.part, robust.gripper, robust.setup, robust.moves,
+            robust.requirements, robust.cell, robust.tray) == (
+        part.id, part.seed, part.part, part.gripper, part.setup, part.moves,
+        part.requirements, part.cell, part.tray)
     sensitivity = robust.experiments[-1]
     assert sensitivity.type == 'sensitivity' and all(x.source for x in sensitivity.inputs)
 

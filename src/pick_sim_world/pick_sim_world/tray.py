@@ -42,6 +42,19 @@ def vibration_amplitude(vibration: Vibration, rng: np.random.Generator,
     return np.array([x, y, z])
 
 
+def centring_share(to_centre: np.ndarray | None, half_extents: tuple[float, float]) -> float:
+    """The share of a CENTRE vibration's duration a tray runs: the parts' centroid's farthest
+    coordinate from the tray's centre, normalised to the walls (0 at the centre, 1 at a
+    wall), as Asyril's smart centering sets its duration from the centre of mass's farthest
+    normalised coordinate and the time to cross the platform (Asycube TCP/IP commands, "EC -
+    Execute centering" and "Duration of vibration for smart centering"). So the move's duration
+    is the centring from a wall. 0 with no part (`to_centre` None)."""
+    if to_centre is None:
+        return 0.0
+    return float(min(1.0, max(abs(to_centre[0]) / half_extents[0],
+                              abs(to_centre[1]) / half_extents[1])))
+
+
 def vibration_substeps(frequency: float, time_step: float) -> int:
     """How many sub-steps each physics step is cut into while vibrating at `frequency` (Hz), so
     that one period has at least MIN_STEPS_PER_CYCLE steps (1 when it already has)."""
@@ -69,24 +82,30 @@ class TrayDrive:
         self._lift = [0.0, 0.0, mass * GRAVITY]
         self._amplitudes = np.zeros((len(self._bodies), 3))
         self._moving: list[int] = []
+        self._until = np.zeros(len(self._bodies), dtype=np.int64)
         self._omega = self._dt = 0.0
         self._step = 0
         self._positions: list[np.ndarray] = []
         self._velocities: list[np.ndarray] = []
 
     def start(self, trays: Sequence[int], amplitudes: np.ndarray, frequency: float,
-              time_step: float) -> None:
+              time_step: float, steps: Sequence[int] | None = None) -> None:
         """Move trays (indices) along amplitude[k] * sin(2 pi frequency t), t from 0 at the next
-        step of `time_step` s; the others stay at their origins."""
+        step of `time_step` s, each for its `steps` (all of the vibration when None: each
+        moves until stop()); the others, and a tray past its steps, stay at their origins."""
         self._amplitudes[:] = 0.0
         self._amplitudes[list(trays)] = amplitudes
         self._moving = list(trays)
+        self._until = np.full(len(self._bodies), np.iinfo(np.int64).max)
+        if steps is not None:
+            self._until[list(trays)] = steps
         self._omega, self._dt = 2.0 * math.pi * frequency, time_step
         self._step = 0
         self._positions, self._velocities = [], []
 
     def _command(self, step: int) -> np.ndarray:
-        return self._amplitudes * math.sin(self._omega * step * self._dt)
+        on = (step < self._until)[:, None]
+        return self._amplitudes * on * math.sin(self._omega * step * self._dt)
 
     def _measure(self) -> None:
         positions, velocities = [], []
@@ -117,8 +136,8 @@ class TrayDrive:
                                   physicsClientId=self._client)
 
     def motion(self) -> TrayMotion | None:
-        """The motion delivered so far, of the tray that tracked its command worst; None before
-        three steps of a vibration."""
+        """The motion delivered so far, of the tray that tracked its command worst (over its own
+        steps); None before three steps of a vibration, or when no tray moved for three."""
         if len(self._positions) < 3:
             return None
         n = len(self._positions)
@@ -127,11 +146,15 @@ class TrayDrive:
         positions, velocities = np.array(self._positions), np.array(self._velocities)
         worst = None
         for i, k in enumerate(self._moving):
+            own = min(n, int(self._until[k]))      # the states of its own motion
+            if own < 3:
+                continue
             commanded = float(np.linalg.norm(self._amplitudes[k]))
             shown = TrayMotion(
-                commanded, float(np.linalg.norm(fundamental(times, positions[:, i], self._omega))),
+                commanded,
+                float(np.linalg.norm(fundamental(times[:own], positions[:own, i], self._omega))),
                 commanded * self._omega,
-                float(np.linalg.norm(fundamental(mid, velocities[:, i], self._omega))))
+                float(np.linalg.norm(fundamental(mid[:own], velocities[:own, i], self._omega))))
             if worst is None or shown.error > worst.error:
                 worst = shown
         return worst

@@ -46,7 +46,7 @@ from .camera import Overlay
 from .config import check_physics, PhysicsConfig
 from .freezing import Freezer
 from .stepping import ProgressCallback
-from .tray import TrayDrive, vibration_amplitude, vibration_substeps
+from .tray import centring_share, TrayDrive, vibration_amplitude, vibration_substeps
 
 
 @dataclass
@@ -288,7 +288,9 @@ class World:
 
         With direction RANDOM, each tray's horizontal amplitude is first turned about the
         vertical by an angle drawn from its instance's generator (so a seed gives the same
-        motions); with CENTRE, laid toward the tray's centre from its parts' centroid. Raises
+        motions); with CENTRE, laid toward the tray's centre from its parts' centroid, for the
+        share of the duration that centroid's farthest normalised coordinate gives
+        (tray.centring_share; a tray whose parts are centred does not move). Raises
         InvalidArgument for a bad vibration or an instance whose container is a bin.
         """
         targets = self._instance_ids(instances)
@@ -297,15 +299,23 @@ class World:
             raise InvalidArgument('instances', targets[0], f'is a {self._scene.container.kind}'
                                   ': only trays vibrate')
         centring = vibration.direction == CENTRE
-        amplitudes = np.array([vibration_amplitude(vibration, self._instances[k].rng,
-                                                   self._to_centre(k) if centring else None)
-                               for k in targets])
+        to_centre = [self._to_centre(k) if centring else None for k in targets]
+        amplitudes = np.array([vibration_amplitude(vibration, self._instances[k].rng, c)
+                               for k, c in zip(targets, to_centre, strict=True)])
         # A period gets at least MIN_STEPS_PER_CYCLE steps: finer steps while vibrating when
         # the physics step is too coarse for the frequency.
         dt = self._physics.time_step / vibration_substeps(vibration.frequency,
                                                           self._physics.time_step)
         steps = max(1, int(round(vibration.duration / dt)))
-        self._drive.start(targets, amplitudes, vibration.frequency, dt)
+        own = None
+        if centring:    # each tray for its share of the duration, in whole periods
+            half = (self._scene.container.inner_size[0] / 2,
+                    self._scene.container.inner_size[1] / 2)
+            periods = [round(vibration.duration * vibration.frequency * centring_share(c, half))
+                       for c in to_centre]
+            own = [int(round(n / (vibration.frequency * dt))) for n in periods]
+            steps = max(1, *own)
+        self._drive.start(targets, amplitudes, vibration.frequency, dt, own)
         drive = self._drive
         self._tray_speed = float(np.linalg.norm(amplitudes, axis=1).max()
                                  * 2.0 * math.pi * vibration.frequency)

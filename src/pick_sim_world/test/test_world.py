@@ -14,7 +14,7 @@ from pick_common.states import quaternion_angles, rotate
 from pick_sim_world import spawning
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.stepping import speed_limit
-from pick_sim_world.tray import vibration_amplitude
+from pick_sim_world.tray import centring_share, vibration_amplitude
 from pick_sim_world.world import World
 import pybullet as pb
 import pytest
@@ -299,27 +299,42 @@ def test_a_centring_vibration_points_its_stroke_from_the_parts_to_the_tray_centr
     assert vibration_amplitude(move, rng, np.zeros(2)).tolist() == [0.0, 0.0, 0.003]
 
 
+def test_a_centring_lasts_the_share_of_its_duration_the_offset_gives():
+    # Asyril's smart centering: the farthest normalised coordinate of the parts' centre of
+    # mass (0 at the centre, 1 at a wall) sets the duration
+    half = (0.0975, 0.075)
+    assert centring_share(None, half) == 0.0
+    assert centring_share(np.zeros(2), half) == 0.0
+    assert centring_share(np.array([-0.0975 / 2, 0.0]), half) == pytest.approx(0.5)
+    assert centring_share(np.array([0.01, 0.06]), half) == pytest.approx(0.8)   # y's, farther
+    assert centring_share(np.array([0.5, 0.0]), half) == 1.0                   # at most all
+
+
 def test_centring_carries_parts_off_centre_toward_the_middle_where_a_flip_does_not():
     """Three capacitors lying 50 mm toward the tray's +x wall, far from it and each other: one
-    `centre` move conveys them toward the middle (at the full 1.4 mm stroke, 90-odd mm: past
-    it, as `backward` would); `flip`, vertical only, hardly moves them (a pile by a wall would
-    spread away from it under either, so lone parts)."""
-    def centroid_after(move: Vibration) -> tuple[float, float]:
-        with _world(ContainerSpec.tray(), seed=3) as world:
-            ids, _ = world.drop(3, zone='feeder')
+    `centre` move conveys them toward the middle, for the share of its 0.5 s their offset gives
+    (0.05 / 0.0975: 7 of 13 periods; at the full 1.4 mm stroke for 0.5 s a lone capacitor goes
+    90-odd mm); `flip`, vertical only, hardly moves them (a pile by a wall would spread away
+    from it under either, so lone parts). With one tray of two centred, only the other moves."""
+    def centroid_after(move: Vibration, instances: int = 1) -> tuple[float, float, object]:
+        with _world(ContainerSpec.tray(), seed=3, instances=instances) as world:
+            ids, _ = world.drop(3, instances=[0], zone='feeder')
             for pid, y in zip(ids, (-0.03, 0.0, 0.03), strict=True):
-                pb.resetBasePositionAndOrientation(world._bodies[pid], [0.05, y, 0.004],
-                                                   [0.0, 0.7071068, 0.0, 0.7071068],
-                                                   physicsClientId=world._client)
+                pb.resetBasePositionAndOrientation(
+                    world._bodies[pid], np.add(world.instances[0].origin, [0.05, y, 0.004]),
+                    [0.0, 0.7071068, 0.0, 0.7071068], physicsClientId=world._client)
             world.settle()
-            before = world.snapshot().poses[:, 0].mean()
-            world.vibrate(move)
-            return before, world.snapshot().poses[:, 0].mean()
-    before, centred = centroid_after(MOVES['centre'])
-    _, flipped = centroid_after(MOVES['flip'])
+            before = world.snapshot([0]).poses[:, 0].mean()
+            report = world.vibrate(move)
+            return before, world.snapshot([0]).poses[:, 0].mean(), (report, world._drive._until)
+    before, centred, (report, until) = centroid_after(MOVES['centre'], instances=2)
+    _, flipped, _ = centroid_after(MOVES['flip'])
     assert before == pytest.approx(0.05, abs=0.005)
     assert centred < before - 0.01 and abs(flipped - before) < abs(centred - before) / 3, \
         (before, centred, flipped)
+    periods = round(0.5 * 26 * before / 0.0975)           # 7 of 13 at 50 mm
+    assert until.tolist() == [round(periods / 26 * 480), 0]     # the empty tray: no share
+    assert report.tray.error < 0.05 and report.tray.amplitude == pytest.approx(0.0014 * 2**0.5)
 
 
 def test_random_vibrations_repeat_with_the_seed():
