@@ -52,8 +52,10 @@ class Vibration:
     lays its horizontal length along the line from the parts' centroid on the tray to the
     tray's centre, as a flexible feeder's centring vibration does (the Asycube's takes the
     parts' centre of mass from the camera: programming guide, table 5-3), so that the parts
-    gather away from the walls; with no part, or the centroid at the centre, no horizontal
-    part.
+    gather away from the walls, and for the share of `duration` the centroid's farthest
+    normalised coordinate gives (0 at the centre, 1 at a wall: the Asycube's smart centering
+    sets its duration so; world.vibrate), so `duration` is the centring from a wall; with no
+    part, or the centroid at the centre, the tray does not move.
     The default is a flip at the vertical speed of a real feeder's: 1.4 mm at 26 Hz is a peak
     vertical speed of 0.23 m/s (3.8 g), the SHOP4CF shakeit feeder's flip (26 Hz, at most
     0.23 m/s); with an equal horizontal stroke in phase, in a random direction, it throws the
