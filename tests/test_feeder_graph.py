@@ -57,17 +57,19 @@ class Feeder:
 
 def test_a_run_feeds_vibrates_picks_and_stops_at_the_limit(client, nodes):
     feeder = Feeder(client, nodes)
-    # One cycle of two moves: a flip of the given stroke, then the world's default vibration.
-    flip = Vibration(amplitude=Vector3(z=0.001), direction=Vibration.DIRECTION_FIXED)
+    # One cycle of two moves: a throw of the given stroke, then the world's default vibration
+    # (a 1.4 mm flip).
+    throw = Vibration(amplitude=Vector3(x=0.001, z=0.001), direction=Vibration.DIRECTION_RANDOM)
     first = feeder.cycle(restart=True, feeder_parts=30, min_count=5, max_count=10,
                          max_vibrations=3, valid_parts=0, parts_on_table=0,
-                         moves=[flip, Vibration()])
+                         moves=[throw, Vibration()])
     assert first.error_code == OK, first.error_msg
     assert first.decision == FeedCycle.Result.DECISION_FEED_AND_VIBRATE and first.parts_fed == 10
-    drop, flipped, default = first.reports      # the world's reports of the cycle, in order
-    assert drop.tray.amplitude == 0 and flipped.tray.amplitude == pytest.approx(0.001)
-    assert default.tray.amplitude == pytest.approx(math.hypot(0.0014, 0.0014))
-    for r in (flipped, default):
+    drop, thrown, default = first.reports       # the world's reports of the cycle, in order
+    assert drop.tray.amplitude == 0 and thrown.tray.amplitude == pytest.approx(math.hypot(
+        0.001, 0.001))
+    assert default.tray.amplitude == pytest.approx(0.0014)
+    for r in (thrown, default):
         assert abs(r.tray.delivered_amplitude / r.tray.amplitude - 1) < 0.05
     on_table = feeder.parts()
     assert len(on_table) == 10, 'the world has the fed parts'

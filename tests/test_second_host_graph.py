@@ -34,7 +34,7 @@ pytestmark = pytest.mark.graph
 FILE = """id: two_hosts
 seed: 13
 gripper: {body_diameter_mm: 8, jaw_depth_mm: 3}
-moves: [{direction: fixed}]
+moves: [forward]          # what {direction: fixed} over spread was until 2026-11-27
 experiments:
   - {id: bins, type: bin_static, iterations: 2, parts: 20, bins_mm: [[100, 100, 20]]}
   - {id: emptying, type: bin_emptying, iterations: 2, parts: 15, bin: [100, 100, 20]}

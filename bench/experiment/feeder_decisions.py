@@ -5,7 +5,8 @@ Two steps:
 writes DIR/feeder_pth0.yaml, feeder_pth1.yaml, feeder_pth2.yaml: the test case's parts,
 grippers and requirements (config/test_case/pth*.yaml) with one experiment, 50 feeder runs at
 the optimal range of the full-count sweeps (n* 72, 45 and 54, +-5: docs/paper-test-case.md),
-to be run through the graph:
+to be run through the graph (`files DIR --moves centre,flip` writes feeder_pth0_centre_flip.yaml
+and so on: the same runs with another feeder cycle, for compare_runs.py):
   tools/ws install/experiment_manager/lib/experiment_manager/run --output DIR/runs DIR/*.yaml
 and then
   tools/ws python -m bench.experiment.feeder_decisions table RUN_DIR... [--draws 2000]
@@ -50,7 +51,10 @@ RUNS = 50
 SIZES = (3, 5, 8, 12)
 
 
-def write_files(directory: str) -> list[str]:
+def write_files(directory: str, moves: list[str] | None = None) -> list[str]:
+    """The files (see the module's doc); with `moves`, that feeder cycle in place of the test
+    case's, and the cycle's names in each file's id and name (the same seeds: a seed comes from
+    the file's seed, the experiment's id and the iteration's key)."""
     os.makedirs(directory, exist_ok=True)
     paths = []
     for part, n_star in N_STAR.items():
@@ -59,8 +63,11 @@ def write_files(directory: str) -> list[str]:
         feeder = next(e for e in data['experiments'] if e['type'] == 'feeder_emptying')
         feeder.update(iterations=RUNS, optimal_range=[n_star - MARGIN, n_star + MARGIN])
         data['experiments'] = [feeder]
-        data['id'] = f'feeder_{part}'
-        path = os.path.join(directory, f'feeder_{part}.yaml')
+        name = f'feeder_{part}' + ''.join(f'_{m}' for m in moves or ())
+        data['id'] = name
+        if moves:
+            data['moves'] = list(moves)
+        path = os.path.join(directory, f'{name}.yaml')
         with open(path, 'w', encoding='utf-8') as f:
             f.write(f'# {RUNS} feeder runs of {part} at n* {n_star} +- {MARGIN} '
                     '(bench/experiment/feeder_decisions.py)\n')
@@ -167,6 +174,8 @@ def main(argv: list[str] | None = None) -> int:
     sub = parser.add_subparsers(dest='command', required=True)
     files = sub.add_parser('files')
     files.add_argument('directory')
+    files.add_argument('--moves', help="a feeder cycle in place of the test case's, names "
+                       'separated by commas (centre,flip)')
     tab = sub.add_parser('table')
     tab.add_argument('run_dirs', nargs='+')
     tab.add_argument('--draws', type=int, default=2000)
@@ -178,7 +187,8 @@ def main(argv: list[str] | None = None) -> int:
     model.add_argument('--seed', type=int, default=44)
     args = parser.parse_args(argv)
     if args.command == 'files':
-        print('\n'.join(write_files(args.directory)))
+        print('\n'.join(write_files(args.directory,
+                                     args.moves.split(',') if args.moves else None)))
     elif args.command == 'noise':
         noise(args.run_dirs, args.populations, args.draws, args.seed)
     else:

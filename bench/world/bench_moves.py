@@ -7,7 +7,8 @@ test_centring_carries_parts_off_centre_toward_the_middle_where_a_flip_does_not.
         [--offset-mm 50]
 
 Prints per move: the parts' centroid (x, y, mm) before and after, how far it moved toward the
-tray's centre along x (mm; negative: away), and the simulated time of the vibration and settle.
+tray's centre along x (mm; negative: away), the simulated time of the vibration and settle,
+and the tray's tracking error (delivered against commanded amplitude).
 """
 
 import argparse
@@ -23,8 +24,9 @@ import pybullet as pb
 LYING = (0.0, 0.7071068, 0.0, 0.7071068)     # the capacitor's axis along x
 
 
-def carry(move: str, offset: float) -> tuple[np.ndarray, np.ndarray, float]:
-    """(centroid before, after, simulated s of the move and its settle), x y in m."""
+def carry(move: str, offset: float) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """(centroid before, after, simulated s of the move and its settle, the tray's tracking
+    error), x y in m."""
     scene = SceneSpec(ContainerSpec.tray(), PartSpec(model='radial_capacitor'), 1, 3)
     with World(scene, PhysicsConfig()) as world:
         ids, _ = world.drop(3, zone='feeder')
@@ -34,7 +36,8 @@ def carry(move: str, offset: float) -> tuple[np.ndarray, np.ndarray, float]:
         world.settle()
         before = world.snapshot().poses[:, :2].mean(axis=0)
         report = world.vibrate(MOVES[move])
-        return before, world.snapshot().poses[:, :2].mean(axis=0), report.sim_time
+        error = report.tray.error if report.tray else float('nan')
+        return before, world.snapshot().poses[:, :2].mean(axis=0), report.sim_time, error
 
 
 def main() -> None:
@@ -43,12 +46,12 @@ def main() -> None:
     ap.add_argument('--offset-mm', type=float, default=50.0)
     args = ap.parse_args()
     print(f'{"move":<10} {"before x, y mm":>16} {"after x, y mm":>16} {"toward centre mm":>17} '
-          f'{"sim s":>6}')
+          f'{"sim s":>6} {"tray error":>10}')
     for move in args.moves.split(','):
-        before, after, sim = carry(move, args.offset_mm / 1000.0)
+        before, after, sim, error = carry(move, args.offset_mm / 1000.0)
         print(f'{move:<10} {before[0] * 1e3:8.1f} {before[1] * 1e3:7.1f} '
               f'{after[0] * 1e3:8.1f} {after[1] * 1e3:7.1f} '
-              f'{(abs(before[0]) - abs(after[0])) * 1e3:17.1f} {sim:6.2f}')
+              f'{(abs(before[0]) - abs(after[0])) * 1e3:17.1f} {sim:6.2f} {100 * error:9.1f}%')
 
 
 if __name__ == '__main__':

@@ -22,7 +22,7 @@ import time
 from experiment_manager.experiment_file import load
 import numpy as np
 from pick_common.containers import ContainerSpec
-from pick_common.specs import SceneSpec, Vibration
+from pick_common.specs import MOVES, SceneSpec
 from pick_common.states import rotate
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
@@ -66,7 +66,7 @@ def run(job: tuple[str, str, list[int], int, int, int]) -> list[str]:
                     line.append(f'{done}: {100 * f["head down"]:3.0f}/{100 * f["side"]:3.0f}'
                                 f'/{100 * f["leaning"]:2.0f}/{100 * f["on leads"]:2.0f}')
                 if done < moves:
-                    world.vibrate(Vibration())
+                    world.vibrate(MOVES['spread'])
         wall = time.perf_counter() - start
         lines.append(f'{name:8s} seed {seed}: % head down/side/leaning/on leads after moves '
                      + ', '.join(line) + f'  (wall {wall:.0f} s)')

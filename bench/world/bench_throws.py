@@ -20,7 +20,7 @@ import time
 
 from pick_common.containers import ContainerSpec
 from pick_common.parts import PartSpec
-from pick_common.specs import SceneSpec, Vibration
+from pick_common.specs import MOVES, SceneSpec
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
 
@@ -45,7 +45,7 @@ def run(job: tuple[str, list[int], int, int]) -> list[str]:
         with World(SceneSpec(ContainerSpec.tray(), PartSpec(model='to220'), 1, seed),
                    physics) as world:
             world.drop(parts, zone='feeder')
-            reports = [world.vibrate(Vibration(), max_settle_time=0.25) for _ in range(moves)]
+            reports = [world.vibrate(MOVES['spread'], max_settle_time=0.25) for _ in range(moves)]
             off = int((~world.snapshot().inside).sum())
         wall = time.perf_counter() - start
         thrown = {i for r in reports for i in r.thrown_ids}

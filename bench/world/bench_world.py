@@ -23,7 +23,7 @@ import time
 import numpy as np
 from pick_common.containers import ContainerSpec
 from pick_common.rclpy_adapter import LockedActionClient
-from pick_common.specs import SceneSpec, Vibration
+from pick_common.specs import MOVES, SceneSpec
 from pick_msgs.action import DropParts
 from pick_msgs.srv import ResetScene
 from pick_sim_world.config import PhysicsConfig
@@ -44,7 +44,7 @@ def drop(container: ContainerSpec, count: int, seed: int, physics: PhysicsConfig
                    settled=report.settled, escaped=len(report.escaped_ids))
         if vibrate:
             start = time.perf_counter()
-            vib = world.vibrate(Vibration())
+            vib = world.vibrate(MOVES['spread'])
             out.update(vib_wall=time.perf_counter() - start, vib_sim=vib.sim_time,
                        vib_escaped=len(vib.escaped_ids), vib_settled=vib.settled)
     return out

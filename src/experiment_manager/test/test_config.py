@@ -29,7 +29,7 @@ def test_the_default_file_parses_into_si_units():
     assert f.gripper.body_diameter == pytest.approx(0.020)
     assert f.check.tolerance == pytest.approx(math.radians(45))
     assert f.tray.inner_size == pytest.approx((0.195, 0.150, 0.027))
-    assert f.moves == (MOVES['spread'],) and f.requirements.max_spilled == 0
+    assert f.moves == (MOVES['centre'], MOVES['flip']) and f.requirements.max_spilled == 0
     assert f.requirements.success_rate == 0.9
     assert f.requirements.refill_interval == 4 * 3600 and f.requirements.capacity == 60
     emptying = f.experiment('emptying')
@@ -200,18 +200,20 @@ def test_a_reduced_copy_caps_iterations_and_keeps_the_rest(tmp_path):
 
 def test_feeder_moves_are_named_or_set_field_by_field():
     text = open(DEFAULT).read()
-    f = experiment_file.parse(text.replace('moves: [spread]', 'moves: [flip, {move: backward, '
-                                  'duration_s: 0.2}, {amplitude_mm: [0, 1, 2]}]'))
-    flip, back, own = f.moves
-    assert flip == MOVES['flip'] and back.duration == 0.2
+    assert 'moves: [centre, flip]' in text
+    f = experiment_file.parse(text.replace('moves: [centre, flip]', 'moves: [spread, {move: '
+                                  'backward, duration_s: 0.2}, {amplitude_mm: [0, 1, 2]}]'))
+    spread, back, own = f.moves
+    assert spread == MOVES['spread'] and spread.direction == 'random' and back.duration == 0.2
     assert back.amplitude == MOVES['backward'].amplitude and back.direction == 'fixed'
-    assert own.amplitude == pytest.approx((0.0, 0.001, 0.002)) and own.direction == 'random'
-    for moves, error in (('[shake]', r"moves\[0\].move: 'shake' must be one of spread, flip"),
+    # fields over the default move, the flip: no random direction unless asked for
+    assert own.amplitude == pytest.approx((0.0, 0.001, 0.002)) and own.direction == 'fixed'
+    for moves, error in (('[shake]', r"moves\[0\].move: 'shake' must be one of flip, centre"),
                          ('[]', r'moves: \[\] must be a list of 1 to 16 moves'),
                          ('[{amplitude_mm: [0, 0, -1]}]',
                           r'moves\[0\] \(vibration.amplitude\[2\]\): -0.001 must be >= 0')):
         with pytest.raises(InvalidArgument, match=error):
-            experiment_file.parse(text.replace('moves: [spread]', f'moves: {moves}'))
+            experiment_file.parse(text.replace('moves: [centre, flip]', f'moves: {moves}'))
 
 
 def test_the_cell_s_times_default_and_are_checked():

@@ -56,31 +56,37 @@ class Vibration:
     normalised coordinate gives (0 at the centre, 1 at a wall: the Asycube's smart centering
     sets its duration so; world.vibrate), so `duration` is the centring from a wall; with no
     part, or the centroid at the centre, the tray does not move.
-    The default is a flip at the vertical speed of a real feeder's: 1.4 mm at 26 Hz is a peak
-    vertical speed of 0.23 m/s (3.8 g), the SHOP4CF shakeit feeder's flip (26 Hz, at most
-    0.23 m/s); with an equal horizontal stroke in phase, in a random direction, it throws the
-    pile along a 45 degree line as a linear vibratory conveyor does (world README, "Vibration").
+    The default is a flip (vertical only) at the vertical speed of a real feeder's: 1.4 mm at
+    26 Hz is a peak vertical speed of 0.23 m/s (3.8 g), the SHOP4CF shakeit feeder's flip
+    (26 Hz, at most 0.23 m/s). Until 2026-11-27 it had an equal horizontal stroke in phase, in
+    a random direction (now the named move `spread`), which throws the pile along a 45 degree
+    line as a linear vibratory conveyor does (world README, "Vibration").
     """
 
-    amplitude: tuple[float, float, float] = (0.0014, 0.0, 0.0014)
+    amplitude: tuple[float, float, float] = (0.0, 0.0, 0.0014)
     frequency: float = 26.0
     duration: float = 0.5
-    direction: str = RANDOM
+    direction: str = FIXED
 
 
 # The feeder moves a cell can sequence, modelled on a flexible feeder's vibration types (the
 # Asycube's forward A, backward F, left D, right E, flip I and centering; world README,
-# "Feeder moves"): each at the default's stroke and frequency. 'spread' is the default Vibration.
+# "Feeder moves"): each at the default's stroke and frequency. 'flip' is the default Vibration.
 _STROKE, _HZ, _S = 0.0014, 26.0, 0.5
 MOVES = {
-    'spread': Vibration(),                                          # a throw, random direction
-    'flip': Vibration((0.0, 0.0, _STROKE), _HZ, _S, FIXED),         # vertical: turns parts over
+    'flip': Vibration(),                                            # vertical: turns parts over
+    'centre': Vibration((_STROKE, 0.0, _STROKE), _HZ, _S, CENTRE),  # toward the tray's centre
     'forward': Vibration((_STROKE, 0.0, _STROKE), _HZ, _S, FIXED),  # conveys toward +x
     'backward': Vibration((-_STROKE, 0.0, _STROKE), _HZ, _S, FIXED),
     'left': Vibration((0.0, _STROKE, _STROKE), _HZ, _S, FIXED),     # toward +y
     'right': Vibration((0.0, -_STROKE, _STROKE), _HZ, _S, FIXED),
-    'centre': Vibration((_STROKE, 0.0, _STROKE), _HZ, _S, CENTRE),  # toward the tray's centre
-}
+    'spread': Vibration((_STROKE, 0.0, _STROKE), _HZ, _S, RANDOM),  # a throw, random direction:
+}                                                                   # no feeder documents it
+# The default vibration cycle of a feeder: the Asycube's typical vibration sequence after a
+# feed, "a centering action" then "flip: flip and spread the parts" (Asyril, EYE+ Studio
+# recipe wizard, "Vibration Sequence"); the wait after it is the world's settle. Until
+# 2026-11-27 the cycle was `spread` alone (docs/physics.md, "Feeder moves").
+DEFAULT_CYCLE = ('centre', 'flip')
 
 
 def check_scene(scene: SceneSpec) -> SceneSpec:

@@ -146,7 +146,9 @@ class TrayDrive:
         positions, velocities = np.array(self._positions), np.array(self._velocities)
         worst = None
         for i, k in enumerate(self._moving):
-            own = min(n, int(self._until[k]))      # the states of its own motion
+            # the states of its own motion: a tray that stops early is brought to its origin
+            # over its last step, whose state is not on the sinusoid
+            own = min(n, int(self._until[k]) - 1)
             if own < 3:
                 continue
             commanded = float(np.linalg.norm(self._amplitudes[k]))

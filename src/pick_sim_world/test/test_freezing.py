@@ -9,7 +9,7 @@ import numpy as np
 from pick_common.containers import ContainerSpec
 from pick_common.errors import InvalidArgument
 from pick_common.parts import PartSpec
-from pick_common.specs import SceneSpec, Vibration
+from pick_common.specs import MOVES, SceneSpec
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
 import pybullet as pb
@@ -77,7 +77,7 @@ def test_the_tray_is_dynamic_again_after_a_settle_and_vibrates_as_commanded():
         world.drop(30)
         tray = world.instances[0].body
         for _ in range(2):
-            report = world.vibrate(Vibration())
+            report = world.vibrate(MOVES['spread'])
             assert pb.getDynamicsInfo(tray, -1, physicsClientId=world._client)[0] > 0
             assert report.tray.error < 0.05
         assert _masses(world) == {world.part.mass}
@@ -86,7 +86,7 @@ def test_the_tray_is_dynamic_again_after_a_settle_and_vibrates_as_commanded():
 def test_an_empty_tray_settles_and_vibrates():
     with World(SceneSpec(ContainerSpec.tray(), PartSpec(), 1, 1), PhysicsConfig()) as world:
         assert world.settle().settled
-        assert world.vibrate(Vibration()).settled
+        assert world.vibrate(MOVES['spread']).settled
 
 
 def test_settle_freeze_must_be_a_boolean():

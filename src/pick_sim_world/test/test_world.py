@@ -172,7 +172,7 @@ def test_the_solver_throws_no_part_off_a_vibrating_tray():
     with _world(ContainerSpec.tray(), 'to220', seed=10, warm_starting_factor=WARM_START,
                 time_step=TIME_STEP) as world:
         world.drop(50, zone='feeder')
-        reports = [world.vibrate(Vibration(), max_settle_time=0.25) for _ in range(40)]
+        reports = [world.vibrate(MOVES['spread'], max_settle_time=0.25) for _ in range(40)]
         limit = speed_limit(world.scene.container, world.part, reports[0].tray.peak_velocity)
     fastest = max(r.max_speed for r in reports)
     assert [r.thrown_ids for r in reports if r.thrown_ids] == [], \
@@ -343,7 +343,7 @@ def test_random_vibrations_repeat_with_the_seed():
         with _world(ContainerSpec.tray(), seed=seed) as world:
             world.drop(30, zone='feeder')
             for _ in range(3):
-                world.vibrate(Vibration())
+                world.vibrate(MOVES['spread'])
             runs.append(world.snapshot().poses)
     assert np.array_equal(runs[0], runs[1])
     assert not np.allclose(runs[0], runs[2])
@@ -369,13 +369,13 @@ def test_a_standing_part_stays_up_below_1_g_and_tips_under_the_default_move():
     # shakes; every finer setting tips it at the first: world README, "Piles that rest".)
     gentle = Vibration((0.0, 0.0, 0.0003), direction=FIXED)
     assert [_tipped(gentle, seed) for seed in range(3)] == [False] * 3
-    assert [_tipped(Vibration(), seed, shakes=2) for seed in range(3)] == [True] * 3
+    assert [_tipped(MOVES['spread'], seed, shakes=2) for seed in range(3)] == [True] * 3
 
 
 def test_vibrating_a_bin_is_refused():
     with _world() as world:
         with pytest.raises(InvalidArgument, match='only trays vibrate'):
-            world.vibrate(Vibration())
+            world.vibrate(MOVES['spread'])
 
 
 def test_feed_drops_into_the_feeder_zone_on_top_of_the_parts_there():

@@ -13,7 +13,14 @@ from typing import Annotated, Any
 
 from pick_common.containers import TRAY_DEFAULT_SIZE
 from pick_common.parts import BUILTIN_MODELS, PartSpec, UNITS
-from pick_common.specs import DIRECTIONS, MAX_MOVES, MAX_PARTS_PER_INSTANCE, MAX_SEED, MOVES
+from pick_common.specs import (
+    DEFAULT_CYCLE,
+    DIRECTIONS,
+    MAX_MOVES,
+    MAX_PARTS_PER_INSTANCE,
+    MAX_SEED,
+    MOVES,
+)
 from pick_validity.config import CheckConfig, Gripper
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator, WrapValidator
 
@@ -148,7 +155,7 @@ def _named_move(value: Any) -> Any:
 class Move(Section):
     """One feeder move: a named move of pick_common.specs.MOVES, fields set over it."""
 
-    move: Text(*MOVES) = 'spread'
+    move: Text(*MOVES) = 'flip'
     amplitude_mm: Vector(3) | None = None
     frequency_hz: Number() | None = None
     duration_s: Number() | None = None
@@ -171,7 +178,8 @@ class FileKeys(Section):
     cell: Any = None
     tray_mm: PositiveSize = tuple(s / MM for s in TRAY_DEFAULT_SIZE)
     moves: Annotated[list[Annotated[Move, BeforeValidator(_named_move)]], BeforeValidator(
-        partial(list_of, low=1, high=MAX_MOVES, what=f'1 to {MAX_MOVES} moves'))] = ['spread']
+        partial(list_of, low=1, high=MAX_MOVES, what=f'1 to {MAX_MOVES} moves'))] = list(
+            DEFAULT_CYCLE)
     bin_wall_mm: Number(0.5, 100.0) = 3.0
     experiments: Annotated[list[Any], BeforeValidator(partial(
         list_of, low=1, high=MAX_EXPERIMENTS, what=f'1..{MAX_EXPERIMENTS} experiments'))]
