@@ -326,6 +326,8 @@ def test_run_check_says_what_the_scenarios_add(tmp_path, capsys):
         'iterations\n' in out
     assert '    part_lateral_friction_low: part.lateral_friction 0.3\n' in out
     assert out.count('    joint_') == 2
+    assert 'feeder cycle, one vibration: forward (1.4, 0, 1.4 mm at 26 Hz for 0.5 s, as ' \
+        'given)\n' in out
     assert run_main(['--check', '--adaptive', SENSITIVITY, '--output', str(tmp_path)]) == 0
     assert 'plan: 2 experiment(s), at most 9 iterations (sampling adaptive' \
         in capsys.readouterr().out

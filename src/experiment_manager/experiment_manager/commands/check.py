@@ -1,16 +1,18 @@
 """`run --check FILE...`: read each experiment file as a run would, without starting the graph,
 print what the run will use of its part and grasps and what it will run (each experiment's
-iterations, a sensitivity's scenarios and the repeats they add), and draw the part sheet
+iterations, a sensitivity's scenarios and the repeats they add, the feeder's cycle of moves
+when a feeder runs), and draw the part sheet
 (analysis/part_sheet.py) beside it, so that a wrong file is seen before it runs."""
 
 import os
 import sys
 
 from pick_common.errors import InvalidArgument
+from pick_common.specs import CENTRE, FIXED, MOVES, RANDOM, Vibration
 
 from .. import experiment_file
 from ..analysis import part_sheet
-from ..experiment_file.model import ExperimentFile, SENSITIVITY
+from ..experiment_file.model import ExperimentFile, FEEDER_EMPTYING, SENSITIVITY
 from ..experiment_file.plan import count_iterations, experiment_iterations
 
 
@@ -65,4 +67,22 @@ def describe_plan(file: ExperimentFile) -> list[str]:
         for s in exp.scenarios:
             values = ', '.join(f'{name} {value:g}' for name, value in s.values)
             lines.append(f'    {s.name}: {values}')
+    if any(e.type == FEEDER_EMPTYING for e in own):
+        lines.append('feeder cycle, one vibration: ' + ', '.join(describe_move(m)
+                                                                for m in file.moves))
     return lines
+
+
+DIRECTION_WORDS = {FIXED: 'as given', RANDOM: 'turned to a random direction',
+                   CENTRE: "toward the tray's centre"}
+
+
+def describe_move(move: Vibration) -> str:
+    """A move by its name in MOVES when it is one, and its stroke, frequency, duration and
+    direction: 'flip (0, 0, 1.4 mm at 26 Hz for 0.5 s, as given)'."""
+    name = next((n for n, m in MOVES.items() if m == move), 'own move')
+    stroke = ', '.join(f'{a * 1000:g}' for a in move.amplitude)
+    span = (f"up to {move.duration:g} s by the parts' offset" if move.direction == CENTRE
+            else f'{move.duration:g} s')
+    return (f'{name} ({stroke} mm at {move.frequency:g} Hz for {span}, '
+            f'{DIRECTION_WORDS[move.direction]})')
