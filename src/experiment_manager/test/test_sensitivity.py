@@ -177,6 +177,16 @@ def test_the_report_draws_the_tornado_and_lists_the_scenarios(sens, tmp_path):
         assert f.read(8) == b'\x89PNG\r\n\x1a\n'
 
 
+def test_an_end_with_no_value_is_drawn_on_top_and_named():
+    # PTH1's jaws at 6 mm: no feeder run emptied, so no vibrations to empty; the bar cannot
+    # show it, and it is where the verdict flipped
+    bars = report.tornado_bars({'gripper.jaw_depth_mm': {'low': 79.7, 'high': None},
+                                'moves.amplitude_scale': {'low': 224.0, 'high': 81.0},
+                                'part.restitution': {'low': 79.7, 'high': 75.3}}, 79.7)
+    assert [b[0] for b in bars] == ['part.restitution', 'moves.amplitude_scale',
+                                    'gripper.jaw_depth_mm (high: no value)']
+
+
 def test_repeats_give_the_same_rows_in_any_order_on_a_backend_switched_between_scenarios(sens):
     directory, _ = sens
     file = experiment_file.load(SENSITIVITY)

@@ -423,14 +423,27 @@ def _sensitivity(exp_id: str, s: dict, plotted: bool) -> list[str]:
     return lines
 
 
+def tornado_bars(by_input: dict, base: float) -> list[tuple[str, float | None, float | None]]:
+    """One panel's bars, bottom to top: (label, low, high) per input, ordered by how far it
+    moves the answer from `base`; an input with an end that gave no value (no run emptied, say,
+    or a bound the fit check refused) last, so on top, its label saying which end: the
+    answer's bar cannot show it, and such an end is where a verdict may have flipped."""
+    def key(b: tuple) -> tuple:
+        return (any(x is None for x in b[1:]),
+                max(abs((x if x is not None else base) - base) for x in b[1:]))
+    bars = sorted(((name, v['low'], v['high']) for name, v in by_input.items()), key=key)
+    return [(name + ''.join(f' ({end}: no value)' for end, x in (('low', low), ('high', high))
+                            if x is None), low, high) for name, low, high in bars]
+
+
 def plot_tornado(exp_id: str, s: dict, path: str) -> bool:
     """Each answer of a sensitivity experiment (a panel) at each input's low and high (a bar
     from one to the other, the low end marked), the file's values' answer a line; inputs
-    ordered by how far they move it."""
+    ordered by how far they move it, an end with no value marked x at the line (tornado_bars)."""
     # an answer no input moved has no bars to draw (the scenarios' table says so)
     base_answers = s['base']['answers']
     panels = [(k, v) for k, v in s['tornado'].items() if base_answers.get(k) is not None
-              and any(x is not None and x != base_answers[k]
+              and any(x is None or x != base_answers[k]
                       for ends in v.values() for x in ends.values())]
     if not panels:
         return False
@@ -438,15 +451,15 @@ def plot_tornado(exp_id: str, s: dict, path: str) -> bool:
                              squeeze=False)
     for ax, (key, by_input) in zip(axes[:, 0], panels, strict=True):
         base = s['base']['answers'][key]
-        bars = sorted(((name, v['low'], v['high']) for name, v in by_input.items()),
-                      key=lambda b: max(abs((x if x is not None else base) - base)
-                                        for x in b[1:]))
+        bars = tornado_bars(by_input, base)
         for y, (_, low, high) in enumerate(bars):
             ends = [x if x is not None else base for x in (low, high)]
             ax.barh(y, ends[1] - ends[0], left=ends[0], height=0.5,
                     color='#1f77b4' if ends[1] >= ends[0] else '#d62728')
             if low is not None:
                 ax.plot([low], [y], 'k|', markersize=12)
+            if low is None or high is None:
+                ax.plot([base], [y], 'x', color='#c62828', markersize=9, markeredgewidth=2)
         ax.axvline(base, color='k', linewidth=1)
         seen = [base] + [x for b in bars for x in b[1:] if x is not None]
         pad = 0.06 * (max(seen) - min(seen)) or 1.0
@@ -454,7 +467,8 @@ def plot_tornado(exp_id: str, s: dict, path: str) -> bool:
         ax.set_yticks(range(len(bars)), [b[0] for b in bars], fontsize=7)
         words, unit = ANSWERS[key]
         ax.set_title(words + (f', {unit}' if unit else ''), fontsize=9)
-    fig.suptitle(f'{exp_id}: each input from low (|) to high; blue rises, red falls', fontsize=9)
+    fig.suptitle(f'{exp_id}: each input from low (|) to high; blue rises, red falls;\n'
+                 "x: an end with no value (the scenarios' table says why)", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
