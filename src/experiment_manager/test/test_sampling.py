@@ -17,6 +17,7 @@ from experiment_manager.running.scheduler import Runner
 import numpy as np
 from pick_common.errors import InvalidArgument
 import pytest
+from scipy import stats
 
 SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
 
@@ -104,6 +105,34 @@ def test_bins_leave_the_race_when_they_are_clearly_behind_the_leader():
     assert sampling.unsettled(file, exp, bin_rows(rng, [90, 50, 60, 30], 1)) == [0, 1, 2, 3]
     one = replace(exp, bins=exp.bins[:1])        # nothing to race: the one bin is the best
     assert sampling.unsettled(file, one, bin_rows(rng, [90], 1)) == []
+
+
+def test_a_bin_leaves_the_race_on_its_difference_from_the_leader():
+    """Bins 5 points of 100 apart on 6 drops of +-2: their own 99.9 % intervals still overlap
+    (the rule before 2026-11-27 raced them on), but the one-sided bound of the difference, at
+    each interval's tail, lies below 0: the second leaves and the leader is the best."""
+    file, exp = four_bins()
+    rows = bin_rows(np.random.default_rng(0), [90, 85, 60, 30], 6)
+    share = [[r['container_free'] / 100 for r in rows if r['group'] == g] for g in (0, 1)]
+    ahead, second = (metrics.interval(v, sampling.INTERIM_CONFIDENCE) for v in share)
+    assert second[1] >= ahead[0]                                # the intervals overlap
+    assert metrics.difference_bound(share[1], share[0], sampling.RACE_CONFIDENCE) < 0
+    assert sampling.race(exp, rows) == ([], [])
+
+
+def test_the_difference_bound_is_welchs_one_sided_test():
+    """Below 0 exactly when Welch's one-sided t test (scipy's) rejects at 1 - confidence, and
+    equal to the difference when neither sample varies."""
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        a, b = rng.normal(0.0, rng.uniform(0.5, 2.0), 6), rng.normal(1.0, 1.0, 9)
+        p = stats.ttest_ind(a, b, equal_var=False, alternative='less').pvalue
+        bound = metrics.difference_bound(a, b, 0.99)
+        assert (bound < 0) == (p < 0.01)
+        t = stats.ttest_ind(a, b, equal_var=False)
+        assert bound == pytest.approx(a.mean() - b.mean() + stats.t.ppf(0.99, t.df)
+                                      * (a.mean() - b.mean()) / t.statistic)
+    assert metrics.difference_bound([1.0, 1.0], [3.0, 3.0], 0.99) == -2.0
 
 
 def test_a_race_between_bins_that_tie_within_bin_tie_ends_in_the_tie(monkeypatch):
@@ -293,8 +322,8 @@ def test_a_resumed_adaptive_run_looks_only_at_the_batches_it_released(tmp_path):
 
 
 def test_an_adaptive_race_that_runs_out_names_the_bins_it_could_not_tell_apart(tmp_path):
-    """Two drops per bin cannot part two bins at 99.9 %: the race ends at the most iterations
-    with both still in it, and the summary, the terminal and the report say which."""
+    """Two drops per bin cannot part two bins at the race's 99.95 %: the race ends at the most
+    iterations with both still in it, and the summary, the terminal and the report say which."""
     text = open(SMALL).read()
     bins = next(line for line in text.splitlines() if '{id: bins' in line)
     file = experiment_file.parse(text.split('experiments:\n')[0] + f'experiments:\n{bins}\n'
@@ -313,9 +342,12 @@ def test_a_tie_is_said_with_its_bins():
     experiment = {'bins': [{'index': 0, 'size_mm': [100, 100, 20]},
                            {'index': 1, 'size_mm': [120, 80, 20]},
                            {'index': 2, 'size_mm': [75, 75, 40]}],
-                  'sampling': {'settled': True, 'tie': [1, 0], 'tie_within': 0.05}}
+                  'sampling': {'settled': True, 'tie': [1, 0], 'tie_within': 0.05,
+                               'race_confidence': sampling.RACE_CONFIDENCE}}
     assert sampling_end(experiment) == ('settled: bins 120 x 80 x 20 and 100 x 100 x 20 mm tie '
-                                        'within 5.0 % at 99.9 % (the first has the highest '
-                                        'mean)')
+                                        'within 5.0 % of the first, which has the highest mean '
+                                        '(one-sided 99.95 % bounds of the differences)')
+    del experiment['sampling']['race_confidence']       # a summary of a run before 2026-11-27
+    assert sampling_end(experiment).endswith('(99.9 % intervals)')
     del experiment['sampling']['tie']
     assert sampling_end(experiment) == 'settled'

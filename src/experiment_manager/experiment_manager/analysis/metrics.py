@@ -63,6 +63,22 @@ def interval(values, confidence: float = 0.95, counts: bool = False
     return float(a.mean() - half), float(a.mean() + half)
 
 
+def difference_bound(a, b, confidence: float) -> float:
+    """The one-sided upper confidence bound of mean(a) - mean(b) at `confidence`, Welch's (a t
+    with the Welch-Satterthwaite degrees of freedom: the two spreads need not be equal); a and
+    b each of at least two values. Two separate intervals that do not overlap are a far
+    stricter test than this one (Schenker and Gentleman, "On judging the significance of
+    differences by examining the overlap between confidence intervals", The American
+    Statistician 55(3), 2001)."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    va, vb = a.var(ddof=1) / a.size, b.var(ddof=1) / b.size
+    difference = float(a.mean() - b.mean())
+    if va + vb == 0.0:
+        return difference
+    df = (va + vb) ** 2 / (va ** 2 / (a.size - 1) + vb ** 2 / (b.size - 1))
+    return difference + float(scipy_stats.t.ppf(confidence, df) * np.sqrt(va + vb))
+
+
 def rate_interval(successes, n, confidence: float = 0.95):
     """The exact (Clopper-Pearson) two-sided confidence interval of a success rate from
     `successes` of `n` trials (ints or int arrays of one shape), as (low, high); (None, None)

@@ -17,18 +17,22 @@ def dims(values) -> str:
 
 def sampling_end(experiment: dict) -> str:
     """How an adaptive experiment's sampling ended, from its summary: 'settled' (for bins that
-    tie, with them), or 'not settled', for bins with the ones whose intervals still reached
-    the leader's."""
+    tie, with them), or 'not settled', for bins with the ones the race could not tell from the
+    leader."""
     a = experiment['sampling']
+    # a bound on a bin's difference from the leader, one-sided (running/sampling.race); a
+    # summary written before 2026-11-27 has none: its race compared 99.9 % intervals
+    bound = (f'one-sided {100 * a["race_confidence"]:g} % bounds of the differences'
+             if 'race_confidence' in a else '99.9 % intervals')
     if a['settled']:
         if not a.get('tie'):
             return 'settled'
         return (f'settled: bins {_bins(experiment, a["tie"])} mm tie within '
-                f'{pct(a["tie_within"])} at 99.9 % (the first has the highest mean)')
+                f'{pct(a["tie_within"])} of the first, which has the highest mean ({bound})')
     if not a.get('tied_bins'):
         return 'not settled'
     return f'not settled: bins {_bins(experiment, a["tied_bins"])} mm could not be told apart ' \
-        'at 99.9 %'
+        f'({bound})'
 
 
 def _bins(experiment: dict, indices: list[int]) -> str:

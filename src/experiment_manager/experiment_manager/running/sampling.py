@@ -18,14 +18,21 @@ What settles each decision, looked at after every batch:
   spills; settled when one ground is NOT FEASIBLE or every ground FEASIBLE. An iteration left
   out of the figures (a physics fault) settles bins and feeder too: the verdict is NOT
   FEASIBLE then.
-- bin_static, a race: a bin leaves it when the interval of its mean container-free fraction lies
-  wholly below the interval of the leading bin's (the highest mean). The race ends with one bin
-  left (the best bin), or with a tie: every bin left is known to lie within BIN_TIE (5 %) of
-  the leader (the leader's upper bound less its lower bound at most 5 % of the leader's lower
-  bound), so whichever of them is taken gives at least 95 % of the best bin's container-free
-  parts (the leader is named best; the summary lists the tie); or at the most iterations.
-  5 % is our choice, the same as FLAT_TOP's: PTH1's three widest bins lie within 1 % of each
-  other on 40 drops each and no race could part them.
+- bin_static, a race: a bin leaves it when it is known to lie below the leading bin (the
+  highest mean container-free fraction): the one-sided RACE_CONFIDENCE (99.95 %) upper bound of
+  its mean less the leader's, Welch's (metrics.difference_bound), is below 0. The race ends
+  with one bin left (the best bin), or with a tie: every bin left is known to lie within
+  BIN_TIE (5 %) of the leader (the same bound of the leader's mean less the bin's at most 5 %
+  of the leader's lower bound), so whichever of them is taken gives at least 95 % of the best
+  bin's container-free parts (the leader is named best; the summary lists the tie); or at the
+  most iterations. 5 % is our choice, the same as FLAT_TOP's: PTH1's three widest bins lie
+  within 1 % of each other on 40 drops each and no race could part them. Until 2026-11-27 a
+  bin left when its own 99.9 % interval lay below the leader's: two intervals that do not
+  overlap ask for a difference of about the sum of their half-widths, where the difference's
+  own bound asks for about the root of the sum of their squares, and on 5 drops a t with 4
+  degrees of freedom where Welch's has up to 8. The chance that the best bin leaves at a look
+  is at most (bins - 1) x 0.05 % (a comparison with each bin that could lead), where the two
+  intervals' was bins x 0.05 %.
 - table_sweep: the optimum n* of the fit, bootstrapped (metrics.n_star_interval: iterations
   resampled within each count, a seed of the file's): settled when the interval of n* lies
   inside the optimal range n* +- margin, so the feeder runs' range holds the optimum; or when
@@ -65,6 +72,8 @@ from ..experiment_file import (
 from ..experiment_file.plan import groups
 
 INTERIM_CONFIDENCE = 0.999
+# a bin's difference from the leader, one-sided: the tail of each INTERIM_CONFIDENCE interval
+RACE_CONFIDENCE = 1.0 - (1.0 - INTERIM_CONFIDENCE) / 2.0
 FLAT_TOP = 0.05     # a sweep's top is flat when its fit over n*'s interval is within this
 BIN_TIE = 0.05      # bins tie when each is known to lie within this share of the leader
 
@@ -110,23 +119,28 @@ def rate_settled(successes: int, n: int, required: float,
 
 
 def race(exp: Experiment, rows: list[dict]) -> tuple[list[int], list[int]]:
-    """(the bins still in the race, the bins of a tie that ended it). Racing: every bin whose
-    interval of the mean container-free fraction reaches the leader's; all of them while any
-    has fewer than two iterations; none when one is left (it is the best) or when those left
-    tie within BIN_TIE of the leader (they are then the tie, the leader first)."""
+    """(the bins still in the race, the bins of a tie that ended it). Racing: the leader (the
+    highest mean container-free fraction) and every bin not known to lie below it: the
+    one-sided RACE_CONFIDENCE bound of its mean less the leader's (metrics.difference_bound)
+    reaches 0; all of them while any has fewer than two iterations; none when one is left (it
+    is the best) or when those left tie within BIN_TIE of the leader: the same bound of the
+    leader's mean less each one's at most BIN_TIE of the leader's INTERIM_CONFIDENCE lower
+    bound (they are then the tie, the leader first)."""
     if len(groups(exp)) == 1:
         return [], []
     fractions = {g: [r['container_free'] / r['checked'] for r in rows
                      if r['group'] == g and r['checked']] for g in groups(exp)}
-    intervals = {g: metrics.interval(v, INTERIM_CONFIDENCE) for g, v in fractions.items()}
-    if any(low is None for low, _ in intervals.values()):
+    if any(len(v) < 2 for v in fractions.values()):
         return groups(exp), []
     leader = max(groups(exp), key=lambda g: (np.mean(fractions[g]), -g))
-    floor, top = intervals[leader]
-    racing = [g for g in groups(exp) if intervals[g][1] >= floor]
+    ahead = fractions[leader]
+    racing = [g for g in groups(exp) if g == leader
+              or metrics.difference_bound(fractions[g], ahead, RACE_CONFIDENCE) >= 0.0]
     if len(racing) == 1:
         return [], []
-    if all(top - intervals[g][0] <= BIN_TIE * floor for g in racing):
+    floor = metrics.interval(ahead, INTERIM_CONFIDENCE)[0]
+    if all(metrics.difference_bound(ahead, fractions[g], RACE_CONFIDENCE) <= BIN_TIE * floor
+           for g in racing if g != leader):
         return [], [leader] + [g for g in racing if g != leader]
     return racing, []
 

@@ -230,9 +230,12 @@ class Runner:
                 'batches': self._looks[exp.id], 'iterations_run': len(rows),
                 'most': experiment_iterations(exp), 'settled': not left}
             if left and exp.type == BIN_STATIC:     # the bins that could not be told apart
-                self._summary[exp.id]['sampling']['tied_bins'] = left
+                self._summary[exp.id]['sampling'].update(
+                    tied_bins=left, race_confidence=sampling.RACE_CONFIDENCE)
             elif tie:                               # bins known to tie within BIN_TIE
-                self._summary[exp.id]['sampling'].update(tie=tie, tie_within=sampling.BIN_TIE)
+                self._summary[exp.id]['sampling'].update(
+                    tie=tie, tie_within=sampling.BIN_TIE,
+                    race_confidence=sampling.RACE_CONFIDENCE)
         self.sink.write_summary(metrics.file_summary(self.file, self._ordered_summary()))
         self._release()
 
