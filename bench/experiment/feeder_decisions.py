@@ -15,7 +15,9 @@ subsamples of 3, 5, 8 and 12 runs drawn without replacement `--draws` times, how
 verdict on the subsample agrees with the full data's, how often it says FEASIBLE where the
 full data does not (false FEASIBLE), and how often it is UNDECIDED; and the same for a
 borderline refill interval (the full data's estimate of the 90 % quantile of the time to
-empty), where the verdict should say UNDECIDED more than anything else. Last, the cost of the
+empty), where the verdict should say UNDECIDED more than anything else; and the same at the
+runs' own 90 % quantile, no model's (a tenth of the runs over it: a subsample drawn from them
+that says FEASIBLE there is wrong). Last, the cost of the
 table's decision per part in worker-minutes (the runs' wall_time, as they ran): all the
 runs (fixed counts), the runs adaptive sampling took before this rule (batches of 5 until the
 share of runs emptied was settled at 99.9 %, two-sided: 73 runs when all empty, so all 50),
@@ -23,12 +25,17 @@ and the runs it takes with this rule (sampling.unsettled after each batch of 5).
 
   tools/ws python -m bench.experiment.feeder_decisions noise RUN_DIR... [--populations 60]
 asks how far the borderline's false-FEASIBLE rate would stray with a decision that is exact:
-it draws populations of as many runs as each part has from the lognormal fitted to them (the
+it draws populations of as many runs as each part has from the Gumbel fitted to them (the
 model the decision assumes, so that its 95 % holds by construction), puts each population's
 borderline where `table` puts it, and prints the spread of the same rate over the populations
 (median, 90th percentile, the share above 5 %) beside the part's own. The borderline sits on
 the quantile itself, where a one-sided 95 % bound says FEASIBLE 5 % of the time on average;
 one population of 50 scatters about that.
+
+  tools/ws python -m bench.experiment.feeder_decisions regrade RUN_DIR...
+decides the table's time ground of every feeder experiment of finished runs (a sensitivity
+run's scenarios too) again with today's rule, from their iterations.csv, and prints each with
+its bound, its fit check's p and its runs' times: for results written before a rule changed.
 """
 
 import argparse
@@ -98,10 +105,14 @@ def table(run_dirs: list[str], draws: int, seed: int) -> None:
               f'{min(r["time"] for r in runs) / 60:.1f}-{max(r["time"] for r in runs) / 60:.1f}'
               f' min; all runs: {full.verdict} ({full.reason})')
         # borderline: the interval at the full data's estimate of the 90 % quantile (its
-        # bound lies past it, its lower bound before it: UNDECIDED on all the runs)
-        fit = full.detail.get('lognormal')
-        border = fit['estimate'] if fit else float(np.quantile([r['time'] for r in runs], 0.9))
-        for label, interval in (('refill interval', refill), ('borderline', border)):
+        # bound lies past it, its lower bound before it: UNDECIDED on all the runs); and at
+        # the runs' own 90 % quantile, no model's: a tenth of them over it
+        fit = full.detail.get('gumbel')
+        ordered = sorted(r['time'] for r in runs)
+        own = ordered[len(ordered) - 1 - len(ordered) // 10]
+        border = fit['estimate'] if fit else own
+        for label, interval in (('refill interval', refill), ('borderline', border),
+                                ('borderline, a tenth of the runs over it', own)):
             truth = _decide(runs, file, interval)
             print(f'  {label} {interval / 60:.1f} min: all {len(runs)} runs say {truth}')
             print('    runs | agree | false FEASIBLE | UNDECIDED | NOT FEASIBLE')
@@ -119,9 +130,9 @@ def table(run_dirs: list[str], draws: int, seed: int) -> None:
 
 def _rate_at_border(runs: list[dict], file, draws: int, rng, size: int) -> float:
     """The share of `draws` subsamples of `size` of `runs` that say FEASIBLE at the runs'
-    borderline (the lognormal estimate of their 90 % quantile, as `table` puts it)."""
+    borderline (the Gumbel estimate of their 90 % quantile, as `table` puts it)."""
     fit = decisions.table_time(runs, file.requirements.refill_interval,
-                               file.requirements.success_rate).detail['lognormal']
+                               file.requirements.success_rate).detail['gumbel']
     said = [_decide([runs[i] for i in rng.choice(len(runs), size, replace=False)], file,
                     fit['estimate']) for _ in range(draws)]
     return float(np.mean([s == decisions.FEASIBLE for s in said]))
@@ -130,20 +141,20 @@ def _rate_at_border(runs: list[dict], file, draws: int, rng, size: int) -> float
 def noise(run_dirs: list[str], populations: int, draws: int, seed: int) -> None:
     rng = np.random.default_rng(seed)
     print(f"borderline false FEASIBLE: the part's own runs against {populations} populations "
-          f'drawn from their fitted lognormal ({draws} subsamples each)')
+          f'drawn from their fitted Gumbel ({draws} subsamples each)')
     print('  part | runs | size | own | model: median | 90th percentile | share above 5 %')
     for run_dir in run_dirs:
         file = experiment_file.load(os.path.join(run_dir, 'experiment.yaml'))
         runs = decisions.feeder_runs(read_csv(os.path.join(run_dir, 'iterations.csv')),
                                      file.cell)
         fit = decisions.table_time(runs, file.requirements.refill_interval,
-                                   file.requirements.success_rate).detail['lognormal']
-        shift, n = fit['shift_s'], len(runs)
+                                   file.requirements.success_rate).detail['gumbel']
+        n = len(runs)
         for size in (k for k in SIZES if k < n):
             own = _rate_at_border(runs, file, draws, rng, size)
             model = np.array([_rate_at_border(
-                [{'time': shift + t, 'picking': shift, 'spilled': 0, 'emptied': True}
-                 for t in np.exp(rng.normal(fit['log_mean'], fit['log_sd'], n))],
+                [{'time': t, 'spilled': 0, 'emptied': True}
+                 for t in rng.gumbel(fit['location_s'], fit['scale_s'], n)],
                 file, draws, rng, size) for _ in range(populations)])
             print(f'  {file.id} | {n} | {size} | {own:.1%} | {np.median(model):.1%} | '
                   f'{np.quantile(model, 0.9):.1%} | {(model > 0.05).mean():.0%}')
@@ -169,6 +180,27 @@ def cost(run_dirs: list[str]) -> None:
               f'({before}) | {minutes[now - 1]:.1f} ({now})')
 
 
+def regrade(run_dirs: list[str]) -> None:
+    for run_dir in run_dirs:
+        file = experiment_file.load(os.path.join(run_dir, 'experiment.yaml'))
+        rows = read_csv(os.path.join(run_dir, 'iterations.csv'))
+        print(os.path.basename(os.path.normpath(run_dir)))
+        for exp_id in dict.fromkeys(r['experiment'] for r in rows
+                                    if r['type'] == 'feeder_emptying'):
+            mine = [r for r in rows if r['experiment'] == exp_id]
+            out = metrics.left_out(mine)
+            grounds = metrics.table_grounds(file, [r for r in mine if (r['group'], r['iteration'])
+                                                   not in out])
+            time = grounds['time']
+            fit = time.detail.get('gumbel')
+            times = ', '.join('-' if t is None else f'{t / 60:.2f}'
+                              for t in time.detail.get('times_s', []))
+            bound = '-' if time.bound is None else f'{time.bound / 60:.1f} min'
+            p = '-' if fit is None else f'{fit["p"]:.3f}'
+            print(f'  {exp_id}: {decisions.combined([g.verdict for g in grounds.values()])}; '
+                  f'time {time.verdict}, bound {bound}, fit p {p}; times {times} min')
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     sub = parser.add_subparsers(dest='command', required=True)
@@ -185,10 +217,14 @@ def main(argv: list[str] | None = None) -> int:
     model.add_argument('--populations', type=int, default=60)
     model.add_argument('--draws', type=int, default=400)
     model.add_argument('--seed', type=int, default=44)
+    again = sub.add_parser('regrade')
+    again.add_argument('run_dirs', nargs='+')
     args = parser.parse_args(argv)
     if args.command == 'files':
         print('\n'.join(write_files(args.directory,
                                      args.moves.split(',') if args.moves else None)))
+    elif args.command == 'regrade':
+        regrade(args.run_dirs)
     elif args.command == 'noise':
         noise(args.run_dirs, args.populations, args.draws, args.seed)
     else:

@@ -8,34 +8,48 @@ import numpy as np
 import pytest
 
 
-def test_the_tolerance_factor_is_the_published_one():
-    # NIST/SEMATECH e-Handbook 7.2.6.3 (one-sided, 90 % coverage, 95 % confidence):
-    # n = 10: 2.355; n = 20: 1.926 (Krishnamoorthy and Mathew, Table B1: n = 3: 6.158)
-    assert decisions.k_factor(10, 0.9) == pytest.approx(2.355, abs=2e-3)
-    assert decisions.k_factor(20, 0.9) == pytest.approx(1.926, abs=2e-3)
-    assert decisions.k_factor(3, 0.9) == pytest.approx(6.158, abs=5e-3)
+def test_the_gumbel_fit_finds_the_location_and_scale_it_was_drawn_with():
+    location, scale = decisions.gumbel_fit(np.random.default_rng(5).gumbel(900.0, 30.0, 100_000))
+    assert location == pytest.approx(900.0, abs=0.5) and scale == pytest.approx(30.0, rel=0.01)
 
 
-def test_the_lognormal_bound_covers_the_quantile_as_often_as_it_promises():
-    """Drawn from a known lognormal, the 95 % upper bound of the 90 % quantile lies above the
-    true quantile in 95 % of samples, whatever the sample's size."""
+def test_the_gumbel_bound_covers_the_quantile_as_often_as_it_promises():
+    """Drawn from a known Gumbel (another generator than the factors'), the 95 % upper bound of
+    the 90 % quantile lies above the true quantile in 95 % of samples, and the 95 % lower
+    bound below it in 95 %, whatever the sample's size."""
     rng = np.random.default_rng(43)
-    mu, sigma = math.log(1200.0), 0.3
-    quantile = math.exp(mu + 1.2815515655446004 * sigma)
+    location, scale = 1200.0, 40.0
+    quantile = location - scale * math.log(-math.log(0.9))
     for n in (3, 5, 12):
-        covered = []
+        upper, lower = [], []
         for _ in range(2000):
-            runs = [{'time': t, 'spilled': 0} for t in rng.lognormal(mu, sigma, n)]
-            fit = decisions.table_time(runs, 1e9, 0.9).detail['lognormal']
-            covered.append(fit['upper'] >= quantile)
-        assert 0.93 <= np.mean(covered) <= 0.97, (n, np.mean(covered))
+            runs = [{'time': t, 'spilled': 0} for t in rng.gumbel(location, scale, n)]
+            fit = decisions.table_time(runs, 1e9, 0.9).detail['gumbel']
+            upper.append(fit['upper'] >= quantile)
+            lower.append(fit['lower'] <= quantile)
+        assert 0.94 <= np.mean(upper) <= 0.96, (n, np.mean(upper))
+        assert 0.94 <= np.mean(lower) <= 0.96, (n, np.mean(lower))
+
+
+def test_the_fit_check_rejects_as_often_as_it_should_and_a_sample_the_gumbel_cannot_be():
+    """Gumbel samples are rejected at 5 % about 5 % of the time; a sample skewed the other
+    way (most runs long, a few short) nearly always."""
+    rng = np.random.default_rng(7)
+    rejected = [not decisions.table_time([{'time': t, 'spilled': 0} for t in
+                                          rng.gumbel(1000.0, 20.0, 12)], 1e9, 0.9)
+                .detail['gumbel']['fits'] for _ in range(2000)]
+    assert 0.04 <= np.mean(rejected) <= 0.06
+    left = [[{'time': 2000.0 - t, 'spilled': 0} for t in rng.gumbel(1000.0, 20.0, 12)]
+            for _ in range(200)]
+    assert np.mean([not decisions.table_time(r, 1e9, 0.9).detail['gumbel']['fits']
+                    for r in left]) > 0.3
 
 
 def test_the_time_ground_decides_on_the_bound_and_says_which():
     runs = [{'time': t, 'spilled': 0} for t in (1000.0, 1010.0, 1030.0)]
     far = decisions.table_time(runs, 14400.0, 0.9)
     assert far.verdict == decisions.FEASIBLE and far.runs == 3
-    assert far.interval == 'one-sided 95 % tolerance bound, lognormal'
+    assert far.interval == 'one-sided 95 % tolerance bound, Gumbel'
     assert 1030.0 < far.bound < 14400.0
     assert decisions.table_time(runs, 900.0, 0.9).verdict == decisions.NOT_FEASIBLE
     near = decisions.table_time(runs, 1040.0, 0.9)     # past the runs, inside the bound

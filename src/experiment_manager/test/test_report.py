@@ -100,9 +100,9 @@ def test_the_table_verdict_rests_on_the_time_to_empty_and_the_spills(run_dir):
     assert table['verdict'] == FEASIBLE, table
     assert table['reasons'][0].startswith('3 runs emptied in 16.7 min to 17.0 min: 90 % of '
                                           'refills empty within ')
-    assert 'one-sided 95 % tolerance bound, lognormal' in table['reasons'][0]
+    assert 'one-sided 95 % tolerance bound, Gumbel' in table['reasons'][0]
     assert table['reasons'][2] == 'grounds settled: time FEASIBLE, spills FEASIBLE'
-    assert table['grounds']['time']['interval'] == 'one-sided 95 % tolerance bound, lognormal'
+    assert table['grounds']['time']['interval'] == 'one-sided 95 % tolerance bound, Gumbel'
     _rates(s, 3, 3, 3, seconds=3.9 * 3600.0)   # just inside the interval: not settled
     table = verdicts.verdicts(s)[1]
     assert table['verdict'] == UNDECIDED
@@ -123,7 +123,7 @@ def test_the_table_verdict_rests_on_the_time_to_empty_and_the_spills(run_dir):
     assert table['reasons'][2] == 'grounds settled: time FEASIBLE, spills NOT FEASIBLE'
     text = report.markdown(s, {}, {})
     assert '| vibrating table | time | time to empty the feeder, 90 % of refills | FEASIBLE |' \
-        in text and '| one-sided 95 % tolerance bound, lognormal | 3 |' in text
+        in text and '| one-sided 95 % tolerance bound, Gumbel | 3 |' in text
 
 
 def test_the_exact_interval_of_a_rate():

@@ -11,7 +11,7 @@ and kept in summary.json as each experiment's `decision`):
 - vibrating table, on two grounds: the cell's time to empty a refill (picks, images, the
   table's simulated feeds and vibrations; a run that did not empty is over) against the
   refill interval, for requirements.success_rate of refills at 95 % confidence (a one-sided
-  tolerance bound, lognormal, with a distribution-free one beside it); and the parts spilled
+  tolerance bound, Gumbel, with a distribution-free one beside it); and the parts spilled
   per refill against requirements.max_spilled_parts; the feeder must hold a refill interval's
   parts. FEASIBLE when every ground is, NOT FEASIBLE when one is, else UNDECIDED, saying
   which grounds are settled;
