@@ -21,9 +21,10 @@ confidence (`table_time`):
   check does not reject at 5 % (with 3 runs the check is weak, and said so); FEASIBLE when the
   upper bound is within the interval; NOT FEASIBLE when the lower 95 % bound of the same
   quantile is beyond it. Until 2026-11-27 a lognormal of the time less the robot's known part;
-  on 50 runs of each test-case part it put the bound of 3 to 12 runs below the 90 % quantile
-  of PTH1's and PTH2's runs 7 to 10 % of the time (their times are skewed to the right beyond
-  a lognormal's), the Gumbel at most 4.5 % (docs/paper-test-case.md, "Deciding on few runs");
+  on 50 runs of each test-case part its bound on 3 to 12 of them said FEASIBLE at the 50's own
+  estimate of PTH1's 90 % quantile up to 7.4 % of the time (the runs are skewed to the right
+  beyond a lognormal's), the Gumbel's at most 4.6 % on any part (docs/paper-test-case.md,
+  "Deciding on few runs");
 - distribution-free, beside it: the runs over the interval (or not emptied) as a binomial
   count: FEASIBLE when the one-sided 95 % upper bound of their share is below 1 - success_rate
   (with none over, 29 runs at 90 %), NOT FEASIBLE when its lower bound is above it. Used alone
@@ -222,7 +223,7 @@ def _gringorten(n: int) -> np.ndarray:
     return -np.log(-np.log((np.arange(1, n + 1) - 0.44) / (n + 0.12)))
 
 
-@functools.cache
+@functools.lru_cache(maxsize=8)     # 4.8 MB a size; an adaptive run looks at a few sizes
 def _gumbel_pivots(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Of GUMBEL_DRAWS standard Gumbel samples of n (a seeded generator: the same every
     run): their L-moment location and scale, and their probability plot correlations,
