@@ -32,6 +32,13 @@ borderline where `table` puts it, and prints the spread of the same rate over th
 the quantile itself, where a one-sided 95 % bound says FEASIBLE 5 % of the time on average;
 one population of 50 scatters about that.
 
+  tools/ws python -m bench.experiment.feeder_decisions plot RUN_DIR... --out PNG
+draws each part's probability plots: its runs' times to empty, ordered, against the Gumbel's
+quantiles, and their logarithms less the picks' time against the normal's (the lognormal the
+bound used before 2026-11-27; Gringorten's and Blom's plotting positions), each with the
+fitted line; where the points bend off a line at the top, that
+model's tail is too short for the runs.
+
   tools/ws python -m bench.experiment.feeder_decisions regrade RUN_DIR...
 decides the table's time ground of every feeder experiment of finished runs (a sensitivity
 run's scenarios too) again with today's rule, from their iterations.csv, and prints each with
@@ -201,6 +208,41 @@ def regrade(run_dirs: list[str]) -> None:
                   f'time {time.verdict}, bound {bound}, fit p {p}; times {times} min')
 
 
+def plot(run_dirs: list[str], out: str) -> None:
+    import matplotlib
+    matplotlib.use('Agg')
+    from matplotlib import pyplot
+    from scipy import stats
+    figure, axes = pyplot.subplots(2, len(run_dirs), figsize=(4.2 * len(run_dirs), 7.5),
+                                   squeeze=False)
+    for column, run_dir in enumerate(run_dirs):
+        file = experiment_file.load(os.path.join(run_dir, 'experiment.yaml'))
+        rows = read_csv(os.path.join(run_dir, 'iterations.csv'))
+        times = np.sort([r['time'] for r in decisions.feeder_runs(rows, file.cell)]) / 60.0
+        n = len(times)
+        location, scale = decisions.gumbel_fit(times)
+        gumbel = -np.log(-np.log((np.arange(1, n + 1) - 0.44) / (n + 0.12)))
+        normal = stats.norm.ppf((np.arange(1, n + 1) - 0.375) / (n + 0.25))
+        # the lognormal before 2026-11-27 was of the time less the picks' (the same in every
+        # emptied run)
+        picking = max(r['picks'] for r in rows) * file.cell.pick_time / 60.0
+        logs = np.log(times - picking)
+        for row, (x, y, line, name) in enumerate((
+                (gumbel, times, location + scale * gumbel, 'Gumbel quantile'),
+                (normal, logs, logs.mean() + logs.std(ddof=1) * normal,
+                 'normal quantile (lognormal)'))):
+            ax = axes[row][column]
+            ax.plot(x, y, 'o', markersize=3)
+            ax.plot(x, line, '-', linewidth=1)
+            ax.set_xlabel(name)
+            ax.set_ylabel('time to empty, min' if row == 0 else
+                          'log of the time to empty less the picks', fontsize=9)
+            ax.set_title(f'{file.id}, {n} runs')
+    figure.tight_layout()
+    figure.savefig(out, dpi=90)
+    print(out)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     sub = parser.add_subparsers(dest='command', required=True)
@@ -217,12 +259,17 @@ def main(argv: list[str] | None = None) -> int:
     model.add_argument('--populations', type=int, default=60)
     model.add_argument('--draws', type=int, default=400)
     model.add_argument('--seed', type=int, default=44)
+    drawn = sub.add_parser('plot')
+    drawn.add_argument('run_dirs', nargs='+')
+    drawn.add_argument('--out', required=True)
     again = sub.add_parser('regrade')
     again.add_argument('run_dirs', nargs='+')
     args = parser.parse_args(argv)
     if args.command == 'files':
         print('\n'.join(write_files(args.directory,
                                      args.moves.split(',') if args.moves else None)))
+    elif args.command == 'plot':
+        plot(args.run_dirs, args.out)
     elif args.command == 'regrade':
         regrade(args.run_dirs)
     elif args.command == 'noise':
