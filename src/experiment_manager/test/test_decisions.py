@@ -54,6 +54,9 @@ def test_the_time_ground_decides_on_the_bound_and_says_which():
     assert decisions.table_time(runs, 900.0, 0.9).verdict == decisions.NOT_FEASIBLE
     near = decisions.table_time(runs, 1040.0, 0.9)     # past the runs, inside the bound
     assert near.verdict == decisions.UNDECIDED
+    # runs that all took the same time: nothing spreads, the bound is that time
+    same = decisions.table_time([{'time': 1000.0, 'spilled': 0}] * 3, 14400.0, 0.9)
+    assert same.verdict == decisions.FEASIBLE and same.bound == pytest.approx(1000.0)
     # two runs: no fitted bound; the distribution-free one needs 29 runs all within
     two = decisions.table_time(runs[:2], 14400.0, 0.9)
     assert two.verdict == decisions.UNDECIDED and 'fewer than 3 runs' in two.reason
