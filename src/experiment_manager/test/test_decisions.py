@@ -27,8 +27,9 @@ def test_the_gumbel_bound_covers_the_quantile_as_often_as_it_promises():
             fit = decisions.table_time(runs, 1e9, 0.9).detail['gumbel']
             upper.append(fit['upper'] >= quantile)
             lower.append(fit['lower'] <= quantile)
-        assert 0.94 <= np.mean(upper) <= 0.96, (n, np.mean(upper))
-        assert 0.94 <= np.mean(lower) <= 0.96, (n, np.mean(lower))
+        # 2,000 samples: a coverage of 95 % is seen within 0.5 % (one standard deviation)
+        assert 0.935 <= np.mean(upper) <= 0.965, (n, np.mean(upper))
+        assert 0.935 <= np.mean(lower) <= 0.965, (n, np.mean(lower))
 
 
 def test_the_fit_check_rejects_as_often_as_it_should_and_a_sample_the_gumbel_cannot_be():
