@@ -221,7 +221,7 @@ def plot(run_dirs: list[str], out: str) -> None:
         times = np.sort([r['time'] for r in decisions.feeder_runs(rows, file.cell)]) / 60.0
         n = len(times)
         location, scale = decisions.gumbel_fit(times)
-        gumbel = -np.log(-np.log((np.arange(1, n + 1) - 0.44) / (n + 0.12)))
+        gumbel = decisions.gringorten(n)
         normal = stats.norm.ppf((np.arange(1, n + 1) - 0.375) / (n + 0.25))
         # the lognormal before 2026-11-27 was of the time less the picks' (the same in every
         # emptied run)

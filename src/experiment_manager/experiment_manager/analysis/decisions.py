@@ -217,7 +217,7 @@ def gumbel_fit(values) -> tuple[float, float]:
     return b0 - EULER_GAMMA * scale, scale
 
 
-def _gringorten(n: int) -> np.ndarray:
+def gringorten(n: int) -> np.ndarray:
     """The standard Gumbel's quantiles at Gringorten's plotting positions (i - 0.44) /
     (n + 0.12), the probability plot's x for n ordered values."""
     return -np.log(-np.log((np.arange(1, n + 1) - 0.44) / (n + 0.12)))
@@ -230,7 +230,7 @@ def _gumbel_pivots(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     sorted."""
     rng = np.random.default_rng(20261127)
     location, scale, correlation = [], [], []
-    z = _gringorten(n) - _gringorten(n).mean()
+    z = gringorten(n) - gringorten(n).mean()
     for rows in np.array_split(np.arange(GUMBEL_DRAWS), max(1, GUMBEL_DRAWS * n // 2_000_000)):
         sample = np.sort(rng.gumbel(size=(rows.size, n)), axis=1)
         a, b = gumbel_fit(sample)
@@ -260,7 +260,7 @@ def _gumbel(times: np.ndarray, coverage: float, confidence: float) -> dict:
     location, scale = (float(v) for v in gumbel_fit(times))
     spread = times - times.mean()
     if scale > 0:
-        z = _gringorten(n) - _gringorten(n).mean()
+        z = gringorten(n) - gringorten(n).mean()
         r = float(np.sort(spread) @ z / math.sqrt((spread @ spread) * (z @ z)))
         p = float(np.searchsorted(_gumbel_pivots(n)[2], r) / GUMBEL_DRAWS)
     else:
