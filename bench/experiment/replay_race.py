@@ -21,6 +21,8 @@ from experiment_manager.experiment_file.plan import groups
 from experiment_manager.running import sampling
 import numpy as np
 
+from . import replay_decisions
+
 
 def overlap_race(exp, rows: list[dict]) -> tuple[list[int], list[int]]:
     """sampling.race before 2026-11-27: each bin's own interval at INTERIM_CONFIDENCE against
@@ -48,31 +50,16 @@ def replay(run_dir: str, batch: int) -> str:
     exp = file.experiment('bins')
     rows = [r for r in read_csv(os.path.join(run_dir, 'iterations.csv'))
             if r['experiment'] == 'bins']
-    recorded = {}
-    for r in rows:
-        recorded[r['group']] = max(recorded.get(r['group'], 0), r['iteration'] + 1)
-    given = dict.fromkeys(range(len(exp.bins)), batch)
-    looks, end = 1, 'one bin left'
-    while True:
-        racing, tie = sampling.ended(file, exp, [r for r in rows
-                                                 if r['iteration'] < given[r['group']]])
-        if tie:
-            end = f'a tie of bins {tie}'
-        if not racing:
-            break
-        if any(given[g] + batch > recorded.get(g, 0) for g in racing):
-            end = f'the recorded drops ran out with bins {racing} racing'
-            break
-        for g in racing:
-            given[g] += batch
-        looks += 1
-    used = [r for r in rows if r['iteration'] < given[r['group']]]
-    means = {g: np.mean([r['container_free'] / r['checked'] for r in used if r['group'] == g])
-             for g in given}
-    best = max(means, key=lambda g: (means[g], -g))
-    size = ' x '.join(f'{x * 1000:.4g}' for x in exp.bins[best].inner_size)
-    return (f'{os.path.basename(os.path.normpath(run_dir))}: best bin {best} ({size} mm), '
-            f'{len(used)} of {len(rows)} drops, '
+    used, looks, end = replay_decisions.replay(file, exp, rows, batch)
+    racing, tie = sampling.ended(file, exp, used)
+    if tie:
+        end = 'a tie'
+    elif racing:
+        end = f'{end} with bins {racing} racing'
+    elif end == 'settled':
+        end = 'one bin left'
+    return (f'{os.path.basename(os.path.normpath(run_dir))}: '
+            f'{replay_decisions.decision(file, exp, used)}, {len(used)} of {len(rows)} drops, '
             f'{sum(r["wall_time"] for r in used) / 60:.1f} of '
             f'{sum(r["wall_time"] for r in rows) / 60:.1f} '
             f'worker-min, {looks} looks, ended by {end}')
