@@ -36,3 +36,11 @@ def test_a_log_gets_a_line_per_twentieth_and_per_experiment():
         bar.update(_progress(done, total=40))
     lines = log.getvalue().splitlines()
     assert len(lines) == 21 and lines[-1].startswith('40/40  0:08:00 elapsed, eta 0:00:31')
+
+
+def test_an_adaptive_run_says_its_estimate_is_of_the_most_it_may_take():
+    log = io.StringIO()
+    bar = ProgressBar(log)
+    bar.at_most = True
+    bar.update(_progress(3))
+    assert log.getvalue().startswith('3/46  0:00:36 elapsed, eta at most 0:00:31')

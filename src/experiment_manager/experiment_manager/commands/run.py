@@ -69,6 +69,8 @@ class ProgressBar:
     def __init__(self, stream=sys.stderr, columns: int | None = None) -> None:
         self.stream, self.columns = stream, columns
         self.tty = stream.isatty()
+        # an adaptive run's estimate is of the most it may take (running/estimate.py): said so
+        self.at_most = False
         self._bar: tqdm | None = None
         self._last = (None, -1)
 
@@ -78,7 +80,7 @@ class ProgressBar:
         return f'{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}'
 
     def update(self, p) -> None:
-        eta = self._clock(p.eta) if p.eta else '?'
+        eta = (('at most ' if self.at_most else '') + self._clock(p.eta)) if p.eta else '?'
         status = f'{self._clock(p.elapsed)} elapsed, eta {eta}  {p.phase}'
         if not self.tty:
             fraction = p.iterations_done / p.iterations_total if p.iterations_total else 0.0
@@ -197,11 +199,11 @@ def _summary_lines(summary: dict) -> list[str]:
 
 
 def _goals(args: argparse.Namespace,
-           temporary: list[str]) -> list[tuple[RunExperiment.Goal, str, str]]:
-    """A goal per file with the file's mesh ('' for none) and the path as given (the goal's may
-    be a reduced copy), every file checked first. Raises InvalidArgument naming the file
-    (InvalidFile when it has several errors). The copies that --iterations and --adaptive write are
-    added to `temporary`, for the caller to remove."""
+           temporary: list[str]) -> list[tuple[RunExperiment.Goal, str, str, bool]]:
+    """A goal per file with the file's mesh ('' for none), the path as given (the goal's may
+    be a reduced copy) and whether it runs adaptively, every file checked first. Raises
+    InvalidArgument naming the file (InvalidFile when it has several errors). The copies that
+    --iterations and --adaptive write are added to `temporary`, for the caller to remove."""
     goals = []
     files = args.experiment_files or [os.path.join(args.resume, 'experiment.yaml')
                                       if args.resume else default_file()]
@@ -222,7 +224,8 @@ def _goals(args: argparse.Namespace,
         output = os.path.abspath(os.path.expanduser(args.resume or args.output
                                                     or file.output_dir))
         goals.append((RunExperiment.Goal(experiment_file=path, resume=bool(args.resume),
-                                         output_dir=output), file.part.mesh_path, given))
+                                         output_dir=output), file.part.mesh_path, given,
+                      args.adaptive or file.sampling.adaptive))
     return goals
 
 
@@ -259,12 +262,13 @@ def _main(args: argparse.Namespace, temporary: list[str]) -> int:
     try:
         lock = claim(node, args.namespace, args.workers)   # released after our nodes stop
         graph = Graph(start_graph(args.namespace, log_dir, args.workers,
-                                  [g.experiment_file for g, _, _ in goals],
-                                  [m for _, m, _ in goals],
-                                  [g.output_dir for g, _, _ in goals], args.respawns),
+                                  [g.experiment_file for g, *_ in goals],
+                                  [m for _, m, *_ in goals],
+                                  [g.output_dir for g, *_ in goals], args.respawns),
                       args.respawns)
         client = LockedActionClient(node, RunExperiment, 'run_experiment')
-        for goal, _, given in goals:
+        for goal, _, given, adaptive in goals:
+            bar.at_most = adaptive
             code = _run(node, client, goal, given, graph, bar)
             if code:
                 return code
