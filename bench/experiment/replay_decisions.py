@@ -26,6 +26,7 @@ import os
 from experiment_manager import experiment_file
 from experiment_manager.analysis import decisions, metrics
 from experiment_manager.analysis.results import read_csv
+from experiment_manager.analysis.wording import dims
 from experiment_manager.experiment_file import (
     BIN_EMPTYING,
     BIN_STATIC,
@@ -34,7 +35,6 @@ from experiment_manager.experiment_file import (
 )
 from experiment_manager.experiment_file.plan import groups
 from experiment_manager.running import sampling
-import numpy as np
 
 
 def replay(file, exp, rows: list[dict], batch: int) -> tuple[list[dict], int, str]:
@@ -60,16 +60,15 @@ def replay(file, exp, rows: list[dict], batch: int) -> tuple[list[dict], int, st
 def decision(file, exp, taken: list[dict]) -> str:
     if exp.type == BIN_STATIC:
         racing, tie = sampling.ended(file, exp, taken)
-        means = {g: np.mean([r['container_free'] / r['checked'] for r in taken
-                             if r['group'] == g and r['checked']]) for g in groups(exp)}
-        best = max(means, key=lambda g: (means[g], -g))
-        size = ' x '.join(f'{x * 1000:.4g}' for x in exp.bins[best].inner_size)
-        return f'best bin {size} mm' + (f', a tie of bins {tie}' if tie else '') + \
+        best = metrics.bin_static(exp, taken)['best_bin_mm']
+        return f'best bin {dims(best)} mm' + (f', a tie of bins {tie}' if tie else '') + \
             (f', bins {racing} not told apart' if racing else '')
     if exp.type == TABLE_SWEEP:
         fitted = metrics.fit_optimum([r['group'] for r in taken], [r['valid'] for r in taken],
                                      exp.counts[0], exp.counts[-1], exp.margin)
         return f'n* {fitted["n_star"]}'
+    if exp.type in (FEEDER_EMPTYING, BIN_EMPTYING) and metrics.left_out(taken):
+        return 'NOT FEASIBLE: an iteration left out of the figures (a physics fault)'
     if exp.type == FEEDER_EMPTYING:
         grounds = metrics.table_grounds(file, taken)
         return 'table ' + decisions.combined([g.verdict for g in grounds.values()])
