@@ -217,10 +217,25 @@ def gumbel_fit(values) -> tuple[float, float]:
     return b0 - EULER_GAMMA * scale, scale
 
 
+def standard_quantile(share):
+    """The standard Gumbel's (location 0, scale 1) quantile of `share` (a float or an array)."""
+    return -np.log(-np.log(share))
+
+
 def gringorten(n: int) -> np.ndarray:
     """The standard Gumbel's quantiles at Gringorten's plotting positions (i - 0.44) /
     (n + 0.12), the probability plot's x for n ordered values."""
-    return -np.log(-np.log((np.arange(1, n + 1) - 0.44) / (n + 0.12)))
+    return standard_quantile((np.arange(1, n + 1) - 0.44) / (n + 0.12))
+
+
+def plot_correlation(values: np.ndarray) -> np.ndarray:
+    """The probability plot correlation of `values` (the last axis: a sample, at least one
+    value apart from the rest): their order statistics' correlation with gringorten's."""
+    ordered = np.sort(values, axis=-1)
+    centred = ordered - ordered.mean(axis=-1, keepdims=True)
+    z = gringorten(ordered.shape[-1])
+    z = z - z.mean()
+    return centred @ z / np.sqrt((centred ** 2).sum(axis=-1) * (z @ z))
 
 
 @functools.lru_cache(maxsize=8)     # 4.8 MB a size; an adaptive run looks at a few sizes
@@ -230,14 +245,12 @@ def _gumbel_pivots(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     sorted."""
     rng = np.random.default_rng(20261127)
     location, scale, correlation = [], [], []
-    z = gringorten(n) - gringorten(n).mean()
     for rows in np.array_split(np.arange(GUMBEL_DRAWS), max(1, GUMBEL_DRAWS * n // 2_000_000)):
-        sample = np.sort(rng.gumbel(size=(rows.size, n)), axis=1)
+        sample = rng.gumbel(size=(rows.size, n))
         a, b = gumbel_fit(sample)
         location.append(a)
         scale.append(b)
-        centred = sample - sample.mean(axis=1, keepdims=True)
-        correlation.append(centred @ z / np.sqrt((centred ** 2).sum(axis=1) * (z @ z)))
+        correlation.append(plot_correlation(sample))
     return np.concatenate(location), np.concatenate(scale), np.sort(np.concatenate(correlation))
 
 
@@ -247,8 +260,7 @@ def gumbel_k(n: int, coverage: float, confidence: float = CONFIDENCE) -> float:
     `coverage` of the population from above with `confidence` (n >= 3): the `confidence`
     quantile of the pivot (quantile - location) / scale over standard samples."""
     location, scale, _ = _gumbel_pivots(n)
-    quantile = -math.log(-math.log(coverage))
-    return float(np.quantile((quantile - location) / scale, confidence))
+    return float(np.quantile((standard_quantile(coverage) - location) / scale, confidence))
 
 
 def _gumbel(times: np.ndarray, coverage: float, confidence: float) -> dict:
@@ -258,10 +270,8 @@ def _gumbel(times: np.ndarray, coverage: float, confidence: float) -> dict:
     (the share of standard samples that correlate less)."""
     n = len(times)
     location, scale = (float(v) for v in gumbel_fit(times))
-    spread = times - times.mean()
     if scale > 0:
-        z = gringorten(n) - gringorten(n).mean()
-        r = float(np.sort(spread) @ z / math.sqrt((spread @ spread) * (z @ z)))
+        r = float(plot_correlation(times))
         p = float(np.searchsorted(_gumbel_pivots(n)[2], r) / GUMBEL_DRAWS)
     else:
         p = 1.0     # every run took the same time: nothing to check
@@ -269,7 +279,7 @@ def _gumbel(times: np.ndarray, coverage: float, confidence: float) -> dict:
     return {'n': n, 'location_s': location, 'scale_s': scale, 'p': p, 'fits': p >= FIT_ALPHA,
             'k_upper': k_upper, 'k_lower': k_lower,
             'upper': location + k_upper * scale, 'lower': location + k_lower * scale,
-            'estimate': location - math.log(-math.log(coverage)) * scale}
+            'estimate': location + float(standard_quantile(coverage)) * scale}
 
 
 def _pc(share: float) -> str:
