@@ -17,6 +17,7 @@ import time
 
 from ament_index_python.packages import get_package_share_directory
 from experiment_manager import experiment_file
+from experiment_manager.analysis import summary as summary_model
 from experiment_manager.analysis.results import FILES, read_text_rows, ResultsWriter
 from experiment_manager.analysis.verdicts import verdicts
 from experiment_manager.commands import interrupt, supervisor
@@ -82,9 +83,9 @@ def test_the_graph_gives_the_results_of_the_cores(graph_run, core_run):
     assert [line.split()[0] for line in verdict_lines] == ['static', 'vibrating', 'gripper']
     assert all(re.search(r': (NOT FEASIBLE|FEASIBLE|UNDECIDED) \(.+\)$', line)
                for line in verdict_lines)
-    with open(os.path.join(core_run, 'summary.json')) as f:     # the cores decide the same
-        expected = [f'  {v["option"].replace("`", "")}: {v["verdict"]} ('
-                    for v in verdicts(json.load(f))]
+    # the cores decide the same
+    expected = [f'  {v.option.replace("`", "")}: {v.verdict} ('
+                for v in verdicts(summary_model.read(os.path.join(core_run, 'summary.json')))]
     assert all(line.startswith(e) for line, e in zip(verdict_lines, expected, strict=True)), \
         (verdict_lines, expected)
     report = re.search(r'^report:\s+(\S+)', done.stdout, re.M).group(1)
@@ -224,11 +225,10 @@ def test_the_run_s_verdicts_are_published_recorded_and_printed(graph_run):
         got = [msg for _, channel, _, msg in make_reader(
             f, decoder_factories=[DecoderFactory()]).iter_decoded_messages()
             if channel.topic == f'{NS}/verdicts']
-    with open(os.path.join(run_dir, 'summary.json')) as f:
-        expected = verdicts(json.load(f))
+    expected = verdicts(summary_model.read(os.path.join(run_dir, 'summary.json')))
     assert len(got) == 1 and got[0].run_directory == run_dir
     assert [(v.option, v.verdict, list(v.reasons)) for v in got[0].verdicts] == [
-        (v['option'], v['verdict'], v['reasons']) for v in expected]
+        (v.option, v.verdict, v.reasons) for v in expected]
     assert {v.verdict for v in got[0].verdicts} <= {
         Verdict.FEASIBLE, Verdict.NOT_FEASIBLE, Verdict.UNDECIDED, Verdict.NOT_ANALYSED}
     printed = done.stdout[done.stdout.index('verdicts:\n'):].splitlines()[1:]

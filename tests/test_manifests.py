@@ -14,8 +14,8 @@ import pytest
 SRC = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src')
 
 # What a top-level import needs, as a rosdep key or a ROS package name. None: no rosdep key
-# exists (mcap, mcap_ros2 and coacd are on PyPI only); requirements.txt installs them, and a
-# comment in the package.xml says so.
+# exists (mcap, mcap_ros2, coacd and markdown_it are on PyPI only); requirements.txt installs
+# them, and a comment in the package.xml says so.
 IMPORT_KEYS = {
     'numpy': 'python3-numpy',
     'scipy': 'python3-scipy',
@@ -27,6 +27,7 @@ IMPORT_KEYS = {
     'tqdm': 'python3-tqdm',
     'pytest': 'python3-pytest',
     'hypothesis': 'python3-hypothesis',
+    'jsonschema': 'python3-jsonschema',
     'trimesh': 'python3-trimesh-pip',
     'networkx': 'python3-networkx',         # imported by trimesh (split, fill_holes)
     'fcl': 'python-fcl-pip',
@@ -34,6 +35,7 @@ IMPORT_KEYS = {
     'mcap': None,
     'mcap_ros2': None,
     'coacd': None,
+    'markdown_it': None,
 }
 # ROS 2 Jazzy packages imported under their own names.
 ROS_PACKAGES = {

@@ -18,6 +18,7 @@ import tempfile
 import time
 
 from experiment_manager.analysis.results import ResultsWriter
+from experiment_manager.analysis.summary import validate
 from experiment_manager.analysis.verdicts import verdicts
 from experiment_manager.running.local_backend import LocalBackend
 from experiment_manager.running.scheduler import Runner
@@ -78,8 +79,8 @@ def main() -> None:
         print(f'  {exp_id}: fixed {decision(s)} | adaptive {decision(a)}, '
               f'{a["sampling"]["iterations_run"]} of {a["sampling"]["most"]} iterations, '
               f'{"settled" if a["sampling"]["settled"] else "not settled"} | {same}')
-    for f, a in zip(verdicts(fixed), verdicts(adaptive), strict=True):
-        print(f'  verdict {f["option"]}: fixed {f["verdict"]} | adaptive {a["verdict"]}')
+    for f, a in zip(verdicts(validate(fixed)), verdicts(validate(adaptive)), strict=True):
+        print(f'  verdict {f.option}: fixed {f.verdict} | adaptive {a.verdict}')
 
 
 if __name__ == '__main__':

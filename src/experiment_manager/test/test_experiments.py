@@ -11,9 +11,10 @@ import time
 
 from experiment_manager import experiment_file
 from experiment_manager.analysis import metrics
+from experiment_manager.analysis.headlines import headlines
 from experiment_manager.analysis.results import read_text_rows, ResultsWriter
 from experiment_manager.analysis.rows import FILES, POSE
-from experiment_manager.commands.run import _summary_lines
+from experiment_manager.analysis.summary import validate
 from experiment_manager.experiment_file.plan import iteration_seed, plan, Unit
 from experiment_manager.running.backend import WorkerLost
 from experiment_manager.running.local_backend import LocalBackend
@@ -73,7 +74,7 @@ def test_every_type_records_its_rows_and_metrics(small):
     low, high = sweep['n_star_ci95']        # two iterations a count: a bootstrap interval
     assert 2 <= low <= sweep['n_star'] <= high <= 14
     assert (f'  sweep (table_sweep): optimum {sweep["n_star"]} parts (95 % interval {low}-'
-            f'{high}), range {sweep["optimal_range"]}') in _summary_lines(summary)
+            f'{high}), range {sweep["optimal_range"]}') in headlines(validate(summary))
     # feeder_emptying: the range came from the sweep; the run stopped by the policy.
     feeder = by_type['feeder_emptying'][0]
     assert s['feeder']['optimal_range'] == sweep['optimal_range']

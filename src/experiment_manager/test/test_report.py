@@ -9,8 +9,9 @@ import re
 import shutil
 
 from experiment_manager import experiment_file
-from experiment_manager.analysis import decisions, pictures, report, verdicts
+from experiment_manager.analysis import decisions, pictures, report, summary, verdicts
 from experiment_manager.analysis.metrics import rate_interval
+from experiment_manager.analysis.report import Run
 from experiment_manager.analysis.verdicts import FEASIBLE, NOT_ANALYSED, NOT_FEASIBLE, UNDECIDED
 from pick_validity.results import STAGE_PLACEABILITY
 import pytest
@@ -26,6 +27,15 @@ def run_dir(small, tmp_path_factory):
 def _summary(run_dir):
     with open(os.path.join(run_dir, 'summary.json')) as f:
         return json.load(f)
+
+
+def _verdicts(s: dict) -> list:
+    """The verdicts of a summary edited as JSON (checked against the model first)."""
+    return verdicts.verdicts(summary.validate(s))
+
+
+def _markdown(s: dict, figures=None) -> str:
+    return report.markdown(Run(summary.validate(s), figures=figures or {}))
 
 
 def test_a_run_gets_its_report_files(run_dir):
@@ -50,8 +60,8 @@ def test_a_run_gets_its_report_files(run_dir):
                      r'60\): 4 s per pick', text)
     # a header people read, and each verdict coloured by what it says
     assert 'Part `radial_capacitor`; gripper body diameter 8 mm, jaw depth 3 mm; seed 11.' in text
-    for v in verdicts.verdicts(_summary(run_dir)):
-        assert f'<b class="{report.VERDICT_CLASS[v["verdict"]]}">{v["verdict"]}</b>' in page
+    for v in _verdicts(_summary(run_dir)):
+        assert f'<strong class="{report.VERDICT_CLASS[v.verdict]}">{v.verdict}</strong>' in page
 
 
 def test_the_report_warns_where_the_optimal_range_runs_past_the_counts_tested(run_dir):
@@ -59,19 +69,19 @@ def test_the_report_warns_where_the_optimal_range_runs_past_the_counts_tested(ru
     sweep = s['experiments']['sweep']
     last = max(p['n'] for p in sweep['per_n'])
     sweep.update(n_star=last - 4, optimal_range=[last - 6, last - 2])
-    assert 'Warning' not in report.markdown(s, {}, {})
+    assert 'Warning' not in _markdown(s)
     # n*'s interval, and a note when it reaches beyond the range
     sweep['n_star_ci95'] = [last - 5, last - 3]
-    text = report.markdown(s, {}, {})
+    text = _markdown(s)
     assert (f'n* = {last - 4} parts on the table (95 % interval {last - 5}-{last - 3}, '
             'bootstrap); optimal range') in text and '**Note**' not in text
     sweep['n_star_ci95'] = [last - 10, last]
-    assert f'could put it anywhere in {last - 10}-{last}.' in report.markdown(s, {}, {})
+    assert f'could put it anywhere in {last - 10}-{last}.' in _markdown(s)
     del sweep['n_star_ci95']
     sweep.update(n_star=last, optimal_range=[last - 2, last + 2])
     assert (f'**Warning**: the optimal range runs past the last count tested ({last} parts): '
             'beyond it the fit is an extrapolation, and n* sits at that count') in \
-        report.markdown(s, {}, {})
+        _markdown(s)
 
 
 def _rates(s: dict, emptied: int, accepted: int, n: int, spilled: int = 0,
@@ -96,32 +106,32 @@ def test_the_table_verdict_rests_on_the_time_to_empty_and_the_spills(run_dir):
     s = _summary(run_dir)
     s['requirements'].update(capacity=10, success_rate=0.9)
     _rates(s, 3, 3, 3)              # three runs in about 17 min: far inside 4 h
-    table = verdicts.verdicts(s)[1]
-    assert table['verdict'] == FEASIBLE, table
-    assert table['reasons'][0].startswith('3 runs emptied in 16.7 min to 17.0 min: 90 % of '
+    table = _verdicts(s)[1]
+    assert table.verdict == FEASIBLE, table
+    assert table.reasons[0].startswith('3 runs emptied in 16.7 min to 17.0 min: 90 % of '
                                           'refills empty within ')
-    assert 'one-sided 95 % tolerance bound, Gumbel' in table['reasons'][0]
-    assert table['reasons'][2] == 'grounds settled: time FEASIBLE, spills FEASIBLE'
-    assert table['grounds']['time']['interval'] == 'one-sided 95 % tolerance bound, Gumbel'
+    assert 'one-sided 95 % tolerance bound, Gumbel' in table.reasons[0]
+    assert table.reasons[2] == 'grounds settled: time FEASIBLE, spills FEASIBLE'
+    assert table.grounds['time'].interval == 'one-sided 95 % tolerance bound, Gumbel'
     _rates(s, 3, 3, 3, seconds=3.9 * 3600.0)   # just inside the interval: not settled
-    table = verdicts.verdicts(s)[1]
-    assert table['verdict'] == UNDECIDED
-    assert table['reasons'][2] == 'grounds settled: spills FEASIBLE; not settled: time'
+    table = _verdicts(s)[1]
+    assert table.verdict == UNDECIDED
+    assert table.reasons[2] == 'grounds settled: spills FEASIBLE; not settled: time'
     _rates(s, 3, 2, 3)              # a run that did not empty counts as over: distribution-free
-    table = verdicts.verdicts(s)[1]
-    assert table['verdict'] == UNDECIDED and '1 of 3 runs over the interval or not emptied' \
-        in table['reasons'][0] and '(a run over the interval or not emptied)' in \
-        table['reasons'][0]
+    table = _verdicts(s)[1]
+    assert table.verdict == UNDECIDED and '1 of 3 runs over the interval or not emptied' \
+        in table.reasons[0] and '(a run over the interval or not emptied)' in \
+        table.reasons[0]
     _rates(s, 3, 0, 30)             # none of 30 emptied
-    assert verdicts.verdicts(s)[1]['verdict'] == NOT_FEASIBLE
+    assert _verdicts(s)[1].verdict == NOT_FEASIBLE
     _rates(s, 3, 3, 3, spilled=1)   # one spilled part, where none may spill: that decides
-    table = verdicts.verdicts(s)[1]
-    assert table['verdict'] == NOT_FEASIBLE
+    table = _verdicts(s)[1]
+    assert table.verdict == NOT_FEASIBLE
     # the ground that decides is said first (run prints only the first reason)
-    assert table['reasons'][0].startswith("1 parts spilled over the tray's walls in 3 runs")
-    assert table['reasons'][1].startswith('3 runs emptied in')
-    assert table['reasons'][2] == 'grounds settled: time FEASIBLE, spills NOT FEASIBLE'
-    text = report.markdown(s, {}, {})
+    assert table.reasons[0].startswith("1 parts spilled over the tray's walls in 3 runs")
+    assert table.reasons[1].startswith('3 runs emptied in')
+    assert table.reasons[2] == 'grounds settled: time FEASIBLE, spills NOT FEASIBLE'
+    text = _markdown(s)
     assert '| vibrating table | time | time to empty the feeder, 90 % of refills | FEASIBLE |' \
         in text and '| one-sided 95 % tolerance bound, Gumbel | 3 |' in text
 
@@ -149,44 +159,44 @@ def test_verdicts_rest_on_the_interval_of_the_rate_and_on_the_capacity(run_dir):
     s['requirements'].update(capacity=10, success_rate=0.9)
     # One iteration that succeeded decides nothing: it reads so, with the count that would.
     _rates(s, 1, 1, 1)
-    static, table = verdicts.verdicts(s)[:2]
-    assert (static['verdict'], table['verdict']) == (UNDECIDED, UNDECIDED)
-    assert static['reasons'][0] == (
+    static, table = _verdicts(s)[:2]
+    assert (static.verdict, table.verdict) == (UNDECIDED, UNDECIDED)
+    assert static.reasons[0] == (
         '1 of 1 bins emptied: at least 5 % and at most 100 % (one-sided 95 % exact bounds '
         '(Clopper-Pearson)); required 90 % (requirements.success_rate); not settled: 29 '
         'iterations would settle it if the rate seen held')
-    assert table['reasons'][0].endswith('not settled: 3 runs give the fitted bound')
+    assert table.reasons[0].endswith('not settled: 3 runs give the fitted bound')
     _rates(s, 29, 29, 29)       # 29 of 29 clear 90 % one-sidedly (the two-sided interval: 36)
-    assert [v['verdict'] for v in verdicts.verdicts(s)][:2] == [FEASIBLE, FEASIBLE]
+    assert [v.verdict for v in _verdicts(s)][:2] == [FEASIBLE, FEASIBLE]
     _rates(s, 0, 0, 40)         # the paper's static bins: 0 of 40
-    assert [v['verdict'] for v in verdicts.verdicts(s)][:2] == [NOT_FEASIBLE, NOT_FEASIBLE]
+    assert [v.verdict for v in _verdicts(s)][:2] == [NOT_FEASIBLE, NOT_FEASIBLE]
     _rates(s, 36, 36, 40)       # 90 % seen, at the requirement itself
-    assert 'no number of iterations would' in verdicts.verdicts(s)[0]['reasons'][0]
+    assert 'no number of iterations would' in _verdicts(s)[0].reasons[0]
     # A tunnelled iteration (left out of the figures) leaves no option feasible, and says so
     # first.
     _rates(s, 40, 40, 40)
     s['experiments']['feeder']['faults'].update(
         tunnelled=1, flagged=[{'group': 0, 'iteration': 3, 'fault': 'tunnelled'}])
-    table = verdicts.verdicts(s)[1]
-    assert table['verdict'] == NOT_FEASIBLE
-    assert table['reasons'][0] == '1 iteration flagged: tunnelled 1 (see Physics health)'
+    table = _verdicts(s)[1]
+    assert table.verdict == NOT_FEASIBLE
+    assert table.reasons[0] == '1 iteration flagged: tunnelled 1 (see Physics health)'
     s['experiments']['feeder']['stops'] = {'stop: empty': 1, 'stop: vibration limit': 2}
     assert 'runs ended by: feeder and table empty 1, vibration limit 2)' in \
-        verdicts.verdicts(s)[1]['reasons'][4]
+        _verdicts(s)[1].reasons[4]
     # 30 parts cannot last a refill interval: that decides, and is said first, whatever the
     # rate would have said (here: not enough iterations to decide)
     s['requirements']['capacity'] = 480
     _rates(s, 1, 1, 1)
-    bin_verdict = verdicts.verdicts(s)[0]
-    assert bin_verdict['verdict'] == NOT_FEASIBLE
+    bin_verdict = _verdicts(s)[0]
+    assert bin_verdict.verdict == NOT_FEASIBLE
     # the bin the emptying ran in, by its size in mm, as a person writes it
     x, y, z = (f'{v:g}' for v in s['experiments']['emptying']['bin_mm'])
-    assert bin_verdict['option'] == f'static bin {x} x {y} x {z} mm'
-    assert bin_verdict['reasons'][0] == ('the bin was filled with 30 parts, fewer than the 480 '
+    assert bin_verdict.option == f'static bin {x} x {y} x {z} mm'
+    assert bin_verdict.reasons[0] == ('the bin was filled with 30 parts, fewer than the 480 '
                                          'a refill interval needs')
-    assert bin_verdict['reasons'][1].startswith('1 of 1 bins emptied')
+    assert bin_verdict.reasons[1].startswith('1 of 1 bins emptied')
     del s['experiments']['emptying'], s['experiments']['feeder'], s['experiments']['grippers']
-    assert [v['verdict'] for v in verdicts.verdicts(s)] == [NOT_ANALYSED, NOT_ANALYSED]
+    assert [v.verdict for v in _verdicts(s)] == [NOT_ANALYSED, NOT_ANALYSED]
 
 
 def test_the_gripper_verdict_names_the_smallest_gripper_that_meets_the_yield(run_dir):
@@ -195,33 +205,33 @@ def test_the_gripper_verdict_names_the_smallest_gripper_that_meets_the_yield(run
     for v in g['variants']:
         v.update(meets=False, valid_ci95=[0.1, 0.9])     # every interval below min_valid 1
     g['smallest'] = None
-    verdict = verdicts.verdicts(s)[2]
-    assert verdict['verdict'] == NOT_FEASIBLE and verdict['option'] == 'gripper (`grippers`)'
-    assert verdict['reasons'][0].startswith('no gripper of the sweep gives 1 valid parts per '
+    verdict = _verdicts(s)[2]
+    assert verdict.verdict == NOT_FEASIBLE and verdict.option == 'gripper (`grippers`)'
+    assert verdict.reasons[0].startswith('no gripper of the sweep gives 1 valid parts per '
                                             'check at 95 % confidence; the most: D ')
     # One interval that reaches min_valid, and one scene that gives none: not decided. A
     # count's interval is said from 0.
     g['variants'][0]['valid_ci95'] = [-0.5, 1.5]
-    assert verdicts.interval_text(g['variants'][0]) == '0 to 1.5'
+    assert verdicts.interval_text(summary.Variant.model_validate(g['variants'][0])) == '0 to 1.5'
     g['variants'][1]['valid_ci95'] = [None, None]
-    verdict = verdicts.verdicts(s)[2]
-    assert verdict['verdict'] == UNDECIDED
-    assert verdict['reasons'][1] == ('not enough scenes to decide: 2 grippers of the sweep had '
+    verdict = _verdicts(s)[2]
+    assert verdict.verdict == UNDECIDED
+    assert verdict.reasons[1] == ('not enough scenes to decide: 2 grippers of the sweep had '
                                      'an interval reaching 1, or too few scenes for one')
     g['variants'][1].update(meets=True, valid_ci95=[1.5, 2.5])
     g['smallest'] = 1
-    verdict = verdicts.verdicts(s)[2]
-    assert verdict['verdict'] == FEASIBLE
-    assert verdict['option'] == ('gripper D 8, W 3, V 15, L 60, clearance 1 mm; grasps upright '
+    verdict = _verdicts(s)[2]
+    assert verdict.verdict == FEASIBLE
+    assert verdict.option == ('gripper D 8, W 3, V 15, L 60, clearance 1 mm; grasps upright '
                                  '(`grippers`)')
-    assert '95 % interval 1.5 to 2.5' in verdict['reasons'][0]
+    assert '95 % interval 1.5 to 2.5' in verdict.reasons[0]
     assert '8 grippers x grasp sets checked on the same 2 scenes of 14 parts' in \
-        verdict['reasons'][1]
-    text = report.markdown(s, {}, {})
+        verdict.reasons[1]
+    text = _markdown(s)
     assert '| D 8, W 3, V 15, L 60, clearance 1 mm; grasps upright |' in text
     assert '| 1.5 to 2.5 |' in text and '| **smallest** |' in text
     g['faults']['tunnelled'] = 1        # a scene left out: no answer to rely on
-    assert verdicts.verdicts(s)[2]['verdict'] == NOT_FEASIBLE
+    assert _verdicts(s)[2].verdict == NOT_FEASIBLE
 
 
 def test_the_papers_numbers_stand_beside_ours_for_its_test_case(run_dir, tmp_path):
@@ -252,10 +262,11 @@ def _as_paper_says(summary: dict, paper: dict) -> dict:
     b['bins'][b['best_bin']]['size_mm'] = b['best_bin_mm'] = [100.0, 175.0, 15.0]
     b['bins'][b['best_bin']]['fractions']['container_free']['mean'] = 0.25
     # 2500 - 0.25 (n - 49)^2 over n = 1..100: a peak at 49, 26 % lower at n = 100
-    w.update(per_n=[{'n': n, 'valid': {'mean': 0.0}} for n in range(1, 101)],
+    none = {'n': 1, 'mean': 0.0, 'min': 0.0, 'max': 0.0, 'std': 0.0}
+    w.update(per_n=[{'n': n, 'valid': none} for n in range(1, 101)],
              coefficients=[-0.25, 24.5, 2500.0 - 0.25 * 49.0 ** 2], n_star=49, fit_max=2500.0,
              no_valid=False)
-    f.update(emptied=50, iterations=50, lost=0)
+    f.update(emptied=50, iterations=50)
     f['vibrations_to_empty']['mean'] = 130.0
     return s
 
@@ -263,7 +274,7 @@ def _as_paper_says(summary: dict, paper: dict) -> dict:
 def test_against_the_paper_says_which_findings_hold_and_why_figures_differ(run_dir):
     paper = verdicts.PAPER['pth0']
     s = _as_paper_says(_summary(run_dir), paper)
-    text = '\n'.join(verdicts.against_paper(s, paper))
+    text = '\n'.join(verdicts.against_paper(summary.validate(s), paper))
     assert text.count('| agrees |') == 3 and '| differs |' not in text, text
     assert 'rise to n* = 49, then fall: 26 % below the peak at n = 100 (fit)' in text
     assert '| best bin (mm) | 100 x 175 x 15 | 100 x 175 x 15 | the same |' in text
@@ -275,7 +286,7 @@ def test_against_the_paper_says_which_findings_hold_and_why_figures_differ(run_d
     s['experiments']['feeder'].update(emptied=47, runs_spilling=3)
     s['experiments']['feeder']['physics']['spilled'] = 4
     s['experiments']['feeder']['vibrations_to_empty']['mean'] = 250.0
-    text = '\n'.join(verdicts.against_paper(s, paper))
+    text = '\n'.join(verdicts.against_paper(summary.validate(s), paper))
     assert '| static bins never emptied (0 of 40) | 1 of 40 emptied | differs |' in text
     assert 'then level off: 1 % below the peak' in text
     assert '| the tray emptied in every feeder run (50 of 50) | 47 of 50 emptied | differs |' \
@@ -289,13 +300,13 @@ def test_against_the_paper_says_which_findings_hold_and_why_figures_differ(run_d
 
     s['experiments']['sweep'].update(n_star=100)
     assert "still rising at the sweep's last count, n = 100" in '\n'.join(
-        verdicts.against_paper(s, paper))
+        verdicts.against_paper(summary.validate(s), paper))
     s['experiments']['sweep'].update(no_valid=True, fit_max=0.0)
     assert 'no valid part at any count: the gripper cannot pick this part' in '\n'.join(
-        verdicts.against_paper(s, paper))
-    assert '**No valid part at any count**' in report.markdown(s, {}, {})
+        verdicts.against_paper(summary.validate(s), paper))
+    assert '**No valid part at any count**' in _markdown(s)
     s['experiments']['sweep'].update(no_valid=False, fit_max=2500.0)
-    page = report.to_html(report.markdown(s, {}, {}), 'pth0')
+    page = report.to_html(_markdown(s), 'pth0')
     against = page.split('<h2>Against the paper</h2>')[1].split('<h2>')[0]
     assert against.count('<li>') == 4
 

@@ -4,13 +4,16 @@ the case), and a run that stops once it is settled, on the real cores."""
 from dataclasses import replace
 import json
 import os
+from types import SimpleNamespace
 
 from experiment_manager import experiment_file
 from experiment_manager.analysis import metrics, report
+from experiment_manager.analysis.headlines import headlines
+from experiment_manager.analysis.report import Run
 from experiment_manager.analysis.results import read_text_rows, ResultsWriter
+from experiment_manager.analysis.summary import Sampling, validate
 from experiment_manager.analysis.verdicts import NOT_FEASIBLE, verdicts
 from experiment_manager.analysis.wording import sampling_end
-from experiment_manager.commands.run import _summary_lines
 from experiment_manager.running import sampling
 from experiment_manager.running.local_backend import LocalBackend
 from experiment_manager.running.scheduler import Runner
@@ -270,12 +273,12 @@ def test_an_adaptive_run_stops_a_feeder_study_that_settled_and_keeps_the_fixed_c
     assert s['iterations'] == 4 and s['accepted'] == 0
     assert rows == runs['fixed'][1][:4]
     assert 'sampling' not in runs['fixed'][0]['experiments']['feeder']
-    assert verdicts(summary)[1]['verdict'] == NOT_FEASIBLE
+    assert verdicts(validate(summary))[1].verdict == NOT_FEASIBLE
     assert metrics.rate_interval(0, 4)[1] < 0.9
     # The terminal and the report say how many iterations ran and why they stopped.
-    assert '[adaptive: 4 of 6 iterations, settled]' in _summary_lines(summary)[0]
-    assert '| `feeder` | 4 | 6 | 2 | settled |' in report.markdown(summary, {}, {})
-    assert '## Sampling' not in report.markdown(runs['fixed'][0], {}, {})
+    assert '[adaptive: 4 of 6 iterations, settled]' in headlines(validate(summary))[0]
+    assert '| `feeder` | 4 | 6 | 2 | settled |' in report.markdown(Run(validate(summary)))
+    assert '## Sampling' not in report.markdown(Run(validate(runs['fixed'][0])))
 
 
 def test_an_interrupted_adaptive_run_resumes_to_the_same_batches_and_results(tmp_path):
@@ -334,20 +337,22 @@ def test_an_adaptive_race_that_runs_out_names_the_bins_it_could_not_tell_apart(t
     s = summary['experiments']['bins']
     assert s['sampling']['settled'] is False and s['sampling']['tied_bins'] == [0, 1]
     said = 'not settled: bins 100 x 100 x 20 and 120 x 80 x 20 mm could not be told apart'
-    assert said in _summary_lines(summary)[0]
-    assert f'at the most iterations, {said}' in report.markdown(summary, {}, {})
+    assert said in headlines(validate(summary))[0]
+    assert f'at the most iterations, {said}' in report.markdown(Run(validate(summary)))
 
 
 def test_a_tie_is_said_with_its_bins():
-    experiment = {'bins': [{'index': 0, 'size_mm': [100, 100, 20]},
-                           {'index': 1, 'size_mm': [120, 80, 20]},
-                           {'index': 2, 'size_mm': [75, 75, 40]}],
-                  'sampling': {'settled': True, 'tie': [1, 0], 'tie_within': 0.05,
-                               'race_confidence': sampling.RACE_CONFIDENCE}}
+    bins = [SimpleNamespace(index=i, size_mm=size) for i, size in enumerate(
+        ([100, 100, 20], [120, 80, 20], [75, 75, 40]))]
+    said = Sampling(mode='adaptive', batch=2, batches=3, iterations_run=6, most=40,
+                    settled=True, tie=[1, 0], tie_within=0.05,
+                    race_confidence=sampling.RACE_CONFIDENCE)
+    experiment = SimpleNamespace(bins=bins, sampling=said)
     assert sampling_end(experiment) == ('settled: bins 120 x 80 x 20 and 100 x 100 x 20 mm tie '
                                         'within 5.0 % of the first, which has the highest mean '
                                         '(one-sided 99.95 % bounds of the differences)')
-    del experiment['sampling']['race_confidence']       # a summary of a run before 2026-11-27
+    # a version-0 summary has no race_confidence: its race compared intervals
+    experiment.sampling = said.model_copy(update={'race_confidence': None})
     assert sampling_end(experiment).endswith('(99.9 % intervals)')
-    del experiment['sampling']['tie']
+    experiment.sampling = said.model_copy(update={'tie': None})
     assert sampling_end(experiment) == 'settled'

@@ -6,12 +6,15 @@ the graph."""
 import os
 
 from experiment_manager import experiment_file
-from experiment_manager.analysis import report
+from experiment_manager.analysis import metrics, report
+from experiment_manager.analysis.headlines import headlines
+from experiment_manager.analysis.report import Run
+from experiment_manager.analysis.report.sensitivity import section as sensitivity_section
 from experiment_manager.analysis.results import read_csv, read_text_rows, ResultsWriter
 from experiment_manager.analysis.sensitivity import _held_said, _map, _robustness
 from experiment_manager.analysis.sensitivity import summarise as sensitivity_summary
+from experiment_manager.analysis.summary import Sensitivity, validate
 from experiment_manager.analysis.verdicts import verdicts
-from experiment_manager.commands.run import _summary_lines
 from experiment_manager.commands.run import main as run_main
 from experiment_manager.experiment_file.plan import plan
 from experiment_manager.experiment_file.scenarios import latin_hypercube, point_key
@@ -32,6 +35,15 @@ experiments:
   - {id: emptying, type: bin_emptying, iterations: 4, parts: 20, bin: bins}
   - {id: sweep, type: table_sweep, iterations: 1, counts: {first: 2, last: 6, step: 2}}
 """
+
+
+def _typed(said: dict) -> Sensitivity:
+    """A sensitivity experiment's summary as summary.json holds it, from the keys a test sets
+    (the rest: no held experiment, no tornado, no fault, no physics)."""
+    return Sensitivity.model_validate({
+        'type': 'sensitivity', 'held': {}, 'tornado': {},
+        'faults': {**dict.fromkeys(metrics.FAULTS, 0), 'flagged': []},
+        'physics': metrics.physics([]), **said})
 
 
 @pytest.fixture(scope='module')
@@ -159,20 +171,21 @@ def test_the_repeats_ran_with_their_scenario_and_the_summary_compares_them(sens)
     table = next(r for r in s['robustness'] if r['option'] == 'vibrating table')
     said = {x['verdicts']['vibrating table'] for x in s['scenarios']}
     assert table['holds'] == (said == {table['verdict']})
-    reasons = next(v for v in verdicts(summary) if v['option'] == 'vibrating table')['reasons']
+    reasons = next(v for v in verdicts(validate(summary))
+                   if v.option == 'vibrating table').reasons
     assert reasons[-1] == f'over the ranges of `robust`: {table["said"]}'
-    assert f'    {table["line"]}' in _summary_lines(summary)
+    assert f'    {table["line"]}' in headlines(validate(summary))
 
 
 def test_the_report_draws_the_tornado_and_lists_the_scenarios(sens, tmp_path):
     directory, summary = sens
-    text = report.markdown(summary, {}, {'sensitivity_robust': True})
+    text = report.markdown(Run(validate(summary), figures={'sensitivity_robust': True}))
     section = text.split('## How far the answers move (`robust`)')[1].split('\n## ')[0]
     assert '![tornado chart of robust](sensitivity_robust.png)' in section
     assert '| `part.lateral_friction` | 0.5 | 0.3 | 0.8 | a guess, for the tests |' in section
     assert '| part_lateral_friction_low | part.lateral_friction 0.3 |' in section
     path = str(tmp_path / 'tornado.png')
-    assert report.plot_tornado('robust', summary['experiments']['robust'], path)
+    assert report.plot_tornado('robust', validate(summary).experiments['robust'], path)
     with open(path, 'rb') as f:
         assert f.read(8) == b'\x89PNG\r\n\x1a\n'
 
@@ -262,9 +275,9 @@ def test_a_grid_maps_the_verdicts_over_two_inputs():
     assert m['verdicts']['static bin'][0][0] == 'FEASIBLE'      # the body's low scenario
     assert m['verdicts']['static bin'][2][2] == 'NOT FEASIBLE'
     assert m['verdicts']['static bin'][1][1] == 'UNDECIDED'
-    text = report._sensitivity('robust', {
+    text = sensitivity_section('robust', _typed({
         'of': ['emptying'], 'scenarios': [], 'iterations': 1, 'inputs': [], 'robustness': [],
-        'ranges': {}, 'base': {'answers': {}, 'verdicts': {}}, 'map': m}, False)
+        'ranges': {}, 'base': {'answers': {}, 'verdicts': {}}, 'map': m}), False)
     assert '| 12 | **FEASIBLE** | **UNDECIDED** | **UNDECIDED** |' in text
     # a level at the file's value: that grid point is the file's own run
     centred = experiment_file.parse(sensitivity(
@@ -304,7 +317,7 @@ def test_only_the_options_whose_runs_are_repeated_are_said_to_hold(small):
     # the feeder's range came from the sweep, not repeated: said with the section and a flip
     assert said['held'] == {'feeder': {'what': 'range', 'from': 'sweep'}}
     assert '`feeder` ran at the range of `sweep`' in '\n'.join(
-        report._sensitivity('robust', said, False))
+        sensitivity_section('robust', _typed(said), False))
     flipped = _held_said([{**said['robustness'][0], 'holds': False, 'flips': [{}],
                            'line': 'vibrating table FEASIBLE here, but NOT FEASIBLE at x 1'}],
                          said['held'])

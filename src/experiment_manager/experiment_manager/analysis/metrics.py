@@ -25,6 +25,7 @@ from ..experiment_file import (
     TABLE_SWEEP,
 )
 from . import decisions
+from .summary import SCHEMA_VERSION
 
 # The physics faults an iteration is flagged with (procedures.faults); the first three leave it
 # out of the figures.
@@ -358,12 +359,13 @@ def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: li
 
 
 def file_summary(file: ExperimentFile, summaries: dict) -> dict:
-    """The run's summary: `experiments`, the file's own by id; `repeats`, a sensitivity
-    experiment's repeats of them in its scenarios (id `<experiment>@<scenario>`), apart, so
-    that the verdicts and the report's tables are the file's experiments'."""
+    """The run's summary, as summary.json holds it (summary.Summary describes it):
+    `experiments`, the file's own by id; `repeats`, a sensitivity experiment's repeats of them
+    in its scenarios (id `<experiment>@<scenario>`), apart, so that the verdicts and the
+    report's tables are the file's experiments'."""
     r = file.requirements
     repeats = {k: v for k, v in summaries.items() if '@' in k}
-    return {'id': file.id, 'seed': file.seed,
+    return {'schema_version': SCHEMA_VERSION, 'id': file.id, 'seed': file.seed,
             'requirements': {'parts_per_hour': r.parts_per_hour,
                              'refill_interval_h': r.refill_interval / 3600.0,
                              'capacity': r.capacity, 'success_rate': r.success_rate,

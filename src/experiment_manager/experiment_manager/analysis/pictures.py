@@ -29,6 +29,7 @@ from scipy.spatial.transform import Rotation
 from ..experiment_file import BIN_EMPTYING, ExperimentFile, TABLE_SWEEP
 from ..experiment_file.plan import plan, Unit
 from . import part_sheet
+from . import summary as summary_model
 
 SIZE = (800, 600)
 # stage: (its name in the pictures' files, what a part stopped there hits)
@@ -205,7 +206,7 @@ def tray_picture(file: ExperimentFile, summary: dict, run_dir: str,
     """tray.png at the count nearest n*, and the parts its stages stopped that the bin did not
     show (`stopped_in_world`); returns its caption (None: nothing to draw)."""
     exp = next((e for e in file.experiments if e.type == TABLE_SWEEP), None)
-    if exp is None or 'n_star' not in summary['experiments'].get(exp.id, {}):
+    if exp is None or summary['experiments'].get(exp.id, {}).get('n_star') is None:
         return None
     n_star = summary['experiments'][exp.id]['n_star']
     n = min(exp.counts, key=lambda c: (abs(c - n_star), c))
@@ -226,8 +227,10 @@ def tray_picture(file: ExperimentFile, summary: dict, run_dir: str,
 def write(file: ExperimentFile, run_dir: str) -> dict[str, str]:
     """Render the pictures of a finished run; returns {file name: caption}, also written to
     pictures.json for the report."""
-    with open(os.path.join(run_dir, 'summary.json'), encoding='utf-8') as f:
-        summary = json.load(f)
+    typed = summary_model.read(os.path.join(run_dir, 'summary.json'))
+    # the experiments' summaries as the scheduler keeps them, which plan() reads
+    summary = {'experiments': {k: v.model_dump(by_alias=True, exclude_unset=True)
+                               for k, v in typed.experiments.items()}}
     captions: dict[str, str] = {}
     for name, draw in (('bin.png', bin_picture), ('tray.png', tray_picture)):
         caption = draw(file, summary, run_dir, captions)

@@ -25,6 +25,7 @@ import tempfile
 from pick_common.errors import InvalidArgument
 
 from .rows import FILES, KEY, parse_row, Record
+from .summary import validate
 
 UMASK = os.umask(0o022)
 os.umask(UMASK)
@@ -234,6 +235,9 @@ class ResultsWriter:
         return [r for r in self._rows['checks'] if r['experiment'] == experiment_id]
 
     def write_summary(self, summary: dict) -> None:
+        """summary.json, checked against its model first (summary.validate): a summary that
+        breaks the published schema is a bug of ours, raised here, never written."""
+        validate(summary)
         self._write_text('summary.json', json.dumps(summary, indent=2, allow_nan=False) + '\n')
 
     def close(self) -> None:

@@ -1,5 +1,5 @@
 """How far a run's answers and verdicts move with the inputs nobody can measure before the
-hardware is bought: a sensitivity experiment's summary (issue 44).
+hardware is bought: a sensitivity experiment's summary.
 
 A sensitivity experiment repeats experiments of the file in scenarios (experiment_file/
 scenarios.py: each input at its low and its high, the others at the file's values, and jointly
@@ -10,7 +10,7 @@ on the scenario's repeats standing in for the experiments they repeat; only the 
 whose deciding experiment is repeated: the static bin's bin_emptying, the table's
 feeder_emptying, a gripper_sweep); per input, each
 answer at its low and its high against the file's values (a tornado chart's bars,
-report.py); and per option whether its verdict holds in every scenario or which scenarios
+report/plots.py); and per option whether its verdict holds in every scenario or which scenarios
 flip it, with the inputs' values there.
 
 Pure: no rclpy, no files.
@@ -20,7 +20,8 @@ from ..experiment_file import ExperimentFile
 from ..experiment_file.model import Experiment
 from ..experiment_file.scenarios import grid_levels, point_key
 from . import metrics
-from .verdicts import NOT_ANALYSED, option_kind, UNDECIDED, verdicts
+from . import summary as summary_model
+from .verdicts import NOT_ANALYSED, UNDECIDED, verdicts
 from .wording import fmt
 
 # answer -> (its words, its unit)
@@ -76,9 +77,8 @@ def summarise(file: ExperimentFile, exp: Experiment, summaries: dict) -> dict:
         f'gripper (`{e}`)' for e in exp.of if base[e]['type'] == 'gripper_sweep'}
 
     def decided(experiments: dict) -> dict:
-        said = verdicts(metrics.file_summary(file, experiments))
-        return {option_kind(v['option']): v['verdict'] for v in said
-                if v['verdict'] != NOT_ANALYSED and option_kind(v['option']) in moved}
+        said = verdicts(summary_model.validate(metrics.file_summary(file, experiments)))
+        return {v.kind: v.verdict for v in said if v.verdict != NOT_ANALYSED and v.kind in moved}
 
     def said(experiments: dict) -> dict:
         # the answers of the experiments repeated (the others' do not move)
@@ -200,6 +200,6 @@ def _faults(repeats: dict) -> dict:
 def _physics(repeats: dict) -> dict:
     """The repeats' physics health (metrics.physics' keys): totals and worsts."""
     total = ('spilled', 'tunnelled', 'thrown')
-    keys = next(iter(repeats.values()))['physics'] if repeats else {}
-    return {k: (sum if k in total else max)(r['physics'][k] for r in repeats.values())
-            for k in keys}
+    none = metrics.physics([])      # the health of no iteration: every count 0
+    values = {k: [r['physics'][k] for r in repeats.values()] for k in none}
+    return {k: sum(v) if k in total else max(v, default=none[k]) for k, v in values.items()}

@@ -1,6 +1,6 @@
 """The decisions of a run: a verdict per option (static bin, vibrating table) with its reasons,
 and, for the paper's test-case files, the paper's findings checked on the run (against_paper).
-Rendering them is report.py's job.
+Rendering them is report/'s job.
 
 Verdicts, per option, each resting on what its runs measure, bounded one-sidedly where the
 requirement is one-sided (decisions.py; the bounds are computed with the metrics, metrics.py,
@@ -25,11 +25,14 @@ feasible.
 An option whose experiment did not run is "not analysed".
 """
 
+from dataclasses import dataclass, field
+
 import numpy as np
 
 from . import decisions
 from .metrics import EXCLUDED, FAULTS
-from .wording import count, dims, fmt, gripper_label, of_type, pct, table
+from .summary import Decision, GripperSweep, Summary, Variant
+from .wording import count, dims, fmt, gripper_label, pct, table
 
 # The paper's results (section 5) for its test case, by experiment-file id.
 PAPER = {
@@ -57,89 +60,86 @@ FEASIBLE, NOT_FEASIBLE, UNDECIDED, NOT_ANALYSED = ('FEASIBLE', 'NOT FEASIBLE', '
 _STOPS = {'stop: empty': 'feeder and table empty', 'stop: vibration limit': 'vibration limit'}
 
 
-def verdicts(summary: dict) -> list[dict]:
-    """The decision per option: option, verdict, and the reasons (for people)."""
-    capacity = summary['requirements']['capacity']
+@dataclass
+class Verdict:
+    """An option's decision: `option` as people read it ('static bin 100 x 175 x 15 mm'),
+    `kind` as scenarios compare it ('static bin' whichever bin was best, a gripper sweep's by
+    its experiment, 'gripper (`id`)', whichever gripper was smallest), the verdict, the reasons
+    (the first decides), and the grounds it rests on, by name."""
+    option: str
+    kind: str
+    verdict: str
+    reasons: list[str]
+    grounds: dict[str, Decision] = field(default_factory=dict)
+
+
+def verdicts(summary: Summary) -> list[Verdict]:
+    """The decision per option, in the order static bin, vibrating table, gripper sweeps."""
+    capacity = summary.requirements.capacity
+    required = summary.requirements.success_rate
     out = []
-    emptying = of_type(summary, 'bin_emptying')
-    if emptying:
-        _, s = emptying[-1]
-        decision = s['decision']
-        verdict = decision['verdict']
-        reasons = [decision['reason'] + _more(decision, summary['requirements']['success_rate']),
-                   f'parts removed per bin: mean {fmt(s["removed"]["mean"])}, max '
-                   f'{fmt(s["removed"]["max"])} of {s["parts"]}']
-        verdict, reasons = _decided(verdict, reasons, s, None if s['parts'] >= capacity else
-                                    f'the bin was filled with {s["parts"]} parts, fewer than '
+    s = summary.last('bin_emptying')
+    if s:
+        decision = s.decision
+        reasons = [decision.reason + _more(decision, required),
+                   f'parts removed per bin: mean {fmt(s.removed.mean)}, max '
+                   f'{fmt(s.removed.max)} of {s.parts}']
+        verdict, reasons = _decided(decision.verdict, reasons, s,
+                                    None if s.parts >= capacity else
+                                    f'the bin was filled with {s.parts} parts, fewer than '
                                     f'the {capacity} a refill interval needs')
-        out.append({'option': f'static bin {dims(s["bin_mm"])} mm', 'verdict': verdict,
-                    'reasons': reasons, 'grounds': {'emptied': decision}})
+        out.append(Verdict(f'static bin {dims(s.bin_mm)} mm', 'static bin', verdict, reasons,
+                           {'emptied': decision}))
     else:
-        out.append({'option': 'static bin', 'verdict': NOT_ANALYSED,
-                    'reasons': ['no bin_emptying experiment in the file']})
-    feeder = of_type(summary, 'feeder_emptying')
-    if feeder:
-        _, s = feeder[-1]
-        grounds = s['decision']
+        out.append(Verdict('static bin', 'static bin', NOT_ANALYSED,
+                           ['no bin_emptying experiment in the file']))
+    s = summary.last('feeder_emptying')
+    if s:
+        grounds = {'time': s.decision.time, 'spills': s.decision.spills}
         time, spills = grounds['time'], grounds['spills']
-        verdict = decisions.combined([g['verdict'] for g in grounds.values()])
-        settled = [f'{name} {g["verdict"]}' for name, g in grounds.items()
-                   if g['verdict'] != UNDECIDED]
-        open_ = [name for name, g in grounds.items() if g['verdict'] == UNDECIDED]
-        v = s['vibrations_to_empty']
+        verdict = decisions.combined([g.verdict for g in grounds.values()])
+        settled = [f'{name} {g.verdict}' for name, g in grounds.items()
+                   if g.verdict != UNDECIDED]
+        open_ = [name for name, g in grounds.items() if g.verdict == UNDECIDED]
+        v = s.vibrations_to_empty
         # the ground that decides first (run prints only the first reason): NOT FEASIBLE,
         # then UNDECIDED, then FEASIBLE; the time first among equals
-        said = sorted([(time, time['reason'] + _more(time, summary['requirements']
-                                                      ['success_rate'])),
-                       (spills, spills['reason'])],
-                      key=lambda g: [NOT_FEASIBLE, UNDECIDED, FEASIBLE].index(g[0]['verdict']))
+        said = sorted([(time, time.reason + _more(time, required)), (spills, spills.reason)],
+                      key=lambda g: [NOT_FEASIBLE, UNDECIDED, FEASIBLE].index(g[0].verdict))
         reasons = [said[0][1], said[1][1],
                    'grounds settled: ' + (', '.join(settled) or 'none')
                    + ('; not settled: ' + ', '.join(open_) if open_ else ''),
-                   f'{s["emptied"]} of {s["iterations"]} feeder runs emptied '
-                   f'(optimal range {s["optimal_range"][0]}-{s["optimal_range"][1]} parts on '
+                   f'{s.emptied} of {s.iterations} feeder runs emptied '
+                   f'(optimal range {s.optimal_range[0]}-{s.optimal_range[1]} parts on '
                    f'the table; runs ended by: '
-                   f'{", ".join(f"{_STOPS.get(k, k)} {n}" for k, n in s["stops"].items())})']
-        if v['mean'] is not None:
-            reasons.append(f'vibrations to empty the feeder: mean {fmt(v["mean"], 4)}; the '
+                   f'{", ".join(f"{_STOPS.get(k, k)} {n}" for k, n in s.stops.items())})']
+        if v.mean is not None:
+            reasons.append(f'vibrations to empty the feeder: mean {fmt(v.mean, 4)}; the '
                            f'refill interval allows one vibration every '
-                           f'{fmt(s["minutes_per_vibration_allowed"])} min')
-        rate = s.get('parts_per_hour') or {}
-        if rate.get('mean') is not None:
-            reasons.append(f'the cell would pick {fmt(rate["mean"], 4)} parts per hour on '
-                           f'average, at {fmt(s["cell"]["pick_s"])} s per pick and '
-                           f'{fmt(s["cell"]["image_s"])} s per image (cell.pick_s, '
+                           f'{fmt(s.minutes_per_vibration_allowed)} min')
+        if s.parts_per_hour.mean is not None:
+            reasons.append(f'the cell would pick {fmt(s.parts_per_hour.mean, 4)} parts per hour '
+                           f'on average, at {fmt(s.cell.pick_s)} s per pick and '
+                           f'{fmt(s.cell.image_s)} s per image (cell.pick_s, '
                            'cell.image_s) and the simulated time of the feeds and vibrations')
-        verdict, reasons = _decided(verdict, reasons, s, None if s['parts'] >= capacity else
-                                    f'the feeder held {s["parts"]} parts, fewer than the '
+        verdict, reasons = _decided(verdict, reasons, s, None if s.parts >= capacity else
+                                    f'the feeder held {s.parts} parts, fewer than the '
                                     f'{capacity} a refill interval needs')
-        out.append({'option': 'vibrating table', 'verdict': verdict, 'reasons': reasons,
-                    'grounds': grounds})
+        out.append(Verdict('vibrating table', 'vibrating table', verdict, reasons, grounds))
     else:
-        out.append({'option': 'vibrating table', 'verdict': NOT_ANALYSED,
-                    'reasons': ['no feeder_emptying experiment in the file']})
-    out += [_gripper_verdict(exp_id, s) for exp_id, s in of_type(summary, 'gripper_sweep')]
-    for exp_id, s in of_type(summary, 'sensitivity'):     # how far each verdict moves
-        lines = {r['option']: r['said'] for r in s['robustness']}
+        out.append(Verdict('vibrating table', 'vibrating table', NOT_ANALYSED,
+                           ['no feeder_emptying experiment in the file']))
+    out += [_gripper_verdict(exp_id, s) for exp_id, s in summary.of_type('gripper_sweep')]
+    for exp_id, s in summary.of_type('sensitivity'):     # how far each verdict moves
+        lines = {r.option: r.said for r in s.robustness}
         for v in out:
-            if option_kind(v['option']) in lines:
-                v['reasons'].append(f'over the ranges of `{exp_id}`: '
-                                    f'{lines[option_kind(v["option"])]}')
+            if v.kind in lines:
+                v.reasons.append(f'over the ranges of `{exp_id}`: {lines[v.kind]}')
     return out
 
 
-def option_kind(option: str) -> str:
-    """An option as scenarios compare it: 'static bin' whichever bin was best, a gripper
-    sweep's by its experiment ('gripper (`id`)') whichever gripper was smallest."""
-    if option.startswith('static bin'):
-        return 'static bin'
-    if option.startswith('gripper') and '(`' in option:
-        return 'gripper (' + option[option.index('(`') + 1:]
-    return option
-
-
-def _decided(verdict: str, reasons: list[str], s: dict,
-             shortfall: str | None) -> tuple[str, list[str]]:
+def _decided(verdict: str, reasons: list[str], s, shortfall: str | None
+             ) -> tuple[str, list[str]]:
     """An option's verdict and reasons after what decides it whatever its rate says: a
     container that cannot hold a refill interval's parts (`shortfall`, its sentence) and
     iterations left out of the figures make it NOT FEASIBLE, and their reasons come first (run
@@ -151,88 +151,81 @@ def _decided(verdict: str, reasons: list[str], s: dict,
     return verdict, first + reasons + ([] if left_out else faults)
 
 
-def _more(decision: dict, required: float) -> str:
+def _more(decision: Decision, required: float) -> str:
     """For an unsettled ground, what would settle it."""
-    if decision['verdict'] != UNDECIDED:
+    if decision.verdict != UNDECIDED:
         return ''
-    if 'successes' in decision:         # a rate
-        more = decisions.iterations_to_decide(decision['successes'], decision['runs'],
-                                              required)
+    if decision.successes is not None:         # a rate
+        more = decisions.iterations_to_decide(decision.successes, decision.runs, required)
         return ('; not settled: ' + (f'{more} iterations would settle it if the rate seen held'
                                      if more else 'no number of iterations would at the rate '
                                      'seen, which is the requirement itself'))
-    if decision['runs'] < 3:
+    if decision.runs < 3:
         return '; not settled: 3 runs give the fitted bound'
     return '; not settled: more runs narrow the bound (run --adaptive runs until it is settled)'
 
 
-def _gripper_verdict(exp_id: str, s: dict) -> dict:
+def _gripper_verdict(exp_id: str, s: GripperSweep) -> Verdict:
     """A gripper_sweep's answer: the smallest gripper whose valid parts per check reach
     min_valid at 95 % confidence, or that none of the sweep does."""
-    variants = s['variants']
-    where = (f'{len(variants)} grippers x grasp sets checked on the same {s["iterations"]} '
-             f'scenes of {s["parts"]} parts in the {dims(s["scene_mm"])} mm '
-             'container')
-    if s['smallest'] is None:
-        best = max(variants, key=lambda v: v['valid']['mean'] or 0.0)
+    variants = s.variants
+    where = (f'{len(variants)} grippers x grasp sets checked on the same {s.iterations} '
+             f'scenes of {s.parts} parts in the {dims(s.scene_mm)} mm container')
+    kind = f'gripper (`{exp_id}`)'
+    if s.smallest is None:
+        best = max(variants, key=lambda v: v.valid.mean or 0.0)
         # not feasible only where every gripper's interval lies below min_valid
-        open_ = [v for v in variants if v['valid_ci95'][1] is None
-                 or v['valid_ci95'][1] >= s['min_valid']]
-        option, verdict = f'gripper (`{exp_id}`)', UNDECIDED if open_ else NOT_FEASIBLE
-        reasons = [f'no gripper of the sweep gives {fmt(s["min_valid"])} valid parts per check '
+        open_ = [v for v in variants if v.valid_ci95[1] is None
+                 or v.valid_ci95[1] >= s.min_valid]
+        option, verdict = kind, UNDECIDED if open_ else NOT_FEASIBLE
+        reasons = [f'no gripper of the sweep gives {fmt(s.min_valid)} valid parts per check '
                    f'at 95 % confidence; the most: {gripper_label(best)}, mean '
-                   f'{fmt(best["valid"]["mean"])} (95 % interval {interval_text(best)})']
+                   f'{fmt(best.valid.mean)} (95 % interval {interval_text(best)})']
         if open_:
             reasons.append(f'not enough scenes to decide: {count(len(open_), "gripper")} of '
-                           f'the sweep had an interval reaching {fmt(s["min_valid"])}, or too '
+                           f'the sweep had an interval reaching {fmt(s.min_valid)}, or too '
                            'few scenes for one')
     else:
-        v = variants[s['smallest']]
+        v = variants[s.smallest]
         option, verdict = f'gripper {gripper_label(v)} (`{exp_id}`)', FEASIBLE
         reasons = [f'the smallest of the sweep whose valid parts per check reach '
-                   f'{fmt(s["min_valid"])} at 95 % confidence: mean '
-                   f'{fmt(v["valid"]["mean"])}, 95 % interval {interval_text(v)}; '
-                   f'{v["scenes_with_valid"]} of {v["scenes"]} scenes had a valid part']
+                   f'{fmt(s.min_valid)} at 95 % confidence: mean '
+                   f'{fmt(v.valid.mean)}, 95 % interval {interval_text(v)}; '
+                   f'{v.scenes_with_valid} of {v.scenes} scenes had a valid part']
     verdict, reasons = _decided(verdict, reasons + [where], s, None)
-    return {'option': option, 'verdict': verdict, 'reasons': reasons}
+    return Verdict(option, kind, verdict, reasons)
 
 
-def shown_interval(v: dict) -> tuple[float | None, float | None]:
+def shown_interval(v: Variant) -> tuple[float | None, float | None]:
     """A gripper_sweep variant's 95 % interval of valid parts per check as the report shows it
     (text and plot): from 0 where the Student-t interval reaches below (two scenes of 4 valid
     parts each gave -14 to 22; a count is never negative). summary.json keeps the interval as
     computed, and `meets` is decided on it."""
-    low, high = v['valid_ci95']
+    low, high = v.valid_ci95
     return (None, None) if low is None else (max(low, 0.0), high)
 
 
-def interval_text(v: dict) -> str:
+def interval_text(v: Variant) -> str:
     """shown_interval, as the report's sentences and tables say it."""
     low, high = shown_interval(v)
     return '-' if low is None else f'{fmt(low)} to {fmt(high)}'
 
 
-def _left_out(s: dict) -> bool:
+def _left_out(s) -> bool:
     """Whether iterations were left out of the figures (a NaN state, a tunnelled or a thrown
     part)."""
-    return any(s['faults'][k] for k in EXCLUDED)
+    return any(getattr(s.faults, k) for k in EXCLUDED)
 
 
-def _fault_reason(s: dict) -> list[str]:
+def _fault_reason(s) -> list[str]:
     """The flagged iterations, in words. Caller: an option is not feasible when any iteration
     was left out (its figures are missing)."""
-    f = s['faults']
-    if not f['flagged']:
+    f = s.faults
+    if not f.flagged:
         return []
-    return [f'{count(len(f["flagged"]), "iteration")} flagged: ' + ', '.join(
-        f'{k} {f[k]}' for k in FAULTS if f[k])
+    return [f'{count(len(f.flagged), "iteration")} flagged: ' + ', '.join(
+        f'{k} {getattr(f, k)}' for k in FAULTS if getattr(f, k))
         + ' (see Physics health)']
-
-
-def _last(summary: dict, kind: str) -> dict | None:
-    """The summary of the file's last experiment of this type (the one the report shows)."""
-    found = of_type(summary, kind)
-    return found[-1][1] if found else None
 
 
 def _ratio(ours, paper) -> str:
@@ -243,32 +236,32 @@ def _differs(ours, paper) -> bool:
     return ours is not None and bool(paper) and not 1 / DIFFERS <= ours / paper <= DIFFERS
 
 
-def _sweep_shape(s: dict) -> tuple[str, bool]:
+def _sweep_shape(s) -> tuple[str, bool]:
     """How valid parts go with the parts on the tray (the fit), and whether that is the
     paper's shape: up to a peak inside the sweep, then down by at least FALLS."""
-    last = s['per_n'][-1]['n']
-    if s.get('no_valid'):
+    last = s.per_n[-1].n
+    if s.no_valid:
         return 'no valid part at any count: the gripper cannot pick this part off the table', False
-    if s['n_star'] >= last:
+    if s.n_star >= last:
         return f"still rising at the sweep's last count, n = {last}", False
-    fall = 1 - float(np.polyval(s['coefficients'], last)) / s['fit_max']
+    fall = 1 - float(np.polyval(s.coefficients, last)) / s.fit_max
     shape = 'then fall' if fall >= FALLS else 'then level off'
-    return (f'rise to n* = {s["n_star"]}, {shape}: {100 * fall:.0f} % below the peak at '
+    return (f'rise to n* = {s.n_star}, {shape}: {100 * fall:.0f} % below the peak at '
             f'n = {last} (fit)'), fall >= FALLS
 
 
-def against_paper(summary: dict, paper: dict) -> list[str]:
+def against_paper(summary: Summary, paper: dict) -> list[str]:
     """The paper's three findings and its figures beside this run's, and where and why ours
     differ. The reasons are what we know differs between the two set-ups, not measured causes."""
     findings, figures, differ = [], [], set()
-    e, b, w, f = (_last(summary, kind) for kind in (
+    e, b, w, f = (summary.last(kind) for kind in (
         'bin_emptying', 'bin_static', 'table_sweep', 'feeder_emptying'))
     t2, t3 = paper['table2'], paper['table3']
-    if b and b['best_bin'] is not None:
-        best = b['bins'][b['best_bin']]
-        free = best['fractions']['container_free']['mean']
-        same = [float(x) for x in paper['best_bin_mm']] == [float(x) for x in b['best_bin_mm']]
-        figures += [['best bin (mm)', dims(b['best_bin_mm']),
+    if b and b.best_bin is not None:
+        best = b.bins[b.best_bin]
+        free = best.fractions.container_free.mean
+        same = [float(x) for x in paper['best_bin_mm']] == [float(x) for x in b.best_bin_mm]
+        figures += [['best bin (mm)', dims(b.best_bin_mm),
                      dims(paper['best_bin_mm']),
                      'the same' if same else 'another'],
                     ['its parts free of the bin (bin collision free)', pct(free),
@@ -276,11 +269,11 @@ def against_paper(summary: dict, paper: dict) -> list[str]:
         if not same or _differs(free, paper['container_free']):
             differ.add('bins')
     if e:
-        agrees = e['emptied'] == 0
+        agrees = e.emptied == 0
         findings.append([f'static bins never emptied ({t2["emptied"]} of {t2["iterations"]})',
-                         f'{e["emptied"]} of {e["iterations"]} emptied',
+                         f'{e.emptied} of {e.iterations} emptied',
                          'agrees' if agrees else 'differs'])
-        ours_valid, ours_removed = e['first_check']['valid']['mean'], e['removed']['mean']
+        ours_valid, ours_removed = e.first_check.valid.mean, e.removed.mean
         figures += [['valid at the first check of a full bin', pct(ours_valid),
                      pct(paper['valid_first']), _ratio(ours_valid, paper['valid_first'])],
                     ['parts removed per bin (mean)', fmt(ours_removed), fmt(t2['mean']),
@@ -288,20 +281,20 @@ def against_paper(summary: dict, paper: dict) -> list[str]:
         if not agrees or _differs(ours_valid, paper['valid_first']) \
                 or _differs(ours_removed, t2['mean']):
             differ.add('bins')
-    if w and 'n_star' in w:
+    if w and w.n_star is not None:
         shape, agrees = _sweep_shape(w)
         findings.append([f'valid parts rise with the parts on the tray, then fall (n* = '
                          f'{paper["n_star"]})', shape, 'agrees' if agrees else 'differs'])
-        figures.append(['parts on the table at the optimum, n*', w['n_star'], paper['n_star'],
-                        _ratio(w['n_star'], paper['n_star'])])
-        if not agrees or _differs(w['n_star'], paper['n_star']):
+        figures.append(['parts on the table at the optimum, n*', w.n_star, paper['n_star'],
+                        _ratio(w.n_star, paper['n_star'])])
+        if not agrees or _differs(w.n_star, paper['n_star']):
             differ.add('table')
     if f:
-        agrees = f['iterations'] > 0 and f['emptied'] == f['iterations']
+        agrees = f.iterations > 0 and f.emptied == f.iterations
         findings.append([f'the tray emptied in every feeder run ({t3["emptied"]} of '
-                         f'{t3["iterations"]})', f'{f["emptied"]} of {f["iterations"]} emptied',
+                         f'{t3["iterations"]})', f'{f.emptied} of {f.iterations} emptied',
                          'agrees' if agrees else 'differs'])
-        vib = f['vibrations_to_empty']['mean']
+        vib = f.vibrations_to_empty.mean
         figures.append(['vibrations to empty the feeder (mean)', fmt(vib, 4),
                         fmt(t3['vibrations'], 4), _ratio(vib, t3['vibrations'])])
         if not agrees or _differs(vib, t3['vibrations']):
@@ -323,9 +316,9 @@ def against_paper(summary: dict, paper: dict) -> list[str]:
               f"{1 / DIFFERS:g} times the paper's."
               + (' Where this run differs, and why:' if differ else ' None does.')]
     lines += [f'- {why[k]}' for k in ('bins', 'table', 'feeder') if k in differ]
-    if f and f['physics']['spilled']:
-        lines.append(f'- {count(f["physics"]["spilled"], "part")} spilled over the tray\'s '
-                     f'walls, in {f["runs_spilling"]} of {f["iterations"]} feeder runs; a run '
-                     f'may spill {f["max_spilled"]}.')
+    if f and f.physics.spilled:
+        lines.append(f'- {count(f.physics.spilled, "part")} spilled over the tray\'s '
+                     f'walls, in {f.runs_spilling} of {f.iterations} feeder runs; a run '
+                     f'may spill {f.max_spilled}.')
     lines += ['', 'No setting of the simulation was tuned to agree with the paper.']
     return lines

@@ -1,5 +1,5 @@
 """How the report says numbers and counts, and its Markdown tables: shared by the decisions
-(verdicts.py) and the rendering (report.py)."""
+(verdicts.py), the rendering (report/) and the terminal (commands/run.py)."""
 
 
 def fmt(value, digits: int = 3) -> str:
@@ -15,28 +15,27 @@ def dims(values) -> str:
     return ' x '.join(fmt(x) for x in values)
 
 
-def sampling_end(experiment: dict) -> str:
-    """How an adaptive experiment's sampling ended, from its summary: 'settled' (for bins that
-    tie, with them), or 'not settled', for bins with the ones the race could not tell from the
-    leader."""
-    a = experiment['sampling']
-    # a bound on a bin's difference from the leader, one-sided (running/sampling.race); a
-    # summary written before 2026-11-27 has none: its race compared 99.9 % intervals
-    bound = (f'one-sided {100 * a["race_confidence"]:g} % bounds of the differences'
-             if 'race_confidence' in a else '99.9 % intervals')
-    if a['settled']:
-        if not a.get('tie'):
+def sampling_end(experiment) -> str:
+    """How an adaptive experiment's sampling ended, from its summary (summary.py): 'settled'
+    (for bins that tie, with them), or 'not settled', for bins with the ones the race could
+    not tell from the leader."""
+    a = experiment.sampling
+    # a summary of version 0 has no race_confidence: its race compared 99.9 % intervals
+    bound = (f'one-sided {100 * a.race_confidence:g} % bounds of the differences'
+             if a.race_confidence is not None else '99.9 % intervals')
+    if a.settled:
+        if not a.tie:
             return 'settled'
-        return (f'settled: bins {_bins(experiment, a["tie"])} mm tie within '
-                f'{pct(a["tie_within"])} of the first, which has the highest mean ({bound})')
-    if not a.get('tied_bins'):
+        return (f'settled: bins {_bins(experiment, a.tie)} mm tie within '
+                f'{pct(a.tie_within)} of the first, which has the highest mean ({bound})')
+    if not a.tied_bins:
         return 'not settled'
-    return f'not settled: bins {_bins(experiment, a["tied_bins"])} mm could not be told apart ' \
+    return f'not settled: bins {_bins(experiment, a.tied_bins)} mm could not be told apart ' \
         f'({bound})'
 
 
-def _bins(experiment: dict, indices: list[int]) -> str:
-    sizes = {b['index']: dims(b['size_mm']) for b in experiment['bins']}
+def _bins(experiment, indices: list[int]) -> str:
+    sizes = {b.index: dims(b.size_mm) for b in experiment.bins}
     named = [sizes[g] for g in indices]
     return ' and '.join(filter(None, (', '.join(named[:-1]), named[-1])))
 
@@ -50,13 +49,12 @@ def pct(value) -> str:
     return '-' if value is None else f'{100 * value:.1f} %'
 
 
-def of_type(summary: dict, kind: str) -> list[tuple[str, dict]]:
-    return [(k, v) for k, v in summary['experiments'].items() if v['type'] == kind]
-
-
 def table(header: list[str], rows: list[list]) -> list[str]:
-    lines = ['| ' + ' | '.join(header) + ' |', '|' + ' --- |' * len(header)]
-    lines += ['| ' + ' | '.join(fmt(c) for c in r) + ' |' for r in rows]
+    """A Markdown table (GitHub's): a `|` inside a cell is escaped, so it stays in its cell."""
+    def cell(value) -> str:
+        return fmt(value).replace('|', '\\|')
+    lines = ['| ' + ' | '.join(cell(h) for h in header) + ' |', '|' + ' --- |' * len(header)]
+    lines += ['| ' + ' | '.join(cell(c) for c in r) + ' |' for r in rows]
     return lines
 
 
@@ -65,20 +63,20 @@ GRIPPER_WORDS = {'body_diameter_mm': 'D', 'jaw_depth_mm': 'W', 'jaw_height_mm': 
                  'body_length_mm': 'L', 'finger_clearance_mm': 'clearance'}
 
 
-def gripper_label(variant: dict, keys=tuple(GRIPPER_WORDS), grasp_set: bool = True) -> str:
+def gripper_label(variant, keys=tuple(GRIPPER_WORDS), grasp_set: bool = True) -> str:
     """A gripper_sweep variant as 'D 8, W 3 mm; grasps all': the dimensions `keys` (mm) and,
     when asked, the grasp set."""
-    sizes = ', '.join(f'{GRIPPER_WORDS[k]} {fmt(float(variant["gripper_mm"][k]))}'
+    sizes = ', '.join(f'{GRIPPER_WORDS[k]} {fmt(float(variant.gripper_mm[k]))}'
                       for k in GRIPPER_WORDS if k in keys)
     out = f'{sizes} mm' if sizes else ''
     if grasp_set:
-        out += ('; ' if out else '') + f'grasps {variant["grasp_set"]}'
+        out += ('; ' if out else '') + f'grasps {variant.grasp_set}'
     return out
 
 
-def varying(variants: list[dict]) -> tuple[tuple[str, ...], bool]:
+def varying(variants: list) -> tuple[tuple[str, ...], bool]:
     """The gripper dimensions that differ between the variants, and whether the grasp set
     does: what a label needs to tell them apart."""
     keys = tuple(k for k in GRIPPER_WORDS
-                 if len({v['gripper_mm'][k] for v in variants}) > 1)
-    return keys, len({v['grasp_set'] for v in variants}) > 1
+                 if len({v.gripper_mm[k] for v in variants}) > 1)
+    return keys, len({v.grasp_set for v in variants}) > 1

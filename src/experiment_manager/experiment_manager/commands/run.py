@@ -40,7 +40,8 @@ from rclpy.validate_namespace import validate_namespace
 from tqdm import tqdm
 
 from .. import experiment_file
-from ..analysis.wording import gripper_label, sampling_end
+from ..analysis import summary as summary_model
+from ..analysis.headlines import headlines
 from . import interrupt
 from .claim import claim, NamespaceInUse
 from .supervisor import Graph, report_dead, spin_until, start_graph
@@ -156,46 +157,6 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     except InvalidNamespaceException as exc:
         parser.error(f'--namespace {args.namespace!r}: {exc}')
     return args
-
-
-def _summary_lines(summary: dict) -> list[str]:
-    lines = []
-    for exp_id, s in summary.get('experiments', {}).items():
-        kind = s['type']
-        if kind == 'bin_static':
-            lines.append(f'  {exp_id} (bin_static): best bin {s["best_bin_mm"]} mm')
-        elif kind == 'bin_emptying':
-            r = s['removed']
-            lines.append(f'  {exp_id} (bin_emptying): {s["emptied"]}/{s["iterations"]} bins '
-                         f'emptied, parts removed mean {r["mean"]:.3g} (min {r["min"]:g}, '
-                         f'max {r["max"]:g})')
-        elif kind == 'table_sweep':
-            ci = s.get('n_star_ci95')
-            lines.append(f'  {exp_id} (table_sweep): optimum {s.get("n_star")} parts'
-                         + (f' (95 % interval {ci[0]}-{ci[1]})' if ci else '')
-                         + f', range {s.get("optimal_range")}')
-        elif kind == 'gripper_sweep':
-            found = s['smallest']
-            lines.append(f'  {exp_id} (gripper_sweep): ' + (
-                f'smallest meeting {s["min_valid"]:g} valid per check: '
-                f'{gripper_label(s["variants"][found])}' if found is not None else
-                f'no gripper of {len(s["variants"])} meets {s["min_valid"]:g} valid per check'))
-        elif kind == 'sensitivity':
-            lines.append(f'  {exp_id} (sensitivity): {len(s["scenarios"])} scenarios over '
-                         + ', '.join(x['name'] for x in s['inputs']) + ':')
-            lines += [f'    {r["line"]}' for r in s['robustness']]
-        else:
-            v = s['vibrations_to_empty']['mean']
-            rate = s['parts_per_hour']['mean']
-            lines.append(f'  {exp_id} (feeder_emptying): {s["emptied"]}/{s["iterations"]} '
-                         'runs emptied' + (f', {v:.4g} vibrations to empty on average'
-                                           if v is not None else '')
-                         + (f', {rate:.4g} parts per hour' if rate is not None else ''))
-        if 'sampling' in s:
-            a = s['sampling']
-            lines[-1] += (f' [adaptive: {a["iterations_run"]} of {a["most"]} iterations, '
-                          f'{sampling_end(s)}]')
-    return lines
 
 
 def _goals(args: argparse.Namespace,
@@ -331,8 +292,8 @@ def _run(node: Node, client: LockedActionClient, goal, given: str, graph: Graph,
     print(f'summary:   {os.path.join(result.results_path, "summary.json")}')
     if result.report_path:
         print(f'report:    {result.report_path}')
-    summary = json.loads(result.summary_json)
-    print('\n'.join(_summary_lines(summary)))
+    summary = summary_model.validate(json.loads(result.summary_json))
+    print('\n'.join(headlines(summary)))
     # the manager's decisions, each with its first reason (the report gives them all)
     print('verdicts:\n' + '\n'.join(
         f'  {v.option.replace("`", "")}: {v.verdict} ({v.reasons[0]})'

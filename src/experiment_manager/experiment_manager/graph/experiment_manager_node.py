@@ -29,6 +29,7 @@ from rclpy.node import Node
 from rclpy.validate_namespace import validate_namespace
 from std_msgs.msg import Header
 
+from ..analysis import summary as summary_model
 from ..analysis.verdicts import verdicts
 from ..running.scheduler import Progress
 from .graph_backend import GraphBackend, GraphError
@@ -169,8 +170,9 @@ class ExperimentManagerNode(Node):
         """The run's decisions, published (latched) and recorded with the run."""
         msg = RunVerdicts(header=Header(stamp=self.get_clock().now().to_msg()),
                           experiment_id=session.file.id, run_directory=session.run_dir,
-                          verdicts=[Verdict(option=v['option'], verdict=v['verdict'],
-                                            reasons=v['reasons']) for v in verdicts(summary)])
+                          verdicts=[Verdict(option=v.option, verdict=v.verdict,
+                                            reasons=v.reasons)
+                                    for v in verdicts(summary_model.validate(summary))])
         self._verdicts.publish(msg)
         self._topics.write(self._verdicts, msg)
         return msg.verdicts

@@ -1,0 +1,43 @@
+"""What every section of the report shares: the run as the sections read it (`Run`), and the
+base of a section (`Section`): a heading, and the Markdown lines under it, or none when the run
+has nothing for it."""
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+from ..summary import Summary
+from ..verdicts import PAPER, Verdict, verdicts
+
+
+@dataclass
+class Run:
+    """A finished run as the report reads it. summary: summary.json; part: the file's part
+    section as written (`schema.Part`); gripper: the gripper keys the file gave (mm);
+    figures: which plots were drawn, by name (plots.py); pictures: {image file: caption}
+    (pictures.py); account: the part's account (part_sheet.describe), with its sheet
+    `part.png`; stops: why parts were turned down, per experiment (stages.turned_down)."""
+    summary: Summary
+    part_model: str = ''
+    part_dimensions_mm: dict[str, float] = field(default_factory=dict)
+    gripper: dict[str, float] = field(default_factory=dict)
+    figures: dict[str, bool] = field(default_factory=dict)
+    pictures: dict[str, str] | None = None
+    account: list[str] | None = None
+    stops: dict[str, dict[str, int]] | None = None
+
+    @property
+    def paper(self) -> dict | None:
+        """The paper's figures when the file is one of its test case's (verdicts.PAPER)."""
+        return PAPER.get(self.summary.id)
+
+    @cached_property
+    def verdicts(self) -> list[Verdict]:
+        return verdicts(self.summary)
+
+
+class Section:
+    """A part of the report: `lines(run)`, its Markdown (a heading and what is under it, after
+    a blank line), [] when the run has nothing for it."""
+
+    def lines(self, run: Run) -> list[str]:
+        raise NotImplementedError

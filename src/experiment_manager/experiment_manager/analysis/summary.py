@@ -1,0 +1,409 @@
+"""summary.json as one typed, versioned model: what a run measured and decided, per experiment.
+
+The metrics (metrics.py, sensitivity.py) build an experiment's summary; `Summary` is the
+contract every summary.json a run writes is checked against (results.ResultsWriter), and the
+one way to read one back (`read`, through `migrate` for files of an older version). Its JSON
+Schema is published as docs/summary.schema.json:
+
+    python -m experiment_manager.analysis.summary --schema docs/summary.schema.json
+
+writes it from this module (a test checks that the committed file is current). Units are in
+the names (`_mm`, `_s`, `_h`, `_mm2`); shares are fractions of 1. No rclpy.
+"""
+
+import argparse
+import json
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+SCHEMA_VERSION = 1
+VERDICT = Literal['FEASIBLE', 'NOT FEASIBLE', 'UNDECIDED']
+
+
+class _Record(BaseModel):
+    """A record of summary.json: no key besides its fields, read-only once made."""
+    model_config = ConfigDict(extra='forbid', frozen=True, populate_by_name=True)
+
+
+class Stats(_Record):
+    """A list of numbers as metrics.stats says it: None for an empty list."""
+    n: int
+    mean: float | None
+    min: float | None
+    max: float | None
+    std: float | None = Field(description='sample standard deviation (n - 1); 0 for one value')
+
+
+class Fractions(_Record):
+    """Per iteration, the share of the checked parts that passed each stage."""
+    candidates: Stats
+    placeable: Stats
+    container_free: Stats
+    valid: Stats
+
+
+class Flagged(_Record):
+    group: int
+    iteration: int
+    fault: str = Field(description="procedures.faults' names joined by '+'")
+    experiment: str | None = Field(None, description='a sensitivity summary: the repeat')
+
+
+class Faults(_Record):
+    """How many iterations each physics fault flagged; the first three leave an iteration out
+    of the figures."""
+    physics_fault: int
+    tunnelled: int
+    thrown: int
+    unsettled: int
+    flagged: list[Flagged]
+
+
+class Physics(_Record):
+    """The physics health of every iteration, left-out ones too."""
+    spilled: int
+    tunnelled: int
+    thrown: int
+    max_speed: float = Field(description='m/s')
+    unsettled: int
+    max_penetration: float = Field(description='m')
+    tray_error: float = Field(description='fraction of the commanded motion')
+
+
+class Sampling(_Record):
+    """An adaptive experiment's sampling (running/sampling.py)."""
+    mode: str
+    batch: int
+    batches: int
+    iterations_run: int
+    most: int
+    settled: bool
+    tied_bins: list[int] | None = None
+    tie: list[int] | None = None
+    tie_within: float | None = None
+    race_confidence: float | None = Field(None, description=(
+        "one-sided confidence of the bound of a bin's difference from the leader, where bins "
+        'tied or were left; absent there in a version-0 summary, whose race compared 99.9 % '
+        'intervals'))
+
+
+class GumbelFit(_Record):
+    n: int
+    location_s: float
+    scale_s: float
+    p: float = Field(description='probability plot correlation p of the fit')
+    fits: bool
+    k_upper: float
+    k_lower: float
+    upper: float
+    lower: float
+    estimate: float
+
+
+class FreeBound(_Record):
+    verdict: VERDICT
+    share_bounds: list[float]
+
+
+class Decision(_Record):
+    """One ground of a verdict (decisions.Decision): its quantity bounded one-sidedly."""
+    verdict: VERDICT
+    quantity: str
+    bound: float | None
+    interval: str
+    runs: int
+    reason: str
+    # a rate (bins emptied) and the spills
+    low: float | None = None
+    high: float | None = None
+    successes: int | None = None
+    spilled: int | None = None
+    # the table's time to empty a refill
+    over: int | None = None
+    refill_s: float | None = None
+    coverage: float | None = None
+    times_s: list[float | None] | None = None
+    distribution_free: FreeBound | None = None
+    gumbel: GumbelFit | None = None
+
+
+class _Experiment(_Record):
+    faults: Faults
+    physics: Physics
+    sampling: Sampling | None = None
+
+
+class Bin(_Record):
+    index: int
+    size_mm: list[float]
+    xy_area_mm2: float
+    iterations: int
+    fractions: Fractions
+    spilled: Stats
+
+
+class BinStatic(_Experiment):
+    type: Literal['bin_static']
+    bins: list[Bin]
+    best_bin: int | None
+    best_bin_mm: list[float] | None
+
+
+class BinEmptying(_Experiment):
+    type: Literal['bin_emptying']
+    iterations: int
+    parts: int
+    decision: Decision
+    bin_mm: list[float] | None
+    emptied: int
+    emptied_ci95: list[float | None]
+    removed: Stats
+    searches_per_pick: Stats
+    first_check: Fractions
+
+
+class Count(_Record):
+    n: int
+    valid: Stats
+
+
+class TableSweep(_Experiment):
+    type: Literal['table_sweep']
+    iterations: int
+    per_n: list[Count]
+    margin: int
+    order: int | None = None
+    coefficients: list[float] | None = Field(None, description='highest power first')
+    n_star: int | None = None
+    fit_max: float | None = None
+    optimal_range: list[int] | None = None
+    no_valid: bool | None = None
+    n_star_ci95: list[int] | None = None
+
+
+class Cell(_Record):
+    pick_s: float
+    image_s: float
+
+
+class TableGrounds(_Record):
+    time: Decision
+    spills: Decision
+
+
+class FeederEmptying(_Experiment):
+    type: Literal['feeder_emptying']
+    iterations: int
+    parts: int
+    optimal_range: list[int]
+    max_vibrations: int
+    emptied: int
+    accepted: int
+    accepted_ci95: list[float | None]
+    max_spilled: int
+    runs_spilling: int
+    vibrations_to_empty: Stats
+    feeds: Stats
+    stops: dict[str, int]
+    minutes_per_vibration_allowed: float | None
+    parts_per_hour: Stats
+    parts_per_hour_ci95: list[float | None]
+    cell: Cell
+    decision: TableGrounds
+
+
+class Variant(_Record):
+    index: int
+    grasp_set: str
+    grasps: list[str]
+    gripper_mm: dict[str, float]
+    scenes: int
+    fractions: Fractions
+    valid: Stats
+    valid_ci95: list[float | None]
+    scenes_with_valid: int
+    meets: bool
+
+
+class GripperSweep(_Experiment):
+    type: Literal['gripper_sweep']
+    iterations: int
+    parts: int
+    scene_mm: list[float] | None
+    min_valid: float
+    variants: list[Variant]
+    smallest: int | None
+
+
+class Held(_Record):
+    what: str
+    source: str = Field(alias='from')
+
+
+NUMBER = int | float
+ANSWER = NUMBER | str | None    # the best bin is named ('100x175x15'), the others are numbers
+
+
+class Input(_Record):
+    name: str
+    base: NUMBER
+    low: NUMBER
+    high: NUMBER
+    source: str
+
+
+class Said(_Record):
+    answers: dict[str, ANSWER]
+    verdicts: dict[str, str]
+
+
+class Scenario(Said):
+    name: str
+    values: dict[str, NUMBER]
+
+
+class Flip(_Record):
+    scenario: str
+    verdict: str | None
+    values: dict[str, NUMBER]
+
+
+class Robustness(_Record):
+    option: str
+    verdict: str
+    holds: bool
+    flips: list[Flip]
+    said: str
+    line: str
+    sources: dict[str, str]
+
+
+class Axis(_Record):
+    input: str
+    values: list[NUMBER]
+
+
+class VerdictMap(_Record):
+    rows: Axis
+    columns: Axis
+    verdicts: dict[str, list[list[str | None]]]
+
+
+class Sensitivity(_Experiment):
+    type: Literal['sensitivity']
+    of: list[str]
+    iterations: int
+    held: dict[str, Held]
+    inputs: list[Input]
+    base: Said
+    scenarios: list[Scenario]
+    tornado: dict[str, dict[str, dict[str, ANSWER]]]
+    ranges: dict[str, list[ANSWER]]
+    robustness: list[Robustness]
+    map: VerdictMap | None = None
+
+
+Experiment = Annotated[BinStatic | BinEmptying | TableSweep | FeederEmptying | GripperSweep
+                       | Sensitivity, Field(discriminator='type')]
+
+
+class Requirements(_Record):
+    parts_per_hour: float
+    refill_interval_h: float
+    capacity: int
+    success_rate: float
+    max_dimension_mm: float
+
+
+class Summary(_Record):
+    """summary.json: the file's experiments by id, in the file's order, and a sensitivity
+    experiment's repeats of them (`<experiment>@<scenario>`) apart."""
+    model_config = ConfigDict(title=f'pick_sim run summary, version {SCHEMA_VERSION}')
+    schema_version: Literal[1] = SCHEMA_VERSION
+    id: str
+    seed: int
+    requirements: Requirements
+    experiments: dict[str, Experiment]
+    repeats: dict[str, Experiment] | None = None
+
+    def of_type(self, kind: str) -> list[tuple[str, BinStatic | BinEmptying | TableSweep
+                                                | FeederEmptying | GripperSweep
+                                                | Sensitivity]]:
+        """(id, summary) of the file's experiments of this type, in the file's order."""
+        return [(k, v) for k, v in self.experiments.items() if v.type == kind]
+
+    def last(self, kind: str):
+        """The file's last experiment of this type (the one a report shows), or None."""
+        found = self.of_type(kind)
+        return found[-1][1] if found else None
+
+
+def migrate(raw: dict) -> dict:
+    """A summary.json of any version as the current version's dict. Version 0 (no
+    `schema_version`): a feeder without its throughput (written before the cell's time was
+    measured) gets an empty one; a table's time ground decided on a lognormal keeps its
+    verdict, bound and reason and loses the lognormal's own figures (`lognormal`), which the
+    current model does not describe."""
+    version = raw.get('schema_version', 0)
+    if version > SCHEMA_VERSION:
+        raise ValueError(f'summary.json: schema_version {version} is newer than this reader '
+                         f'({SCHEMA_VERSION})')
+    if version == SCHEMA_VERSION:
+        return raw
+    out = {**raw, 'schema_version': SCHEMA_VERSION}
+    for group in ('experiments', 'repeats'):
+        if group in raw:
+            out[group] = {k: _migrate_experiment(v) for k, v in raw[group].items()}
+    return out
+
+
+def _migrate_experiment(s: dict) -> dict:
+    if s.get('type') != 'feeder_emptying':
+        return s
+    s = dict(s)
+    empty = {'n': 0, 'mean': None, 'min': None, 'max': None, 'std': None}
+    s.setdefault('parts_per_hour', empty)
+    s.setdefault('parts_per_hour_ci95', [None, None])
+    grounds = dict(s['decision'])
+    grounds['time'] = {k: v for k, v in grounds['time'].items() if k != 'lognormal'}
+    s['decision'] = grounds
+    return s
+
+
+def validate(raw: dict) -> Summary:
+    """A summary's dict (current version) as the typed model; pydantic.ValidationError names
+    the key path of every key that breaks it."""
+    return Summary.model_validate(raw)
+
+
+def read(path: str) -> Summary:
+    """A run directory's summary.json, of any version, as the typed model."""
+    with open(path, encoding='utf-8') as f:
+        return validate(migrate(json.load(f)))
+
+
+def schema() -> dict:
+    """The JSON Schema of summary.json (docs/summary.schema.json)."""
+    return Summary.model_json_schema(by_alias=True)
+
+
+def schema_text() -> str:
+    return json.dumps(schema(), indent=1, sort_keys=True) + '\n'
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--schema', metavar='PATH', required=True,
+                        help="write summary.json's JSON Schema to PATH ('-': standard output)")
+    args = parser.parse_args(argv)
+    if args.schema == '-':
+        print(schema_text(), end='')
+    else:
+        with open(args.schema, 'w', encoding='utf-8') as f:
+            f.write(schema_text())
+    return 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())
