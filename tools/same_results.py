@@ -3,7 +3,8 @@
     python3 tools/same_results.py RUN_DIR_A RUN_DIR_B
 
 Compares the result files a run writes (iterations.csv, checks.csv, parts.csv, picks.csv as
-text, row by row, without their wall_time columns; summary.json without its wall-time keys)
+text, row by row, without their wall_time columns; summary.json without its wall-time keys
+and its schema_version, which names the file's format, not a result)
 and prints, per file, 'same' or the first difference. Exit 0 when every file is the same, 1
 otherwise, 2 for a directory that is not a run directory. Standard library only, so that it
 compares runs made by two versions of the code (a restructure must not change a result).
@@ -16,6 +17,7 @@ import sys
 
 CSV_FILES = ('iterations', 'checks', 'parts', 'picks')
 TIMES = ('wall_time',)    # a key or column is a time when its name contains one of these
+FORMAT = ('schema_version',)    # keys that name the format of summary.json
 
 
 def _is_time(name: str) -> bool:
@@ -29,7 +31,8 @@ def _rows(path: str) -> list[dict]:
 
 def _without_times(value):
     if isinstance(value, dict):
-        return {k: _without_times(v) for k, v in value.items() if not _is_time(k)}
+        return {k: _without_times(v) for k, v in value.items()
+                if not _is_time(k) and k not in FORMAT}
     if isinstance(value, list):
         return [_without_times(v) for v in value]
     return value

@@ -20,7 +20,7 @@ import os
 from experiment_manager import experiment_file
 import numpy as np
 from pick_common.containers import ContainerSpec
-from pick_common.parts import build_part
+from pick_common.parts.geometry import build_part
 from pick_validity.results import STAGE_VALID
 from pick_validity.validity import Validator
 from scipy.spatial.transform import Rotation

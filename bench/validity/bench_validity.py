@@ -47,7 +47,7 @@ def main() -> None:
             for _ in range(args.repeats):
                 fast = validator.check(BIN, state.ids, state.poses, neighbour_check=neighbours)
                 walls.append(fast.wall_time)
-            naive = naive_check(validator, BIN, state.ids, state.poses,
+            naive = naive_check(validator.geometry, BIN, state.ids, state.poses,
                                 neighbour_check=neighbours)
             same = [a.key() for a in fast.results] == [b.key() for b in naive.results]
             median = statistics.median(walls)

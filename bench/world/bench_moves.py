@@ -15,7 +15,7 @@ import argparse
 
 import numpy as np
 from pick_common.containers import ContainerSpec
-from pick_common.parts import PartSpec
+from pick_common.parts.spec import PartSpec
 from pick_common.specs import MOVES, SceneSpec
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World

@@ -19,7 +19,7 @@ import os
 import time
 
 from pick_common.containers import ContainerSpec
-from pick_common.parts import PartSpec
+from pick_common.parts.spec import PartSpec
 from pick_common.specs import MOVES, SceneSpec
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World

@@ -317,7 +317,7 @@ def _to220(mesh=STEP, opening=16, point='[2.54, 0, 9]', extra=''):
 def test_a_step_file_is_read_in_its_own_units():
     f = experiment_file.parse(_to220(), STEP)
     assert f.part.scale == 1.0 and f.part.mesh_path == os.path.normpath(STEP)
-    from pick_common.parts import build_part
+    from pick_common.parts.geometry import build_part
     assert build_part(f.part).visual.extents == pytest.approx((0.01025, 0.004455, 0.028525),
                                                               abs=1e-6)
 

@@ -6,7 +6,7 @@ import os
 
 import numpy as np
 from pick_common.containers import ContainerSpec
-from pick_common.parts import PartSpec
+from pick_common.parts.spec import PartSpec
 from pick_common.specs import SceneSpec
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
@@ -71,9 +71,9 @@ def test_moving_the_file_s_origin_and_turning_its_axes_change_no_answer(tmp_path
         assert centred.mean() > 3 and abs(centred.mean() - other.mean()) <= noise, (
             name, centred, other)
     # the check can fail: the mass centre put at the file's origin moves the answer far more
-    import pick_common.parts as parts
-    finish = parts._finish
-    monkeypatch.setattr(parts, '_finish', lambda *args, **kwargs: finish(*args[:6]))
+    import pick_common.parts.geometry as geometry
+    finish = geometry._finish
+    monkeypatch.setattr(geometry, '_finish', lambda *args, **kwargs: finish(*args[:6]))
     old = _valid_per_check(_mesh(tmp_path, 'old', moved), moved, seeds)
     assert abs(centred.mean() - old.mean()) > noise, (centred, old)
 

@@ -29,7 +29,7 @@ from .errors import (
     UnknownInstance,
     UnknownPart,
 )
-from .parts import PartSpec
+from .parts.spec import PartSpec
 from .specs import CENTRE, FIXED, RANDOM, Vibration
 from .states import PartStates, Progress, SettleReport, TrayMotion
 

@@ -9,7 +9,7 @@ import math
 
 from .containers import check_container, ContainerSpec
 from .errors import check_number, InvalidArgument, Limit
-from .parts import PartSpec
+from .parts.spec import PartSpec
 
 MAX_INSTANCES = 64
 MAX_PARTS_PER_INSTANCE = 5000

@@ -1,7 +1,9 @@
 """The layering the packages promise: only the world imports PyBullet, so the validity node
 serves a real cell without the simulator, and the feeder and manager nodes do not load it;
 the pure modules of pick_common import neither rclpy nor PyBullet (trimesh loads python-fcl
-by itself where it is installed, so FCL is not asserted absent)."""
+by itself where it is installed, so FCL is not asserted absent where a part is built); and
+what only names a part (its spec, the built-in models, the messages' conversions) does not
+load the mesh stack."""
 
 import subprocess
 import sys
@@ -33,7 +35,19 @@ def test_the_world_node_does_import_pybullet():
 
 
 @pytest.mark.parametrize('module', ['pick_common.errors', 'pick_common.containers',
-                                    'pick_common.parts', 'pick_common.specs',
+                                    'pick_common.parts.geometry', 'pick_common.specs',
                                     'pick_common.states'])
 def test_pure_modules_import_neither_ros_nor_the_simulator(module):
     assert not _loaded(module) & {'rclpy', 'pybullet'}
+
+
+@pytest.mark.parametrize('module', ['pick_common.parts.spec', 'pick_common.parts.models',
+                                    'pick_common.parts.primitives', 'pick_common.specs',
+                                    'pick_common.conversions', 'pick_validity.config'])
+def test_what_only_names_a_part_does_not_load_the_mesh_stack(module):
+    assert not _loaded(module) & {'trimesh', 'coacd', 'fcl'}
+
+
+def test_the_mesh_stack_is_seen_where_it_is_loaded():
+    # the check above can fail: the same probe sees trimesh where a part is built
+    assert 'trimesh' in _loaded('pick_common.parts.geometry')

@@ -6,9 +6,13 @@ import os
 from hypothesis import given, HealthCheck, settings
 from hypothesis import strategies as st
 import numpy as np
-from pick_common import pieces
 from pick_common.errors import InvalidArgument, MeshError
-from pick_common.parts import build_part, BUILTIN_MODELS, MESH_EXTENT, PartSpec
+from pick_common.parts import pieces
+from pick_common.parts.geometry import build_part
+from pick_common.parts.meshes import MESH_EXTENT
+from pick_common.parts.models import BUILTIN_MODELS
+from pick_common.parts.primitives import Cylinder, Hull
+from pick_common.parts.spec import PartSpec
 import pytest
 import trimesh
 
@@ -31,7 +35,7 @@ def test_capacitor_dimensions_follow_the_parameters():
     assert np.allclose(hi[:2] - lo[:2], [0.008, 0.008])
     assert np.isclose(hi[2] - lo[2], 0.016 + 0.015)
     body = part.primitives[0]
-    assert body.kind == 'cylinder' and body.size == (0.004, 0.016)
+    assert isinstance(body, Cylinder) and (body.radius, body.length) == (0.004, 0.016)
     leads = 2 * np.pi * 0.00025**2 * 0.015
     assert np.isclose(part.volume, np.pi * 0.004**2 * 0.016 + leads, rtol=0.02)
 
@@ -60,7 +64,7 @@ def test_user_mesh_becomes_convex_hulls(tmp_path, suffix):
     mesh.export(path)
     spec = PartSpec(model='mesh', mesh_path=str(path), scale=0.001, mass=0.0003)
     part = build_part(spec)
-    assert [p.kind for p in part.primitives] == ['hull', 'hull']
+    assert [type(p) for p in part.primitives] == [Hull, Hull]
     assert np.isclose(part.volume, 0.006 * 0.004 * 0.002 + np.pi * 0.0005**2 * 0.006, rtol=0.05)
 
 

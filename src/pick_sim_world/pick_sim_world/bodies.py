@@ -4,13 +4,14 @@
 Every function takes the PyBullet client it works on; the World owns the client.
 """
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 import os
 
 import numpy as np
 from pick_common import containers
 from pick_common.containers import ContainerSpec
-from pick_common.parts import PartGeometry
+from pick_common.parts.geometry import PartGeometry
+from pick_common.parts.primitives import Box, Cylinder
 from pick_common.states import quaternion_multiply, rotate
 import pybullet as pb
 import trimesh
@@ -52,10 +53,10 @@ def create_part_shape(client: int, part: PartGeometry, directory: str) -> int:
         radius = length = 0.0
         half = [0.0, 0.0, 0.0]
         path = ''
-        if p.kind == 'box':
-            kind, half = pb.GEOM_BOX, list(p.size)
-        elif p.kind == 'cylinder':
-            kind, (radius, length) = pb.GEOM_CYLINDER, p.size
+        if isinstance(p, Box):
+            kind, half = pb.GEOM_BOX, list(p.half)
+        elif isinstance(p, Cylinder):
+            kind, radius, length = pb.GEOM_CYLINDER, p.radius, p.length
         else:
             kind = pb.GEOM_MESH
             path = os.path.join(directory, f'hull_{i}.obj')
@@ -127,6 +128,12 @@ def part_frame_poses(poses: np.ndarray, part: PartGeometry) -> np.ndarray:
     return out
 
 
+def part_centres(poses: np.ndarray, part: PartGeometry) -> np.ndarray:
+    """Centres (N, 3) of the parts' enclosing spheres (part.center) for part-frame `poses`
+    (N, 7), in the poses' frame, m."""
+    return poses[:, :3] + rotate(poses[:, 3:], part.center)
+
+
 def base_poses(client: int, bodies: list[int]) -> np.ndarray:
     """World-frame poses (N, 7) of bodies, xyz + xyzw."""
     poses = np.empty((len(bodies), 7))
@@ -160,3 +167,11 @@ def touching(client: int, bodies: Sequence[int]) -> set[int]:
         found.update(contact[2] for contact in pb.getContactPoints(bodyA=body,
                                                                    physicsClientId=client))
     return found
+
+
+def parts_touching(client: int, bodies_of: Mapping[int, int], ids: list[int]) -> set[int]:
+    """The parts not in `ids` that a part of `ids` touches (touching); `bodies_of`: part id ->
+    body."""
+    part_of = {body: pid for pid, body in bodies_of.items() if pid not in ids}
+    touched = touching(client, [bodies_of[pid] for pid in ids])
+    return {part_of[b] for b in touched if b in part_of}

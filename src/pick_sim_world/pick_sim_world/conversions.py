@@ -13,7 +13,8 @@ from geometry_msgs.msg import Point, Quaternion, Transform, TransformStamped, Ve
 import numpy as np
 from pick_common import containers
 from pick_common.conversions import container_to_msg, instance_frame, pose_msg
-from pick_common.parts import PartGeometry
+from pick_common.parts.geometry import PartGeometry
+from pick_common.parts.primitives import Box, Cylinder
 from pick_common.states import PartStates, rotate
 from pick_msgs.msg import Instance as InstanceMsg
 from pick_msgs.msg import PartModel, Scene
@@ -43,14 +44,13 @@ def part_model_to_msg(part: PartGeometry) -> PartModel:
         spinning_friction=float(spec.spinning_friction), restitution=float(spec.restitution),
         bounding_radius=float(part.radius + np.linalg.norm(part.center)))
     for p in part.primitives:
-        if p.kind == 'box':
+        if isinstance(p, Box):
             msg.primitives.append(SolidPrimitive(
-                type=SolidPrimitive.BOX, dimensions=[2.0 * s for s in p.size]))
+                type=SolidPrimitive.BOX, dimensions=[2.0 * s for s in p.half]))
             msg.primitive_poses.append(pose_msg(p.position, p.orientation))
-        elif p.kind == 'cylinder':
-            radius, length = p.size
+        elif isinstance(p, Cylinder):
             msg.primitives.append(SolidPrimitive(type=SolidPrimitive.CYLINDER,
-                                                 dimensions=[length, radius]))
+                                                 dimensions=[p.length, p.radius]))
             msg.primitive_poses.append(pose_msg(p.position, p.orientation))
         else:
             msg.hulls.append(_mesh_msg(p.vertices, p.faces))
@@ -122,12 +122,12 @@ def markers_msg(world: World, states: PartStates, stamp: Time, prefix: str) -> M
     primitives = world.part.primitives
     shapes = []     # per primitive: marker type, scale and points, shared by every part
     for p in primitives:
-        if p.kind == 'box':
-            shapes.append((Marker.CUBE, Vector3(x=2 * p.size[0], y=2 * p.size[1],
-                                                z=2 * p.size[2]), []))
-        elif p.kind == 'cylinder':
-            shapes.append((Marker.CYLINDER, Vector3(x=2 * p.size[0], y=2 * p.size[0],
-                                                    z=p.size[1]), []))
+        if isinstance(p, Box):
+            shapes.append((Marker.CUBE, Vector3(x=2 * p.half[0], y=2 * p.half[1],
+                                                z=2 * p.half[2]), []))
+        elif isinstance(p, Cylinder):
+            shapes.append((Marker.CYLINDER, Vector3(x=2 * p.radius, y=2 * p.radius,
+                                                    z=p.length), []))
         else:
             shapes.append((Marker.TRIANGLE_LIST, Vector3(x=1.0, y=1.0, z=1.0),
                            [Point(x=float(x), y=float(y), z=float(z))

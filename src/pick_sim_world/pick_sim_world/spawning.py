@@ -9,9 +9,10 @@ import math
 
 import numpy as np
 from pick_common import containers
-from pick_common.containers import ContainerSpec
-from pick_common.errors import InvalidArgument
-from pick_common.parts import PartGeometry
+from pick_common.containers import check_fits, ContainerSpec
+from pick_common.errors import check_int, InvalidArgument
+from pick_common.parts.geometry import PartGeometry
+from pick_common.specs import MAX_PARTS_PER_INSTANCE
 from pick_common.states import rotate
 
 from .config import GRAVITY
@@ -61,6 +62,36 @@ def layer_interval(part: PartGeometry) -> float:
     height (a bounding-sphere diameter) plus a fifth of it again, so that each layer has landed
     on the pile before the next one appears just above it."""
     return 1.2 * math.sqrt(2.0 * 2.0 * (part.radius + SPAWN_GAP) / GRAVITY)
+
+
+def check_count(count: int, held: dict[int, int], part: PartGeometry,
+                container: ContainerSpec) -> int:
+    """`count` parts more for each instance k that holds `held[k]`: within the per-instance
+    limit and fitting the container (containers.check_fits). Raises InvalidArgument naming
+    what the number is when parts are there already."""
+    count = check_int('count', count, low=1, high=MAX_PARTS_PER_INSTANCE)
+    for k, there in held.items():
+        total = count + there
+        if total > MAX_PARTS_PER_INSTANCE:
+            raise InvalidArgument('count', count, f'would put {total} parts in instance {k}'
+                                  f' (limit {MAX_PARTS_PER_INSTANCE})')
+        check_fits('count' if not there else f'count + the {there} parts in instance {k}',
+                   total, part.volume, container)
+    return count
+
+
+def pile_top(part: PartGeometry, region: tuple[float, float, float, float],
+             centres: np.ndarray) -> float:
+    """The height, m, above which new parts spawn over `region` (centre x, y and half extents
+    x, y): the highest of the parts already there (`centres` (N, 3), their spheres' centres)
+    that lie within two part radii of it, plus a radius; 0 over an empty region."""
+    if not len(centres):
+        return 0.0
+    cx, cy, hx, hy = region
+    reach = 2.0 * part.radius
+    over = ((np.abs(centres[:, 0] - cx) <= hx + reach)
+            & (np.abs(centres[:, 1] - cy) <= hy + reach))
+    return max(0.0, float(centres[over, 2].max()) + part.radius) if over.any() else 0.0
 
 
 def spawn_poses(rng: np.random.Generator, part: PartGeometry,

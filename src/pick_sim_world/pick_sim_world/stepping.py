@@ -16,7 +16,7 @@ import time
 import numpy as np
 from pick_common.containers import ContainerSpec
 from pick_common.errors import PhysicsFault
-from pick_common.parts import PartGeometry
+from pick_common.parts.geometry import PartGeometry
 from pick_common.states import Progress, quaternion_angles
 import pybullet as pb
 

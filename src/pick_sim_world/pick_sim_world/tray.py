@@ -61,6 +61,29 @@ def vibration_substeps(frequency: float, time_step: float) -> int:
     return max(1, math.ceil(MIN_STEPS_PER_CYCLE * frequency * time_step - 1e-9))
 
 
+def vibration_plan(vibration: Vibration, rngs: Sequence[np.random.Generator],
+                   to_centre: Sequence[np.ndarray | None], time_step: float,
+                   half_extents: tuple[float, float]
+                   ) -> tuple[np.ndarray, float, int, list[int] | None]:
+    """How one vibration moves a set of trays: each tray's amplitude (K, 3) m (drawn from its
+    generator in `rngs`; toward its centre with CENTRE, `to_centre`), the step dt, s, the
+    steps to run, and with CENTRE each tray's own steps (its share of the duration,
+    centring_share, in whole periods), else None. A period gets at least
+    MIN_STEPS_PER_CYCLE steps: finer steps while vibrating when the physics step
+    (`time_step`) is too coarse for the frequency."""
+    amplitudes = np.array([vibration_amplitude(vibration, rng, c)
+                           for rng, c in zip(rngs, to_centre, strict=True)])
+    dt = time_step / vibration_substeps(vibration.frequency, time_step)
+    steps = max(1, int(round(vibration.duration / dt)))
+    own = None
+    if vibration.direction == CENTRE:
+        periods = [round(vibration.duration * vibration.frequency
+                         * centring_share(c, half_extents)) for c in to_centre]
+        own = [int(round(n / (vibration.frequency * dt))) for n in periods]
+        steps = max(1, *own)
+    return amplitudes, dt, steps, own
+
+
 def fundamental(times: np.ndarray, samples: np.ndarray, omega: float) -> np.ndarray:
     """Amplitude (3,) of the sinusoid at `omega` (rad/s) fitted by least squares to `samples`
     (n, 3) taken at `times` (n,), per axis (a constant offset is fitted too)."""

@@ -3,8 +3,9 @@ with its own container, parts and random generator (the paper's "demo instances"
 It drops and feeds parts, vibrates trays, removes parts, and settles.
 
 Pure core: PyBullet (DIRECT mode), numpy and trimesh; no rclpy. `World` keeps the scene's
-state and delegates: bodies.py builds the scene, spawning.py places new parts, tray.py moves
-the trays, stepping.py steps until the parts rest, camera.py takes pictures.
+state and delegates: bodies.py builds the scene, selection.py checks what a request names,
+spawning.py places new parts, tray.py moves the trays, stepping.py steps until the parts rest,
+health.py tells how an operation ended, camera.py takes pictures.
 
 Poses are (N, 7) float64 arrays, xyz in metres then an xyzw unit quaternion, expressed in the
 instance frame (origin at the centre of the container's inner floor, +Z up).
@@ -20,33 +21,18 @@ import tempfile
 
 import numpy as np
 from pick_common import containers
-from pick_common.containers import check_fits
-from pick_common.errors import (
-    check_int,
-    check_number,
-    InvalidArgument,
-    PhysicsFault,
-    UnknownInstance,
-    UnknownPart,
-)
-from pick_common.parts import build_part, PartGeometry
-from pick_common.specs import (
-    CENTRE,
-    check_scene,
-    check_vibration,
-    MAX_PARTS_PER_INSTANCE,
-    SceneSpec,
-    Vibration,
-)
-from pick_common.states import PartStates, Progress, rotate, SettleReport
+from pick_common.errors import check_number, InvalidArgument, PhysicsFault
+from pick_common.parts.geometry import build_part, PartGeometry
+from pick_common.specs import CENTRE, check_scene, check_vibration, SceneSpec, Vibration
+from pick_common.states import PartStates, Progress, SettleReport
 import pybullet as pb
 
-from . import bodies, camera, spawning, stepping
+from . import bodies, camera, health, selection, spawning, stepping
 from .camera import Overlay
 from .config import check_physics, PhysicsConfig
 from .freezing import Freezer
 from .stepping import ProgressCallback
-from .tray import centring_share, TrayDrive, vibration_amplitude, vibration_substeps
+from .tray import TrayDrive, vibration_plan
 
 
 @dataclass
@@ -163,17 +149,7 @@ class World:
 
     # ----------------------------------------------------------------------------- queries
     def _instance_ids(self, instances: Iterable[int] | None) -> list[int]:
-        if instances is None:
-            return [inst.id for inst in self._instances]
-        ids = []
-        for value in instances:
-            k = check_int('instances[]', value, low=0, high=2**32 - 1)
-            if k >= len(self._instances):
-                raise UnknownInstance(f'instances: {k} does not exist (the scene has '
-                                      f'{len(self._instances)}: 0..{len(self._instances) - 1})')
-            if k not in ids:
-                ids.append(k)
-        return ids
+        return selection.instance_ids(instances, len(self._instances))
 
     def snapshot(self, instances: Iterable[int] | None = None) -> PartStates:
         """Poses of the parts of `instances` (all when None), in their instance frames."""
@@ -208,15 +184,7 @@ class World:
         already over the region (spawning.spawn_poses)."""
         region = self.drop_region(instance, zone)
         state = self.snapshot([instance])
-        top = 0.0
-        if len(state.ids):
-            cx, cy, hx, hy = region
-            reach = 2.0 * self._part.radius
-            centres = self._centres(state)
-            over = ((np.abs(centres[:, 0] - cx) <= hx + reach)
-                    & (np.abs(centres[:, 1] - cy) <= hy + reach))
-            if over.any():
-                top = max(0.0, float(centres[over, 2].max()) + self._part.radius)
+        top = spawning.pile_top(self._part, region, bodies.part_centres(state.poses, self._part))
         return spawning.spawn_poses(self._instances[instance].rng, self._part, region, top,
                                     count, zone)
 
@@ -233,16 +201,8 @@ class World:
         out of range or the parts do not fit, UnknownInstance for a bad instance id.
         """
         targets = self._instance_ids(instances)
-        count = check_int('count', count, low=1, high=MAX_PARTS_PER_INSTANCE)
-        for k in targets:
-            total = count + len(self._instances[k].part_ids)
-            if total > MAX_PARTS_PER_INSTANCE:
-                raise InvalidArgument('count', count, f'would put {total} parts in instance {k}'
-                                      f' (limit {MAX_PARTS_PER_INSTANCE})')
-            # The rule is on the instance's total: name what the number is when parts are there.
-            held = total - count
-            check_fits('count' if not held else f'count + the {held} parts in instance {k}',
-                       total, self._part.volume, self._scene.container)
+        count = spawning.check_count(count, {k: len(self._instances[k].part_ids)
+                                             for k in targets}, self._part, self._scene.container)
         per_layer = {k: int(np.prod(spawning.grid(self._part, self.drop_region(k, zone), zone)))
                      for k in targets}
         left = dict.fromkeys(targets, count)
@@ -298,23 +258,12 @@ class World:
         if self._drive is None:
             raise InvalidArgument('instances', targets[0], f'is a {self._scene.container.kind}'
                                   ': only trays vibrate')
-        centring = vibration.direction == CENTRE
-        to_centre = [self._to_centre(k) if centring else None for k in targets]
-        amplitudes = np.array([vibration_amplitude(vibration, self._instances[k].rng, c)
-                               for k, c in zip(targets, to_centre, strict=True)])
-        # A period gets at least MIN_STEPS_PER_CYCLE steps: finer steps while vibrating when
-        # the physics step is too coarse for the frequency.
-        dt = self._physics.time_step / vibration_substeps(vibration.frequency,
-                                                          self._physics.time_step)
-        steps = max(1, int(round(vibration.duration / dt)))
-        own = None
-        if centring:    # each tray for its share of the duration, in whole periods
-            half = (self._scene.container.inner_size[0] / 2,
-                    self._scene.container.inner_size[1] / 2)
-            periods = [round(vibration.duration * vibration.frequency * centring_share(c, half))
-                       for c in to_centre]
-            own = [int(round(n / (vibration.frequency * dt))) for n in periods]
-            steps = max(1, *own)
+        to_centre = [self._to_centre(k) if vibration.direction == CENTRE else None
+                     for k in targets]
+        size = self._scene.container.inner_size
+        amplitudes, dt, steps, own = vibration_plan(
+            vibration, [self._instances[k].rng for k in targets], to_centre,
+            self._physics.time_step, (size[0] / 2, size[1] / 2))
         self._drive.start(targets, amplitudes, vibration.frequency, dt, own)
         drive = self._drive
         self._tray_speed = float(np.linalg.norm(amplitudes, axis=1).max()
@@ -345,16 +294,8 @@ class World:
         step run and no removed part touched a part that stays (by the last step's contacts,
         within the contact-breaking threshold): lifting such a part out moves nothing else.
         """
-        ids = []
-        for value in part_ids:
-            pid = check_int('part_ids[]', value, low=0, high=2**32 - 1)
-            if pid not in self._bodies:
-                raise UnknownPart(f'part_ids: {pid} is not a part of this scene')
-            if pid not in ids:
-                ids.append(pid)
-        if not ids:
-            raise InvalidArgument('part_ids', [], 'is empty: name at least one part')
-        touching = self._parts_touching(ids)
+        ids = selection.part_ids(part_ids, self._bodies)
+        touching = bodies.parts_touching(self._client, self._bodies, ids)
         # From a scene at rest, only the parts the removed ones touched settle at first: no
         # other part felt a force change. The rest start frozen, and wake when a moving part
         # comes near (freezing.py).
@@ -368,12 +309,6 @@ class World:
                                                     asleep=asleep))
         self._at_rest = self._at_rest and not touching
         return ids, self._finished(SettleReport(True, 0.0, 0.0, 0))
-
-    def _parts_touching(self, ids: list[int]) -> set[int]:
-        """The parts not in `ids` that a part of `ids` touches (bodies.touching)."""
-        part_of = {body: pid for pid, body in self._bodies.items() if pid not in ids}
-        touched = bodies.touching(self._client, [self._bodies[pid] for pid in ids])
-        return {part_of[b] for b in touched if b in part_of}
 
     # ----------------------------------------------------------------------------- settle
     def settle(self, max_settle_time: float | None = None,
@@ -415,31 +350,13 @@ class World:
         return Freezer(self._client, trays, p.settle_linear_tolerance,
                        p.settle_angular_tolerance, p.settle_window)
 
-    def _centres(self, state: PartStates) -> np.ndarray:
-        """Centres (N, 3) of the parts' bounding boxes in their instance frames, m."""
-        return state.poses[:, :3] + rotate(state.poses[:, 3:], self._part.center)
-
     def _finished(self, last: SettleReport, before: Sequence[SettleReport] = ()) -> SettleReport:
-        """The report of a whole operation, once, at its end: `last` (how it ended) with the
-        times and steps of its earlier runs `before` added in, and where the parts ended:
-        outside their containers, tunnelled (centre in or under the floor or in a wall), and
-        the deepest penetration; and how fast they moved: the fastest part, and the parts
-        thrown faster than speed_limit (of removed parts too)."""
-        for r in before:
-            last.sim_time += r.sim_time
-            last.wall_time += r.wall_time
-            last.steps += r.steps
-        state = self.snapshot()
-        last.escaped_ids = [int(i) for i in state.ids[~state.inside]]
-        if len(state.ids):
-            gone = containers.tunnelled(self._scene.container, self._centres(state))
-            last.tunnelled_ids = [int(i) for i in state.ids[gone]]
-        last.max_penetration = bodies.max_penetration(self._client)
-        limit = stepping.speed_limit(self._scene.container, self._part, self._tray_speed)
-        last.max_speed = max(self._peaks.values(), default=0.0)
-        last.thrown_ids = sorted(pid for pid, v in self._peaks.items() if v > limit)
+        """The report of a whole operation, once, at its end (health.finished), with the
+        operation's peak speeds: they start again from zero."""
+        report = health.finished(last, before, self._client, self._scene.container, self._part,
+                                 self.snapshot(), self._peaks, self._tray_speed)
         self._peaks, self._tray_speed = {}, 0.0
-        return last
+        return report
 
     def _run(self, phase: str, duration: float, progress: ProgressCallback | None,
              stop_when_settled: bool = True, time_step: float | None = None,

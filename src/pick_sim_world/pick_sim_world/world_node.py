@@ -24,7 +24,8 @@ from pick_common.node_runner import (
     RESULT_KEEP,
     run,
 )
-from pick_common.parts import BUILTIN_MODELS, PartSpec
+from pick_common.parts.models import BUILTIN_MODELS
+from pick_common.parts.spec import PartSpec
 from pick_common.specs import CENTRE, check_vibration, FIXED, RANDOM, SceneSpec, Vibration
 from pick_common.states import Progress, SettleReport
 from pick_msgs.action import DropParts, RemoveParts, Vibrate

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 import numpy as np
 from pick_common.containers import ContainerSpec
 from pick_common.errors import check_inside, InvalidArgument, UnknownInstance
-from pick_common.parts import PartSpec
+from pick_common.parts.spec import PartSpec
 from pick_common.specs import SceneSpec, Vibration
 from pick_sim_world.world import World
 import pytest

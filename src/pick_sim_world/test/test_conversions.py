@@ -3,7 +3,8 @@
 from builtin_interfaces.msg import Time
 import numpy as np
 from pick_common.containers import ContainerSpec
-from pick_common.parts import PartSpec
+from pick_common.parts.primitives import Box, Cylinder, Hull
+from pick_common.parts.spec import PartSpec
 from pick_common.specs import SceneSpec
 from pick_sim_world import conversions as conv
 from pick_sim_world.world import World
@@ -41,10 +42,10 @@ def test_each_part_marker_is_its_primitive_placed_by_the_part_pose(model):
                 position, abs=1e-7)   # pybullet composes in about single precision
             assert abs(np.dot([o.x, o.y, o.z, o.w], orientation)) == pytest.approx(1.0, abs=1e-7)
             assert m.header.frame_id == f'w/instance_{instance}' and m.header.stamp.sec == 3
-            expected = {'box': Marker.CUBE, 'cylinder': Marker.CYLINDER}.get(p.kind,
-                                                                              Marker.TRIANGLE_LIST)
+            expected = {Box: Marker.CUBE, Cylinder: Marker.CYLINDER}.get(type(p),
+                                                                          Marker.TRIANGLE_LIST)
             assert m.type == expected
             assert (m.color.r, m.color.g, m.color.b) == pytest.approx(
                 (0.1, 0.3, 0.8) if inside else (0.9, 0.1, 0.1))
-            if p.kind == 'hull':
+            if isinstance(p, Hull):
                 assert len(m.points) == 3 * len(p.faces)

@@ -8,7 +8,7 @@ hovering where their support went, or a pile that moves on once its parts are dy
 import numpy as np
 from pick_common.containers import ContainerSpec
 from pick_common.errors import InvalidArgument
-from pick_common.parts import PartSpec
+from pick_common.parts.spec import PartSpec
 from pick_common.specs import MOVES, SceneSpec
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World

@@ -7,7 +7,9 @@ import os
 
 import numpy as np
 from pick_common.containers import ContainerSpec
-from pick_common.parts import build_part, mass_properties, PartSpec
+from pick_common.parts.geometry import build_part
+from pick_common.parts.mass import mass_properties
+from pick_common.parts.spec import PartSpec
 from pick_common.specs import SceneSpec
 from pick_common.states import rotate
 from pick_sim_world.config import PhysicsConfig

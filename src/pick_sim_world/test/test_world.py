@@ -8,7 +8,9 @@ import numpy as np
 from pick_common import containers
 from pick_common.containers import ContainerSpec
 from pick_common.errors import InvalidArgument, PhysicsFault, UnknownInstance, UnknownPart
-from pick_common.parts import BUILTIN_MODELS, PartSpec
+from pick_common.parts.models import BUILTIN_MODELS
+from pick_common.parts.primitives import Hull
+from pick_common.parts.spec import PartSpec
 from pick_common.specs import CENTRE, FIXED, MOVES, RANDOM, SceneSpec, Vibration
 from pick_common.states import quaternion_angles, rotate
 from pick_sim_world import spawning
@@ -600,7 +602,7 @@ def test_a_user_mesh_settles_in_a_bin(tmp_path):
     mesh.export(path)
     spec = PartSpec(model='mesh', mesh_path=str(path), scale=0.001, mass=0.0003)
     with World(SceneSpec(ContainerSpec(inner_size=(0.08, 0.08, 0.02)), spec)) as world:
-        assert [p.kind for p in world.part.primitives] == ['hull', 'hull']
+        assert [type(p) for p in world.part.primitives] == [Hull, Hull]
         _, report = world.drop(25)
         assert report.settled and report.escaped_ids == []
         assert world.snapshot().inside.all()

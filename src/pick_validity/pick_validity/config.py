@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 from pick_common.errors import check_vector, InvalidArgument, Limit
-from pick_common.parts import geometry_key, PartSpec
+from pick_common.parts.spec import geometry_key, PartSpec
 
 MAX_GRASPS = 32
 MAX_TILTS = 361

@@ -12,7 +12,8 @@ import math
 
 import fcl
 import numpy as np
-from pick_common.parts import PartGeometry
+from pick_common.parts.geometry import PartGeometry
+from pick_common.parts.primitives import Box, Cylinder
 from scipy.spatial import Delaunay
 import trimesh
 
@@ -82,11 +83,11 @@ def part_shapes(part: PartGeometry) -> tuple[Shape, ...]:
     for p in part.primitives:
         rotation = quaternions_to_matrices(np.array([p.orientation]))[0]
         center = np.array(p.position, dtype=np.float64)
-        if p.kind == 'box':
-            half = np.array(p.size, dtype=np.float64)
+        if isinstance(p, Box):
+            half = np.array(p.half, dtype=np.float64)
             shapes.append(Shape(BOX, half, None, rotation, center, fcl.Box(*(2 * half))))
-        elif p.kind == 'cylinder':
-            radius, length = p.size
+        elif isinstance(p, Cylinder):
+            radius, length = p.radius, p.length
             shapes.append(Shape(CYLINDER, np.array([radius, length / 2]), None, rotation, center,
                                 fcl.Cylinder(radius, length)))
         else:

@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from pick_common.errors import InvalidArgument
-from pick_common.parts import PartGeometry
+from pick_common.parts.geometry import PartGeometry
+from pick_common.parts.primitives import Hull
 
 from .config import GraspPose
 
@@ -79,7 +80,7 @@ def surface(part: PartGeometry) -> np.ndarray:
     uncrossed, and a grasp through it refused), as the mass properties take them."""
     if part.visual.is_watertight:
         return np.asarray(part.visual.triangles)
-    hulls = [p.vertices[p.faces] for p in part.primitives if p.kind == 'hull']
+    hulls = [p.vertices[p.faces] for p in part.primitives if isinstance(p, Hull)]
     return np.concatenate(hulls) if hulls else np.asarray(part.visual.triangles)
 
 

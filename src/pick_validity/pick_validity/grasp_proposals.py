@@ -17,7 +17,7 @@ Units: metres; the part frame.
 from dataclasses import dataclass
 
 import numpy as np
-from pick_common.parts import PartGeometry
+from pick_common.parts.geometry import PartGeometry
 import trimesh
 
 from .config import GraspPose

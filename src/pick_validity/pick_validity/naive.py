@@ -12,6 +12,7 @@ from pick_common import containers
 from pick_common.containers import ContainerSpec
 from scipy.spatial.transform import Rotation
 
+from .check_geometry import CheckGeometry
 from .geometry import collide, gripper_shapes, quaternions_to_matrices
 from .results import (
     CENTRE_TOLERANCE,
@@ -27,18 +28,17 @@ from .results import (
     target_rows,
     TIE,
 )
-from .validity import Validator
 
 
-def naive_check(validator: Validator, container: ContainerSpec, ids: Sequence[int],
+def naive_check(geometry: CheckGeometry, container: ContainerSpec, ids: Sequence[int],
                 poses: np.ndarray, targets: Iterable[int] | None = None,
                 neighbour_check: bool = True) -> Report:
     """The reference: every part, every tilt, every other part, FCL for every decision (the
     placing surface a half-space in the part frame), no broadphase, no bounds, no caching;
     the gripper's frame built per tilt from its definition. Same results as
-    `Validator.check`, far slower."""
+    `Validator.check` on the same geometry (`validator.geometry`), far slower."""
     start = time.perf_counter()
-    v = validator
+    v = geometry
     ids = [int(i) for i in ids]
     poses = check_poses(ids, poses)
     rows = target_rows(ids, targets)

@@ -1,12 +1,13 @@
 """The container and neighbour stages of a check (3 and 4), over every (part, tilt) pair that
 placeability left open: exact bounds decide what they can, FCL the rest (a k-d tree of the
-parts' bounding spheres is the neighbours' broadphase). Used by `validity.Validator.check`.
+parts' bounding spheres is the neighbours' broadphase). Each stage returns which pairs its
+gripper hit; `validity.Validator.check` decides what that means for a part (its stage and
+reason) and drops the pairs hit before the next stage.
 """
 
 from collections.abc import Sequence
 import itertools
 import math
-from typing import TYPE_CHECKING
 
 import fcl
 import numpy as np
@@ -14,21 +15,21 @@ from pick_common import containers
 from pick_common.containers import ContainerSpec
 from scipy.spatial import cKDTree
 
-from .geometry import bounds, collide, place, Shape
-from .results import PartResult, STAGE_CANDIDACY, STAGE_CONTAINER, STAGE_NEIGHBOUR
-
-if TYPE_CHECKING:
-    from .validity import Validator
+from .check_geometry import CheckGeometry
+from .geometry import bounds, BOX, collide, HULL, place, Shape
 
 
 class Pairs:
-    """Every (part, tilt) pair still open after placeability, with the gripper's shapes placed
-    in the container frame, their exact bounds, and the masks of `kept` to update."""
+    """Every (part, tilt) pair still open after placeability: its part's row (`row`), tilt
+    (`k`) and grasp (`g`), with the gripper's shapes placed in the container frame and their
+    exact bounds."""
 
-    def __init__(self, v: 'Validator', kept: dict[int, np.ndarray],
-                 results: dict[int, PartResult], frames: dict[int, np.ndarray],
+    def __init__(self, geometry: CheckGeometry, kept: dict[int, np.ndarray],
+                 grasp_of: dict[int, int], frames: dict[int, np.ndarray],
                  rotations: np.ndarray, positions: np.ndarray) -> None:
-        self.v, self.kept, self.results = v, kept, results
+        """kept: row -> (T,) bool, the tilts open; grasp_of: row -> its grasp; frames: row ->
+        (T, 3, 3) the gripper's rotations; rotations (n, 3, 3), positions (n, 3): the parts'."""
+        self.geometry = geometry
         rows, ks = [], []
         for row, mask in kept.items():
             k = np.flatnonzero(mask)
@@ -36,7 +37,7 @@ class Pairs:
             ks.append(k)
         self.row = np.concatenate(rows) if rows else np.zeros(0, dtype=int)
         self.k = np.concatenate(ks) if ks else np.zeros(0, dtype=int)
-        self.g = np.array([results[r].grasp_index for r in self.row], dtype=int)
+        self.g = np.array([grasp_of[r] for r in self.row], dtype=int)
         count, shapes = len(self.row), 2
         self.rot = np.empty((count, shapes, 3, 3))
         self.center = np.empty((count, shapes, 3))
@@ -48,39 +49,35 @@ class Pairs:
             r = rotations[self.row[sel]]
             frame = np.stack([frames[row][k] for row, k in zip(self.row[sel], self.k[sel],
                                                                 strict=True)])
-            origin = positions[self.row[sel]] + r @ v.grasps[g].point
+            origin = positions[self.row[sel]] + r @ geometry.grasps[g].point
             self.grasp_point[sel] = origin
-            for s, shape in enumerate(v.gripper_shapes[g]):
+            for s, shape in enumerate(geometry.gripper_shapes[g]):
                 rot, center = place(shape, frame, origin)
                 self.rot[sel, s], self.center[sel, s] = rot, center
                 self.lo[sel, s], self.hi[sel, s] = bounds(shape, rot, center)
-        self.hit = np.zeros(count, dtype=bool)
+
+    def __len__(self) -> int:
+        return len(self.row)
 
     def _object(self, q: int, s: int) -> fcl.CollisionObject:
-        obj = self.v.gripper_objects[self.g[q]][s]
+        obj = self.geometry.gripper_objects[self.g[q]][s]
         obj.setTransform(fcl.Transform(self.rot[q, s], self.center[q, s]))
         return obj
 
-    def _close(self, stage: int, why: str) -> None:
-        """Apply hits to the masks; parts with no tilt left stop at `stage`."""
-        for q in np.flatnonzero(self.hit):
-            self.kept[self.row[q]][self.k[q]] = False
-        for row, mask in self.kept.items():
-            result = self.results[row]
-            if result.stage == STAGE_CANDIDACY and not mask.any():
-                result.stage = stage
-                result.reason = why.format(name=self.v.grasps[result.grasp_index].name,
-                                           n=int((self.row == row).sum()))
-        keep = ~self.hit
-        for name in ('row', 'k', 'g', 'rot', 'center', 'lo', 'hi', 'grasp_point', 'hit'):
+    def drop(self, hit: np.ndarray) -> None:
+        """Leave out the pairs `hit` (a stage's answer, over the pairs as they are)."""
+        keep = ~hit
+        for name in ('row', 'k', 'g', 'rot', 'center', 'lo', 'hi', 'grasp_point'):
             setattr(self, name, getattr(self, name)[keep])
 
-    def container(self, container: ContainerSpec) -> int:
-        """Stage 3. A convex shape and an axis-aligned wall box: apart when their bounds are;
-        certainly touching when the shape's bounds lie within the box's on two axes (its
-        projection on the third overlaps, so some point of it is inside). FCL decides the
-        rest. Returns the FCL queries issued."""
+    def container(self, container: ContainerSpec) -> tuple[np.ndarray, int]:
+        """Stage 3: (which pairs' gripper hits the container's walls or floor (len(self),)
+        bool, the FCL queries issued). A convex shape and an axis-aligned wall box: apart when
+        their bounds are; certainly touching when the shape's bounds lie within the box's on
+        two axes (its projection on the third overlaps, so some point of it is inside). FCL
+        decides the rest."""
         queries = 0
+        hit = np.zeros(len(self), dtype=bool)
         for half, center in containers.wall_boxes(container):
             wc, wh = np.array(center), np.array(half)
             wall = fcl.CollisionObject(fcl.Box(*(2 * wh)), fcl.Transform(np.eye(3), wc))
@@ -88,22 +85,23 @@ class Pairs:
                 lo, hi = self.lo[:, s], self.hi[:, s]
                 apart = ((lo > wc + wh) | (hi < wc - wh)).any(axis=1)
                 inside = ((lo >= wc - wh) & (hi <= wc + wh)).sum(axis=1) >= 2
-                self.hit |= ~apart & inside
-                for q in np.flatnonzero(~apart & ~inside & ~self.hit):
+                hit |= ~apart & inside
+                for q in np.flatnonzero(~apart & ~inside & ~hit):
                     queries += 1
-                    self.hit[q] = collide(self._object(q, s), wall)
-        self._close(STAGE_CONTAINER, 'grasp {name!r}: the gripper hits the container at each '
-                    'of the {n} placeable tilts')
-        return queries
+                    hit[q] = collide(self._object(q, s), wall)
+        return hit, queries
 
-    def neighbours(self, ids: Sequence[int], rotations: np.ndarray,
-                   positions: np.ndarray) -> int:
-        """Stage 4. Broadphase: a k-d tree over the parts' bounding spheres, queried at once
-        with the bounding sphere of every gripper shape at every pair; then exact bounds; FCL
-        decides the pairs that overlap, and a pair stops at its first hit."""
-        v = self.v
+    def neighbours(self, ids: Sequence[int], rotations: np.ndarray, positions: np.ndarray
+                   ) -> tuple[np.ndarray, dict[int, set[int]], int]:
+        """Stage 4: (which pairs' gripper hits another part (len(self),) bool, the ids of the
+        parts hit per row, the FCL queries issued). Broadphase: a k-d tree over the parts'
+        bounding spheres, queried at once with the bounding sphere of every gripper shape at
+        every pair; then exact bounds; FCL decides the pairs that overlap, and a pair stops at
+        its first hit."""
+        v = self.geometry
+        stopped = np.zeros(len(self), dtype=bool)
         if not len(self.row):
-            return 0
+            return stopped, {}, 0
         placed = [place(s, rotations, positions) for s in v.part_shapes]
         part_bounds = [bounds(s, r, c) for s, (r, c) in zip(v.part_shapes, placed, strict=True)]
         tree = cKDTree(positions + np.einsum('nij,j->ni', rotations, v.part.center))
@@ -141,22 +139,16 @@ class Pairs:
                     shape_set = s
                 queries += 1
                 if collide(gripper, other):
-                    self.hit[q] = True
+                    stopped[q] = True
                     hits.setdefault(int(self.row[q]), set()).add(ids[j])
                     break
-        self._close(STAGE_NEIGHBOUR, 'grasp {name!r}: the gripper hits other parts at each of '
-                    'the {n} remaining tilts')
-        for row, found in hits.items():
-            result = self.results[row]
-            if result.stage == STAGE_NEIGHBOUR:
-                result.reason += f' (parts {sorted(found)})'
-        return queries
+        return stopped, hits, queries
 
 
 def _radius(shape: Shape) -> float:
     """Radius of a sphere about the shape's center that encloses it, m."""
-    if shape.kind == 'hull':
+    if shape.kind == HULL:
         return float(np.linalg.norm(shape.vertices, axis=1).max())
-    if shape.kind == 'box':
+    if shape.kind == BOX:
         return float(np.linalg.norm(shape.half))
     return float(math.hypot(shape.half[0], shape.half[1]))

@@ -36,22 +36,11 @@ import time
 import numpy as np
 from pick_common import containers
 from pick_common.containers import ContainerSpec
-from pick_common.parts import build_part, PartGeometry
+from pick_common.parts.geometry import PartGeometry
 
-from .config import check_grasps, check_gripper, check_place, Grasp, Setup, tilts
-from .geometry import (
-    contains,
-    CYLINDER,
-    grasped_extent,
-    gripper_shapes,
-    matrix_to_quaternion,
-    part_shapes,
-    place,
-    quaternions_to_matrices,
-    rotations_about_x,
-    support,
-)
-from .grasp_fit import check_grasps_fit, round_axis
+from .check_geometry import build_geometry
+from .config import Setup
+from .geometry import matrix_to_quaternion, place, quaternions_to_matrices, support
 from .pairs import Pairs
 from .results import (
     CENTRE_TOLERANCE,
@@ -59,6 +48,8 @@ from .results import (
     PartResult,
     Report,
     STAGE_CANDIDACY,
+    STAGE_CONTAINER,
+    STAGE_NEIGHBOUR,
     STAGE_OUTSIDE,
     STAGE_PLACEABILITY,
     STAGE_VALID,
@@ -74,8 +65,11 @@ def _deg(rad: float) -> str:
 class Validator:
     """The checks for one part model, gripper, set of grasps, placement and settings.
 
-    Build once and reuse: part and gripper geometry, and how deep each grasp's fingers reach,
-    are computed here, never per part.
+    Build once and reuse: the geometry every check shares (check_geometry.CheckGeometry: part
+    and gripper shapes, how deep each grasp's fingers reach, the round bodies a grasp may turn
+    about) is computed here, never per part; its fields read as the Validator's own
+    (`validator.grasps` is `validator.geometry.grasps`). Only the Validator writes a part's
+    stage and reason.
     """
 
     def __init__(self, setup: Setup, part: PartGeometry | None = None) -> None:
@@ -83,38 +77,14 @@ class Validator:
         world's); built here otherwise. Raises InvalidArgument for a bad setup, a grasp whose
         jaws cannot close on the part among them (grasp_fit)."""
         self.setup = setup
-        self.config = setup.config
-        self.part = part if part is not None else build_part(setup.part)
-        self.gripper = check_gripper(setup.gripper)
-        self.grasps = check_grasps(list(setup.grasps))
-        self.grasp_fits = check_grasps_fit(self.part, setup.grasps)
-        self.place_axis, self.seat_offset = check_place(setup.place)
-        self.tilts = tilts(self.config)
-        self._rotations = rotations_about_x(self.tilts)
-        self.part_shapes = part_shapes(self.part)
-        self.finger_depths = tuple(self._finger_depth(g) for g in self.grasps)
-        self.gripper_shapes = [gripper_shapes(self.gripper, g.jaw_opening, depth)
-                               for g, depth in zip(self.grasps, self.finger_depths, strict=True)]
-        self.gripper_objects = [[s.fcl_object() for s in shapes]
-                                 for shapes in self.gripper_shapes]
-        # per grasp: the axis (part frame) of the round body its jaws close across, about which
-        # it may turn; zero for a grasp that is fixed to the part
-        self.free_axes = np.stack([self._free_axis(g) for g in self.grasps])
+        self.geometry = build_geometry(setup, part)
 
-    def _free_axis(self, grasp: Grasp) -> np.ndarray:
-        """The axis of a cylinder of the part that holds the grasp point on its axis and that
-        the closing axis crosses at a right angle, or zeros. A built-in model's cylinders are
-        its primitives; a mesh's are found from its surface (`grasp_fit.round_axis`)."""
-        if self.part.spec.model == 'mesh':
-            return round_axis(self.part, grasp.point, grasp.closing, grasp.up)
-        for shape in self.part_shapes:
-            axis = shape.rotation[:, 2]
-            off = grasp.point - shape.center
-            if (shape.kind == CYLINDER and contains(shape, grasp.point)
-                    and abs(float(axis @ grasp.closing)) < 1e-6
-                    and np.linalg.norm(off - (off @ axis) * axis) < 1e-9):
-                return axis.copy()
-        return np.zeros(3)
+    def __getattr__(self, name: str):
+        """The shared geometry's fields, read-only (only called for names the Validator itself
+        lacks)."""
+        if name == 'geometry':      # not built yet: no recursion through the geometry
+            raise AttributeError(name)
+        return getattr(self.geometry, name)
 
     def turned(self, rotations: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """For parts at rotations (n, 3, 3): each grasp's angle from world +Z (n, G) once
@@ -156,13 +126,6 @@ class Validator:
         s, c = np.sin(turn)[:, None, None], np.cos(turn)[:, None, None]
         return rotations @ (np.eye(3) + s * k + (1.0 - c) * (k @ k))
 
-    def _finger_depth(self, grasp: Grasp) -> float:
-        """How far below the grasp point the fingertips go, m: to `finger_clearance` above
-        the grasped part's bottom, between the grasp point and V below it."""
-        extent = grasped_extent(self.part_shapes, grasp.point, grasp.up)
-        return min(self.gripper.jaw_height,
-                   max(0.0, extent - self.gripper.finger_clearance))
-
     def gripper_frames(self, rotations: np.ndarray, grasp_index: np.ndarray) -> np.ndarray:
         """The gripper's rotations in the container frame, (n, T, 3, 3), for parts at
         rotations (n, 3, 3) held with the grasps `grasp_index` (n,), at every tilt: x along the
@@ -177,7 +140,7 @@ class Validator:
         z[flat] = np.einsum('nij,nj->ni', rotations[flat], up[flat])
         z /= np.linalg.norm(z, axis=1, keepdims=True)
         base = np.stack([x, np.cross(z, x), z], axis=-1)
-        return base[:, None] @ self._rotations[None]
+        return base[:, None] @ self.tilt_rotations[None]
 
     def _approachable(self, frames: np.ndarray) -> np.ndarray:
         """(n, T) bool: the gripper's axis lies within the approach cone of world +Z."""
@@ -261,16 +224,41 @@ class Validator:
             world_frames[row] = frames[n]
 
         # 3. container, 4. neighbours: vectorised over every (part, tilt) pair left.
-        pairs = Pairs(self, kept, results, world_frames, rotations, positions)
-        queries += pairs.container(container)
+        pairs = Pairs(self.geometry, kept, {row: results[row].grasp_index for row in kept},
+                      world_frames, rotations, positions)
+        hit, asked = pairs.container(container)
+        queries += asked
+        self._close(pairs, hit, kept, results, STAGE_CONTAINER, 'grasp {name!r}: the gripper '
+                    'hits the container at each of the {n} placeable tilts')
         if neighbour_check:
-            queries += pairs.neighbours(ids, rotations, positions)
+            hit, touched, asked = pairs.neighbours(ids, rotations, positions)
+            queries += asked
+            self._close(pairs, hit, kept, results, STAGE_NEIGHBOUR, 'grasp {name!r}: the '
+                        'gripper hits other parts at each of the {n} remaining tilts', touched)
         for row, mask in kept.items():
             if mask.any():
                 self._finish_valid(results[row], mask, world_frames[row], rotations[row],
                                    positions[row])
         return Report([results[row] for row in rows], neighbour_check, queries,
                       time.perf_counter() - start)
+
+    def _close(self, pairs: Pairs, hit: np.ndarray, kept: dict[int, np.ndarray],
+               results: dict[int, PartResult], stage: int, why: str,
+               touched: dict[int, set[int]] | None = None) -> None:
+        """After a pair stage: the tilts it hit (`hit`, over `pairs`) leave `kept`; a part with
+        no tilt left stops at `stage`, its reason `why` with the grasp's name and the tilts
+        that were left, and the parts its gripper hit (`touched`: row -> part ids)."""
+        for q in np.flatnonzero(hit):
+            kept[pairs.row[q]][pairs.k[q]] = False
+        for row, mask in kept.items():
+            result = results[row]
+            if result.stage == STAGE_CANDIDACY and not mask.any():
+                result.stage = stage
+                result.reason = why.format(name=self.grasps[result.grasp_index].name,
+                                           n=int((pairs.row == row).sum()))
+                if touched and row in touched:
+                    result.reason += f' (parts {sorted(touched[row])})'
+        pairs.drop(hit)
 
     def _finish_valid(self, result: PartResult, mask: np.ndarray, frames: np.ndarray,
                       rotation: np.ndarray, position: np.ndarray) -> None:

@@ -6,7 +6,7 @@ grasp poses, the placement and the check settings are parameters.
 """
 
 from pick_common.node_runner import answer_error, declare, declare_mesh_dirs, LATCHED, run
-from pick_common.parts import PartSpec
+from pick_common.parts.spec import PartSpec
 from pick_msgs.msg import ValidityReport
 from pick_msgs.srv import CheckParts
 from rclpy.node import Node

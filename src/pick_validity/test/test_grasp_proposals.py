@@ -4,7 +4,8 @@ what `run --check` prints of them reads back as the same grasps."""
 import os
 
 import numpy as np
-from pick_common.parts import build_part, PartSpec
+from pick_common.parts.geometry import build_part
+from pick_common.parts.spec import PartSpec
 from pick_validity.config import GraspPose
 from pick_validity.grasp_fit import check_grasps_fit
 from pick_validity.grasp_proposals import as_yaml, JAW_MARGIN, propose

@@ -6,7 +6,8 @@ import math
 import numpy as np
 from pick_common.containers import ContainerSpec
 from pick_common.errors import InvalidArgument, UnknownPart
-from pick_common.parts import build_part, PartSpec
+from pick_common.parts.geometry import build_part
+from pick_common.parts.spec import PartSpec
 from pick_common.specs import SceneSpec
 from pick_sim_world.world import World
 from pick_validity.config import CheckConfig, GraspPose, Gripper, PlaceSpec, Setup
@@ -215,7 +216,7 @@ def test_a_part_not_in_the_container_is_answered_outside(where, position, words)
     assert inside.valid
     assert report.counts['outside'] == 1 and report.counts['checked'] == 2
     assert report.counts['candidates'] == 1
-    naive = naive_check(_validator(), BIN, [1, 2], [pose, _lying(0, 0.06)])
+    naive = naive_check(_validator().geometry, BIN, [1, 2], [pose, _lying(0, 0.06)])
     assert [r.stage for r in naive.results] == [STAGE_OUTSIDE, STAGE_VALID]
 
 
@@ -281,7 +282,7 @@ def test_fast_check_equals_the_naive_loop_on_settled_scenes(container, model, co
                             place=PlaceSpec(seat_offset=0.003)), part)
         for neighbours in (False, True):
             fast = v.check(container, state.ids, state.poses, neighbour_check=neighbours)
-            naive = naive_check(v, container, state.ids, state.poses,
+            naive = naive_check(v.geometry, container, state.ids, state.poses,
                                 neighbour_check=neighbours)
             assert [r.key() for r in fast.results] == [r.key() for r in naive.results]
             assert fast.queries < naive.queries
@@ -305,7 +306,7 @@ def test_mesh_parts_are_checked_with_their_hulls(tmp_path):
     v = Validator(Setup(spec, grasps=(GraspPose('flat', (0, 0, 1), (1, 0, 0), 0.01),),
                         place=PlaceSpec(seat_offset=0.001)), part)
     fast = v.check(ContainerSpec.tray(), state.ids, state.poses)
-    naive = naive_check(v, ContainerSpec.tray(), state.ids, state.poses)
+    naive = naive_check(v.geometry, ContainerSpec.tray(), state.ids, state.poses)
     assert [r.key() for r in fast.results] == [r.key() for r in naive.results]
 
 

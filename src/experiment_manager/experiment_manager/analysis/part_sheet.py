@@ -18,7 +18,9 @@ matplotlib.use('Agg')
 import matplotlib.pyplot as plt
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 import numpy as np
-from pick_common.parts import build_part, states_units
+from pick_common.parts.geometry import build_part
+from pick_common.parts.primitives import Hull
+from pick_common.parts.spec import states_units
 from pick_validity.geometry import part_shapes, place, Shape, support
 from pick_validity.grasp_proposals import as_yaml, JAW_MARGIN, Proposal
 from pick_validity.validity import Validator
@@ -56,7 +58,7 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
     lines.append(f'  mass {part.mass * 1000:g} g, volume {part.volume * 1e9:.1f} mm^3; mass '
                  f'centre at ({", ".join(f"{v:.2f}" for v in centre * MM)}) mm in its frame'
                  + ('' if part.mass_frame is not None else ' (the frame origin: a built-in)'))
-    hulls = [p for p in part.primitives if p.kind == 'hull']
+    hulls = [p for p in part.primitives if isinstance(p, Hull)]
     if hulls:
         together = sum(_hull_volume(h) for h in hulls)
         over = 100 * (together / part.volume - 1)

@@ -20,13 +20,12 @@ from typing import Any
 from feeder_controller.policy import check_feeder, FeederConfig
 from pick_common.containers import check_container, check_fits, ContainerSpec
 from pick_common.errors import check_int, check_number, InvalidArgument
-from pick_common.parts import PartGeometry
-from pick_common.specs import check_vibration, MOVES, Vibration
+from pick_common.parts.geometry import PartGeometry
+from pick_common.specs import Vibration
 from pick_validity.config import (
     check_grasps,
     check_gripper,
     check_place,
-    CheckConfig,
     Gripper,
     Setup,
     tilts,
@@ -35,7 +34,7 @@ import yaml
 
 from . import part as part_section
 from . import scenarios as scenario_inputs
-from . import schema
+from . import schema, sections
 from .errors import checked as checked_as
 from .errors import read as read_keys
 from .model import (
@@ -43,7 +42,6 @@ from .model import (
     BIN_EMPTYING,
     BIN_STATIC,
     Cell,
-    DEG,
     Experiment,
     ExperimentFile,
     FEEDER_EMPTYING,
@@ -55,7 +53,6 @@ from .model import (
     MAX_ITERATIONS,
     MAX_VARIANTS,
     MM,
-    Requirements,
     Sampling,
     SENSITIVITY,
     TABLE_SWEEP,
@@ -74,45 +71,6 @@ class InvalidFile(InvalidArgument):
         self.errors = list(errors)
         if len(errors) > 1:
             self.args = (f'{len(errors)} errors:\n' + '\n'.join(f'  {e}' for e in errors),)
-
-
-# ---------------------------------------------------------------- sections, to SI units
-def _gripper(g: schema.GripperSection) -> Gripper:
-    return Gripper(**{attr: MM * getattr(g, key) for key, attr in GRIPPER_KEYS})
-
-
-def _check(c: schema.CheckSection) -> CheckConfig:
-    return CheckConfig(tolerance=DEG * c.tolerance_deg, tilt_min=DEG * c.tilt_min_deg,
-                       tilt_max=DEG * c.tilt_max_deg, tilt_step=DEG * c.tilt_step_deg,
-                       approach_cone=DEG * c.approach_cone_deg,
-                       rim_tolerance=MM * c.rim_tolerance_mm)
-
-
-def _requirements(r: schema.RequirementsSection) -> Requirements:
-    return Requirements(parts_per_hour=r.parts_per_hour,
-                        refill_interval=3600.0 * r.refill_interval_h,
-                        max_dimension=MM * r.max_dimension_mm,
-                        max_spilled=r.max_spilled_parts, success_rate=r.success_rate)
-
-
-def _tray(top: schema.FileKeys) -> ContainerSpec:
-    tray = ContainerSpec.tray(tuple(MM * s for s in top.tray_mm))
-    checked_as(check_container, tray, 'tray_mm')
-    return tray
-
-
-def _moves(top: schema.FileKeys) -> tuple[Vibration, ...]:
-    out = []
-    for i, m in enumerate(top.moves):
-        base = MOVES[m.move]
-        move = Vibration(
-            amplitude=tuple(MM * a for a in m.amplitude_mm) if m.amplitude_mm is not None
-            else tuple(MM * float(a / MM) for a in base.amplitude),
-            frequency=m.frequency_hz if m.frequency_hz is not None else float(base.frequency),
-            duration=m.duration_s if m.duration_s is not None else float(base.duration),
-            direction=m.direction if m.direction is not None else base.direction)
-        out.append(checked_as(check_vibration, move, f'moves[{i}]'))
-    return tuple(out)
 
 
 # -------------------------------------------------------------------------- experiments
@@ -331,11 +289,11 @@ def parse(text: str, path: str = '') -> ExperimentFile:
     s = {key: read(model, data.get(key, {}), key) for key, model in schema.SECTIONS.items()}
     read_part = checked(lambda: part_section.read_part(s['part'], base_dir)) if s['part'] else None
     part, grasps, place = read_part or (None, None, None)
-    gripper = _gripper(s['gripper']) if s['gripper'] else None
-    check = _check(s['check']) if s['check'] else None
-    requirements = _requirements(s['requirements']) if s['requirements'] else None
-    tray = checked(lambda: _tray(top)) if top else None
-    moves = checked(lambda: _moves(top)) if top else None
+    gripper = sections.gripper(s['gripper']) if s['gripper'] else None
+    check = sections.check(s['check']) if s['check'] else None
+    requirements = sections.requirements(s['requirements']) if s['requirements'] else None
+    tray = checked(lambda: sections.tray(top)) if top else None
+    moves = checked(lambda: sections.moves(top)) if top else None
     # The cores' own checks, under the file's names.
     if gripper is not None:
         checked(lambda: checked_as(check_gripper, gripper, 'gripper'))

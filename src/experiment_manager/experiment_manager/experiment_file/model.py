@@ -5,7 +5,7 @@ from dataclasses import dataclass, field, replace
 import math
 
 from pick_common.containers import ContainerSpec
-from pick_common.parts import PartSpec
+from pick_common.parts.spec import PartSpec
 from pick_common.specs import Vibration
 from pick_validity.config import CheckConfig, GraspPose, Gripper, PlaceSpec, Setup
 

@@ -5,7 +5,8 @@ each grasp's jaws close on it, every error named by the file's keys."""
 import os
 
 from pick_common.errors import InvalidArgument
-from pick_common.parts import build_part, PartGeometry, PartSpec, states_units, UNITS
+from pick_common.parts.geometry import build_part, PartGeometry
+from pick_common.parts.spec import PartSpec, states_units, UNITS
 from pick_validity.config import CAPACITOR_GRASPS, GraspPose, PlaceSpec
 from pick_validity.grasp_fit import check_grasps_fit
 from pick_validity.grasp_proposals import propose

@@ -12,7 +12,8 @@ from functools import partial
 from typing import Annotated, Any
 
 from pick_common.containers import TRAY_DEFAULT_SIZE
-from pick_common.parts import BUILTIN_MODELS, PartSpec, UNITS
+from pick_common.parts.models import BUILTIN_MODELS
+from pick_common.parts.spec import PartSpec, UNITS
 from pick_common.specs import (
     DEFAULT_CYCLE,
     DIRECTIONS,

@@ -1,4 +1,5 @@
-"""Convex pieces of a concave part mesh, by CoACD, cached on disk.
+"""The convex pieces a mesh part collides as (`convex_cover`): a hull per convex or open body,
+and CoACD's pieces of a concave closed one, cached on disk.
 
 A moving body collides as a compound of convex pieces; one hull over a concave part (a TO-220
 with its tab hole and three leads: 852 mm^3 of hull over 487 mm^3 of part) fills its gaps and
@@ -9,7 +10,7 @@ Its settings, and where they come from:
 - THRESHOLD 0.05: CoACD's own default concavity threshold (its README's `-t`), a fraction of
   the part's size.
 - MAX_PIECES 32: the compound's limit that a mesh's connected bodies already had
-  (`parts.MAX_MESH_HULLS`).
+  (`MAX_MESH_HULLS`).
 - MAX_PIECE_VERTICES 64: CoACD's decimation cap (`max_ch_vertex`, default 256) lowered, because
   a 1,090-vertex hull made table drops 4 to 7 times slower (issue 42's measurement); a small
   part's piece rarely needs more than a few dozen (TO-220: at most 25).
@@ -32,6 +33,10 @@ import tempfile
 import numpy as np
 import trimesh
 
+from ..errors import MeshError
+
+# The most convex pieces a part collides as, in all.
+MAX_MESH_HULLS = 32
 THRESHOLD = 0.05
 MAX_PIECES = 32
 MAX_PIECE_VERTICES = 64
@@ -113,3 +118,63 @@ def _cached_pieces(body: trimesh.Trimesh) -> list[np.ndarray]:
             np.savez(out, **{f'p{i}': p for i, p in enumerate(points)})
         os.replace(tmp, path)
         return points
+
+
+def _hull(points: np.ndarray) -> trimesh.Trimesh | None:
+    try:
+        hull = trimesh.convex.convex_hull(points)
+    except Exception:  # qhull fails on flat or collinear input
+        return None
+    return hull if hull.volume > 0 else None
+
+
+def convex_cover(mesh: trimesh.Trimesh, path: str) -> tuple[list[trimesh.Trimesh], str]:
+    """The convex pieces a mesh collides as, and how they were made, in words.
+
+    Each connected body: closed and convex (`is_convex`), its hull; closed and concave,
+    CoACD's pieces (`convex_pieces`); open, its hull (an open body has no inside to cut,
+    so its concavities stay filled: said in the words). More than MAX_MESH_HULLS pieces in all,
+    or more than MAX_MESH_HULLS bodies: the hull of the whole mesh, said too.
+    """
+    bodies = mesh.split(only_watertight=False)
+    if len(bodies) > MAX_MESH_HULLS:
+        whole = _hull(mesh.vertices)
+        if whole is None:
+            raise MeshError('part.mesh_path', path, 'has zero volume (flat or a line)')
+        return [whole], (f'one convex hull of the whole mesh: it has {len(bodies)} separate '
+                         f'bodies, more than {MAX_MESH_HULLS}')
+    hulls, counts, failed = [], {'convex': 0, 'concave': 0, 'open': 0}, ''
+    for body in bodies:
+        closed = body.is_watertight and body.volume > 0
+        if closed and not is_convex(body):
+            try:
+                cut = [h for h in (_hull(p) for p in convex_pieces(body))
+                       if h is not None]
+            except Exception as exc:    # CoACD's C++ raises what it raises: keep the hull
+                cut, failed = [], f'; CoACD could not cut a body ({exc}): it is its hull'
+            if cut:
+                hulls += cut
+                counts['concave'] += 1
+                continue
+        hull = _hull(body.vertices)
+        if hull is not None:
+            hulls.append(hull)
+            counts['convex' if closed else 'open'] += 1
+    if not hulls:
+        hull = _hull(mesh.vertices)
+        if hull is None:
+            raise MeshError('part.mesh_path', path, 'has zero volume (flat or a line)')
+        return [hull], 'one convex hull of the whole mesh: no body of it has volume'
+    if len(hulls) > MAX_MESH_HULLS:
+        return [_hull(mesh.vertices)], (f'one convex hull of the whole mesh: its pieces number '
+                                        f'{len(hulls)}, more than {MAX_MESH_HULLS}')
+    words = []
+    if counts['concave']:
+        words.append(f'{counts["concave"]} concave closed body(ies) cut into convex pieces by '
+                     f'CoACD (concavity threshold {THRESHOLD:g})')
+    if counts['convex']:
+        words.append(f'{counts["convex"]} convex closed body(ies) as its hull')
+    if counts['open']:
+        words.append(f'{counts["open"]} open body(ies) as its hull (not closed, so not cut: '
+                     'its hollows and gaps collide as filled; close the mesh to have it cut)')
+    return hulls, '; '.join(words) + failed

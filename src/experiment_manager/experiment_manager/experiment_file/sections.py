@@ -1,0 +1,51 @@
+"""The file's sections as the SI dataclasses a run uses: the gripper and the check (mm and degrees
+to m and rad), the requirements (hours to s), the tray and the table's moves (mm to m, each
+move's unset keys from the named move of pick_common.specs.MOVES), each checked by its core's
+rule under the file's key names."""
+
+from pick_common.containers import check_container, ContainerSpec
+from pick_common.specs import check_vibration, MOVES, Vibration
+from pick_validity.config import CheckConfig, Gripper
+
+from . import schema
+from .errors import checked as checked_as
+from .model import DEG, MM, Requirements
+from .schema import GRIPPER_KEYS
+
+
+def gripper(g: schema.GripperSection) -> Gripper:
+    return Gripper(**{attr: MM * getattr(g, key) for key, attr in GRIPPER_KEYS})
+
+
+def check(c: schema.CheckSection) -> CheckConfig:
+    return CheckConfig(tolerance=DEG * c.tolerance_deg, tilt_min=DEG * c.tilt_min_deg,
+                       tilt_max=DEG * c.tilt_max_deg, tilt_step=DEG * c.tilt_step_deg,
+                       approach_cone=DEG * c.approach_cone_deg,
+                       rim_tolerance=MM * c.rim_tolerance_mm)
+
+
+def requirements(r: schema.RequirementsSection) -> Requirements:
+    return Requirements(parts_per_hour=r.parts_per_hour,
+                        refill_interval=3600.0 * r.refill_interval_h,
+                        max_dimension=MM * r.max_dimension_mm,
+                        max_spilled=r.max_spilled_parts, success_rate=r.success_rate)
+
+
+def tray(top: schema.FileKeys) -> ContainerSpec:
+    tray = ContainerSpec.tray(tuple(MM * s for s in top.tray_mm))
+    checked_as(check_container, tray, 'tray_mm')
+    return tray
+
+
+def moves(top: schema.FileKeys) -> tuple[Vibration, ...]:
+    out = []
+    for i, m in enumerate(top.moves):
+        base = MOVES[m.move]
+        move = Vibration(
+            amplitude=tuple(MM * a for a in m.amplitude_mm) if m.amplitude_mm is not None
+            else tuple(MM * float(a / MM) for a in base.amplitude),
+            frequency=m.frequency_hz if m.frequency_hz is not None else float(base.frequency),
+            duration=m.duration_s if m.duration_s is not None else float(base.duration),
+            direction=m.direction if m.direction is not None else base.direction)
+        out.append(checked_as(check_vibration, move, f'moves[{i}]'))
+    return tuple(out)

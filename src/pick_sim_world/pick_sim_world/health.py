@@ -1,0 +1,36 @@
+"""The physics health of an operation (a drop, a vibration, a removal, a settle), told once at
+its end: where the parts ended (outside their containers; tunnelled: a centre in or under the
+floor or in a wall), the deepest penetration, the fastest part and the parts thrown faster than
+the speed a fall and a tray's bounce can give (stepping.speed_limit). Pure core: PyBullet's
+contact query, numpy; no rclpy."""
+
+from collections.abc import Sequence
+
+from pick_common import containers
+from pick_common.containers import ContainerSpec
+from pick_common.parts.geometry import PartGeometry
+from pick_common.states import PartStates, SettleReport
+
+from . import bodies, stepping
+
+
+def finished(last: SettleReport, before: Sequence[SettleReport], client: int,
+             container: ContainerSpec, part: PartGeometry, state: PartStates,
+             peaks: dict[int, float], tray_speed: float) -> SettleReport:
+    """`last` (how the operation ended) with the times and steps of its earlier runs `before`
+    added in, and its health: `state`, the parts as they ended; `peaks`, each part's peak
+    speed in the operation (m/s, removed parts too); `tray_speed`, the tray's peak speed,
+    m/s."""
+    for r in before:
+        last.sim_time += r.sim_time
+        last.wall_time += r.wall_time
+        last.steps += r.steps
+    last.escaped_ids = [int(i) for i in state.ids[~state.inside]]
+    if len(state.ids):
+        gone = containers.tunnelled(container, bodies.part_centres(state.poses, part))
+        last.tunnelled_ids = [int(i) for i in state.ids[gone]]
+    last.max_penetration = bodies.max_penetration(client)
+    limit = stepping.speed_limit(container, part, tray_speed)
+    last.max_speed = max(peaks.values(), default=0.0)
+    last.thrown_ids = sorted(pid for pid, v in peaks.items() if v > limit)
+    return last

@@ -1,0 +1,106 @@
+"""What every check of one setup shares, built once: the part, the gripper, the grasps and how
+each holds the part (its fit, how deep its fingertips reach, the round body it may turn about),
+the wrist tilts, the placing surface, and the shapes and FCL objects of part and gripper. One
+frozen value that the fast check (validity.Validator), its stages over (part, tilt) pairs
+(pairs.py) and the reference (naive.naive_check) all take.
+
+Units: metres, radians; the part frame, or the gripper frame for the gripper's shapes.
+"""
+
+from dataclasses import dataclass
+
+import fcl
+import numpy as np
+from pick_common.parts.geometry import build_part, PartGeometry
+
+from .config import (
+    check_grasps,
+    check_gripper,
+    check_place,
+    CheckConfig,
+    Grasp,
+    Gripper,
+    Setup,
+    tilts,
+)
+from .geometry import (
+    contains,
+    CYLINDER,
+    grasped_extent,
+    gripper_shapes,
+    part_shapes,
+    rotations_about_x,
+    Shape,
+)
+from .grasp_fit import check_grasps_fit, GraspFit, round_axis
+
+
+@dataclass(frozen=True, eq=False)
+class CheckGeometry:
+    """part: the part's geometry; config: the check's settings; gripper; grasps, with
+    grasp_fits (what each one's jaws close on), finger_depths (m below its grasp point) and
+    free_axes (G, 3) (the axis of the round body a grasp closes across, about which it may
+    turn; zeros for a grasp fixed to the part); tilts (T,) rad and tilt_rotations (T, 3, 3)
+    about the gripper's x; place_axis (3,) and seat_offset, m (the placing surface in the part
+    frame); part_shapes; per grasp, the gripper's shapes (jaws, body) and their FCL objects
+    (one per shape, reused by a query that sets its transform)."""
+    part: PartGeometry
+    config: CheckConfig
+    gripper: Gripper
+    grasps: tuple[Grasp, ...]
+    grasp_fits: tuple[GraspFit, ...]
+    tilts: np.ndarray
+    tilt_rotations: np.ndarray
+    place_axis: np.ndarray
+    seat_offset: float
+    part_shapes: tuple[Shape, ...]
+    finger_depths: tuple[float, ...]
+    gripper_shapes: tuple[tuple[Shape, Shape], ...]
+    gripper_objects: tuple[tuple[fcl.CollisionObject, ...], ...]
+    free_axes: np.ndarray
+
+
+def build_geometry(setup: Setup, part: PartGeometry | None = None) -> CheckGeometry:
+    """The geometry of a setup's checks. `part`: the geometry of setup.part when the caller
+    has built it already (the world's); built here otherwise. Raises InvalidArgument for a bad
+    setup or a grasp whose jaws cannot close on the part (grasp_fit)."""
+    part = part if part is not None else build_part(setup.part)
+    gripper = check_gripper(setup.gripper)
+    grasps = tuple(check_grasps(list(setup.grasps)))
+    fits = check_grasps_fit(part, setup.grasps)
+    place_axis, seat_offset = check_place(setup.place)
+    angles = tilts(setup.config)
+    shapes = part_shapes(part)
+    depths = tuple(_finger_depth(shapes, gripper, g) for g in grasps)
+    jaws = tuple(gripper_shapes(gripper, g.jaw_opening, depth)
+                 for g, depth in zip(grasps, depths, strict=True))
+    return CheckGeometry(
+        part=part, config=setup.config, gripper=gripper, grasps=grasps, grasp_fits=fits,
+        tilts=angles, tilt_rotations=rotations_about_x(angles), place_axis=place_axis,
+        seat_offset=seat_offset, part_shapes=shapes, finger_depths=depths,
+        gripper_shapes=jaws,
+        gripper_objects=tuple(tuple(s.fcl_object() for s in pair) for pair in jaws),
+        free_axes=np.stack([_free_axis(part, shapes, g) for g in grasps]))
+
+
+def _finger_depth(shapes: tuple[Shape, ...], gripper: Gripper, grasp: Grasp) -> float:
+    """How far below the grasp point the fingertips go, m: to `finger_clearance` above the
+    grasped part's bottom, between the grasp point and V below it."""
+    extent = grasped_extent(shapes, grasp.point, grasp.up)
+    return min(gripper.jaw_height, max(0.0, extent - gripper.finger_clearance))
+
+
+def _free_axis(part: PartGeometry, shapes: tuple[Shape, ...], grasp: Grasp) -> np.ndarray:
+    """The axis of a cylinder of the part that holds the grasp point on its axis and that the
+    closing axis crosses at a right angle, or zeros. A built-in model's cylinders are its
+    primitives; a mesh's are found from its surface (`grasp_fit.round_axis`)."""
+    if part.spec.model == 'mesh':
+        return round_axis(part, grasp.point, grasp.closing, grasp.up)
+    for shape in shapes:
+        axis = shape.rotation[:, 2]
+        off = grasp.point - shape.center
+        if (shape.kind == CYLINDER and contains(shape, grasp.point)
+                and abs(float(axis @ grasp.closing)) < 1e-6
+                and np.linalg.norm(off - (off @ axis) * axis) < 1e-9):
+            return axis.copy()
+    return np.zeros(3)
