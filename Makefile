@@ -61,7 +61,7 @@ run: $(BUILD_STAMP)
 	fi
 
 lint: $(DEPS_STAMP)
-	$(WS) ruff check src tests bench tools
+	$(WS) ruff check src tests bench studies tools
 
 test: $(BUILD_STAMP) lint
 	$(WS) python -m pytest $(PYTEST_ARGS)

@@ -8,5 +8,7 @@ run (never timed assertions in tests). Run from the top of the workspace, by are
 
 Each script's docstring says what it measures and how to call it; `paper_case` holds what
 several share (the paper's test-case files, a variant of one, a run on the cores, a worker's
-nodes). Benchmarks call public names only. Their figures are in docs/benchmarks.md.
+nodes). Benchmarks call public names only. Their figures are in docs/benchmarks.md. Studies of
+finished runs (decisions on few runs, replays, run comparisons) are in studies/, with a test
+each; re-deciding a finished run is the `decide` command.
 """

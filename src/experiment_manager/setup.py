@@ -31,6 +31,7 @@ setup(
             'experiment_manager = experiment_manager.graph.experiment_manager_node:main',
             'run = experiment_manager.commands.run:main',
             'replay = experiment_manager.commands.replay:main',
+            'decide = experiment_manager.commands.decide:main',
         ],
     },
 )

@@ -12,7 +12,7 @@ never waits for physics.
 from collections.abc import Callable
 import threading
 
-from pick_common import containers, parts, specs
+from pick_common import containers, specs
 from pick_common import conversions as common
 from pick_common.containers import BIN, ContainerSpec, TRAY
 from pick_common.errors import InvalidArgument
@@ -25,6 +25,7 @@ from pick_common.node_runner import (
     run,
 )
 from pick_common.parts.models import BUILTIN_MODELS
+from pick_common.parts.spec import LIMITS as PART_LIMITS
 from pick_common.parts.spec import PartSpec
 from pick_common.specs import CENTRE, check_vibration, FIXED, RANDOM, SceneSpec, Vibration
 from pick_common.states import Progress, SettleReport
@@ -125,7 +126,7 @@ class WorldNode(Node):
                     for name, value in defaults.items()}
         mass = get('part.mass', default_mass, 'kg; 0 for the model default (checked when the '
                    'part is built)')
-        spec, material = PartSpec(), parts.LIMITS
+        spec, material = PartSpec(), PART_LIMITS
         part = PartSpec(
             model=model, dimensions=dims, mass=mass or None,
             lateral_friction=get('part.lateral_friction', spec.lateral_friction,

@@ -46,6 +46,25 @@ def keep_part_file(mesh_path: str, experiment_path: str, directory: str) -> str:
     return target
 
 
+def write_atomic(path: str, text: str) -> None:
+    """Write a text file atomically (a reader never sees half of it), with the mode open()
+    would give it."""
+    fd, tmp = tempfile.mkstemp(dir=os.path.dirname(path) or '.',
+                               prefix=f'.{os.path.basename(path)}.')
+    with os.fdopen(fd, 'w', encoding='utf-8') as f:
+        f.write(text)
+    os.chmod(tmp, 0o666 & ~UMASK)   # as open() would create it, not mkstemp's 0600
+    os.replace(tmp, path)
+
+
+def write_summary(directory: str, summary: dict) -> None:
+    """A run directory's summary.json, checked against its model first (summary.validate): a
+    summary that breaks the published schema is a bug of ours, raised here, never written."""
+    validate(summary)
+    write_atomic(os.path.join(directory, 'summary.json'),
+                 json.dumps(summary, indent=2, allow_nan=False) + '\n')
+
+
 def read_csv(path: str) -> list[dict]:
     """The rows of a results file, typed."""
     return [parse_row(r) for r in read_text_rows(path)]
@@ -136,12 +155,7 @@ class ResultsWriter:
         return os.path.join(self.directory, name if '.' in name else f'{name}.csv')
 
     def _write_text(self, name: str, text: str) -> None:
-        """Write a file atomically (a reader never sees half of it)."""
-        fd, tmp = tempfile.mkstemp(dir=self.directory, prefix=f'.{name}.')
-        with os.fdopen(fd, 'w', encoding='utf-8') as f:
-            f.write(text)
-        os.chmod(tmp, 0o666 & ~UMASK)   # as open() would create it, not mkstemp's 0600
-        os.replace(tmp, self.path(name))
+        write_atomic(self.path(name), text)
 
     def _resume(self, experiment_text: str) -> None:
         try:
@@ -235,10 +249,7 @@ class ResultsWriter:
         return [r for r in self._rows['checks'] if r['experiment'] == experiment_id]
 
     def write_summary(self, summary: dict) -> None:
-        """summary.json, checked against its model first (summary.validate): a summary that
-        breaks the published schema is a bug of ours, raised here, never written."""
-        validate(summary)
-        self._write_text('summary.json', json.dumps(summary, indent=2, allow_nan=False) + '\n')
+        write_summary(self.directory, summary)
 
     def close(self) -> None:
         for f in self._files.values():

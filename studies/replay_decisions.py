@@ -6,7 +6,7 @@ sampling.unsettled places them) and decides on the recorded rows released so far
 does, until the decision is settled, the experiment's iterations are spent, or the record
 runs out (said: the replay then stops short of what a run would take).
 
-    tools/ws python -m bench.experiment.replay_decisions [--batch B] RUN_DIR...
+    tools/ws python -m studies.replay_decisions [--batch B] RUN_DIR...
 
 --batch: replay as if the file's sampling.batch were B (a smaller batch replays exactly as
 long as its looks stay inside the record).

@@ -1,7 +1,7 @@
 """Two runs of feeder runs side by side on the seeds they share: what a change to the cell (its
 moves, say) did to the same drops. Reads each run directory's iterations.csv and checks.csv.
 
-    tools/ws python -m bench.experiment.compare_runs RUN_DIR_A RUN_DIR_B [--experiment feeder]
+    tools/ws python -m studies.compare_runs RUN_DIR_A RUN_DIR_B [--experiment feeder]
         [--picture PNG [--iteration N]]
 
 Prints, for each run over the iterations whose seeds both ran: runs emptied, vibrations and

@@ -2,7 +2,7 @@
 the comparison with the paper (docs/paper-test-case.md), measured on the run rather than
 guessed.
 
-    tools/ws python -m bench.experiment.run_stages RUN_DIR [--counts 49 80]
+    tools/ws python -m studies.run_stages RUN_DIR [--counts 49 80]
 
 Prints, per experiment type present:
 - table_sweep: at each count asked for (default: the paper's n* for the file's id when it is a

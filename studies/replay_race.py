@@ -5,7 +5,7 @@ running/sampling.ended as a run does, until the race ends or the recorded drops 
 leader's, and a tie was the leader's upper bound less the bin's lower bound); with --overlap
 --tie 0 it gives back the race the runs of 2026-11-27 ran (before the tie rule).
 
-    tools/ws python -m bench.experiment.replay_race [--tie 0.05] [--overlap] RUN_DIR...
+    tools/ws python -m studies.replay_race [--tie 0.05] [--overlap] RUN_DIR...
 
 RUN_DIR: an adaptive run's directory (its experiment.yaml and iterations.csv), with a
 bin_static experiment `bins`.

@@ -1,7 +1,7 @@
 """The table's verdict on few feeder runs against the verdict on many (issue 43, item 3).
 
 Two steps:
-  tools/ws python -m bench.experiment.feeder_decisions files DIR
+  tools/ws python -m studies.feeder_decisions files DIR
 writes DIR/feeder_pth0.yaml, feeder_pth1.yaml, feeder_pth2.yaml: the test case's parts,
 grippers and requirements (config/test_case/pth*.yaml) with one experiment, 50 feeder runs at
 the optimal range of the full-count sweeps (n* 72, 45 and 54, +-5: docs/paper-test-case.md),
@@ -9,7 +9,7 @@ to be run through the graph (`files DIR --moves centre,flip` writes feeder_pth0_
 and so on: the same runs with another feeder cycle, for compare_runs.py):
   tools/ws install/experiment_manager/lib/experiment_manager/run --output DIR/runs DIR/*.yaml
 and then
-  tools/ws python -m bench.experiment.feeder_decisions table RUN_DIR... [--draws 2000]
+  tools/ws python -m studies.feeder_decisions table RUN_DIR... [--draws 2000]
 reads each run's iterations.csv and prints, per part, the verdict on all its runs, then, for
 subsamples of 3, 5, 8 and 12 runs drawn without replacement `--draws` times, how often the
 verdict on the subsample agrees with the full data's, how often it says FEASIBLE where the
@@ -23,7 +23,7 @@ runs (fixed counts), the runs adaptive sampling took before this rule (batches o
 share of runs emptied was settled at 99.9 %, two-sided: 73 runs when all empty, so all 50),
 and the runs it takes with this rule (sampling.unsettled after each batch of 5).
 
-  tools/ws python -m bench.experiment.feeder_decisions noise RUN_DIR... [--populations 60]
+  tools/ws python -m studies.feeder_decisions noise RUN_DIR... [--populations 60]
 asks how far the borderline's false-FEASIBLE rate would stray with a decision that is exact:
 it draws populations of as many runs as each part has from the Gumbel fitted to them (the
 model the decision assumes, so that its 95 % holds by construction), puts each population's
@@ -32,17 +32,14 @@ borderline where `table` puts it, and prints the spread of the same rate over th
 the quantile itself, where a one-sided 95 % bound says FEASIBLE 5 % of the time on average;
 one population of 50 scatters about that.
 
-  tools/ws python -m bench.experiment.feeder_decisions plot RUN_DIR... --out PNG
+  tools/ws python -m studies.feeder_decisions plot RUN_DIR... --out PNG
 draws each part's probability plots: its runs' times to empty, ordered, against the Gumbel's
 quantiles, and their logarithms less the picks' time against the normal's (the lognormal the
 bound used before 2026-11-27; Gringorten's and Blom's plotting positions), each with the
 fitted line; where the points bend off a line at the top, that
 model's tail is too short for the runs.
 
-  tools/ws python -m bench.experiment.feeder_decisions regrade RUN_DIR...
-decides the table's time ground of every feeder experiment of finished runs (a sensitivity
-run's scenarios too) again with today's rule, from their iterations.csv, and prints each with
-its bound, its fit check's p and its runs' times: for results written before a rule changed.
+Deciding finished runs again with today's rules is the `decide` command.
 """
 
 import argparse
@@ -56,7 +53,7 @@ from experiment_manager.running import sampling
 import numpy as np
 import yaml
 
-from ..paper_case import TEST_CASE
+from . import TEST_CASE
 
 # the full-count sweeps' n* (docs/paper-test-case.md, "In short") and the files' margin
 N_STAR = {'pth0': 72, 'pth1': 45, 'pth2': 54}
@@ -187,27 +184,6 @@ def cost(run_dirs: list[str]) -> None:
               f'({before}) | {minutes[now - 1]:.1f} ({now})')
 
 
-def regrade(run_dirs: list[str]) -> None:
-    for run_dir in run_dirs:
-        file = experiment_file.load(os.path.join(run_dir, 'experiment.yaml'))
-        rows = read_csv(os.path.join(run_dir, 'iterations.csv'))
-        print(os.path.basename(os.path.normpath(run_dir)))
-        for exp_id in dict.fromkeys(r['experiment'] for r in rows
-                                    if r['type'] == 'feeder_emptying'):
-            mine = [r for r in rows if r['experiment'] == exp_id]
-            out = metrics.left_out(mine)
-            grounds = metrics.table_grounds(file, [r for r in mine if (r['group'], r['iteration'])
-                                                   not in out])
-            time = grounds['time']
-            fit = time.detail.get('gumbel')
-            times = ', '.join('-' if t is None else f'{t / 60:.2f}'
-                              for t in time.detail.get('times_s', []))
-            bound = '-' if time.bound is None else f'{time.bound / 60:.1f} min'
-            p = '-' if fit is None else f'{fit["p"]:.3f}'
-            print(f'  {exp_id}: {decisions.combined([g.verdict for g in grounds.values()])}; '
-                  f'time {time.verdict}, bound {bound}, fit p {p}; times {times} min')
-
-
 def plot(run_dirs: list[str], out: str) -> None:
     import matplotlib
     matplotlib.use('Agg')
@@ -262,16 +238,12 @@ def main(argv: list[str] | None = None) -> int:
     drawn = sub.add_parser('plot')
     drawn.add_argument('run_dirs', nargs='+')
     drawn.add_argument('--out', required=True)
-    again = sub.add_parser('regrade')
-    again.add_argument('run_dirs', nargs='+')
     args = parser.parse_args(argv)
     if args.command == 'files':
         print('\n'.join(write_files(args.directory,
                                      args.moves.split(',') if args.moves else None)))
     elif args.command == 'plot':
         plot(args.run_dirs, args.out)
-    elif args.command == 'regrade':
-        regrade(args.run_dirs)
     elif args.command == 'noise':
         noise(args.run_dirs, args.populations, args.draws, args.seed)
     else:

@@ -1,0 +1,52 @@
+"""A finished run decided again with today's rules: every experiment's summary computed anew
+from the run's own result files (iterations.csv, picks.csv, checks.csv) and the experiment file
+it kept, in the file's order, as the scheduler computes it when an experiment's last iteration
+is written. What a rule cannot recompute is kept from the run's summary.json: an adaptive
+experiment's sampling (the batches it took are the run's history). Results written before a
+rule changed (the table's bound, the bins' race) are then read as today's. No rclpy."""
+
+import os
+
+from .. import experiment_file
+from ..experiment_file import SENSITIVITY
+from . import metrics, sensitivity
+from . import summary as summary_model
+from .results import read_csv
+
+
+def redecide(run_dir: str) -> dict:
+    """The summary (summary.json's dict, current version) of the run in `run_dir` as today's
+    metrics and decisions give it. Raises InvalidArgument when its experiment.yaml no longer
+    reads, OSError when a result file is missing."""
+    file = experiment_file.load(os.path.join(run_dir, 'experiment.yaml'))
+    rows, picks, checks = (read_csv(os.path.join(run_dir, f'{name}.csv'))
+                           for name in ('iterations', 'picks', 'checks'))
+    sampled = _sampling(run_dir)
+    summaries: dict[str, dict] = {}
+    for exp in file.experiments:
+        if exp.type == SENSITIVITY:
+            if all(source in summaries for source in exp.sources):
+                summaries[exp.id] = sensitivity.summarise(file, exp, summaries)
+            continue
+        mine = [r for r in rows if r['experiment'] == exp.id]
+        if not mine:            # an interrupted run: not reached
+            continue
+        summaries[exp.id] = metrics.summarise(
+            file.for_experiment(exp), exp, mine,
+            [p for p in picks if p['experiment'] == exp.id], summaries,
+            [c for c in checks if c['experiment'] == exp.id])
+        if exp.id in sampled:
+            summaries[exp.id]['sampling'] = sampled[exp.id]
+    return metrics.file_summary(file, summaries)
+
+
+def _sampling(run_dir: str) -> dict[str, dict]:
+    """Each adaptive experiment's sampling as the run's summary.json recorded it (any
+    version), by id; none without a summary."""
+    path = os.path.join(run_dir, 'summary.json')
+    if not os.path.exists(path):
+        return {}
+    old = summary_model.read(path)
+    every = {**old.experiments, **(old.repeats or {})}
+    return {k: s.sampling.model_dump(exclude_unset=True) for k, s in every.items()
+            if s.sampling is not None}

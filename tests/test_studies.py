@@ -1,0 +1,78 @@
+"""Each study of studies/ runs on a small recorded run and prints what its docstring promises:
+a study that docs/ cites must still run. The runs are made here on the cores (no graph): the
+experiment manager's small file without its gripper sweep, once adaptively (the replays need a
+run's looks) and once at fixed counts (compare_runs needs two runs of the same seeds)."""
+
+import os
+import subprocess
+import sys
+
+from experiment_manager import experiment_file
+from experiment_manager.analysis.results import ResultsWriter
+from experiment_manager.running.local_backend import LocalBackend
+from experiment_manager.running.scheduler import Runner
+import pytest
+
+TOP = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..')
+SMALL = os.path.join(TOP, 'src', 'experiment_manager', 'test', 'small_experiment.yaml')
+
+
+@pytest.fixture(scope='module')
+def runs(tmp_path_factory) -> dict[str, str]:
+    """{'adaptive': run directory, 'fixed': run directory} of the small file's bins, bin
+    emptying, sweep and feeder."""
+    with open(SMALL, encoding='utf-8') as f:
+        text = f.read().split('  - {id: grippers')[0]
+    out = {}
+    for mode in ('adaptive', 'fixed'):
+        file = experiment_file.parse(text + f'sampling: {{mode: {mode}, batch: 2}}\n', SMALL)
+        directory = str(tmp_path_factory.mktemp(mode))
+        with LocalBackend() as backend, ResultsWriter(directory, file.text) as sink:
+            Runner(file, [backend], sink).run()
+        out[mode] = directory
+    return out
+
+
+def _study(*args: str) -> str:
+    done = subprocess.run([sys.executable, '-m', *args], cwd=TOP, capture_output=True,
+                          text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+    return done.stdout
+
+
+def test_run_stages_says_where_parts_were_turned_down(runs):
+    out = _study('studies.run_stages', runs['fixed'])
+    assert 'bins (bin_static)' in out and 'feeder (feeder_emptying)' in out, out
+    assert 'per check: checked' in out
+
+
+def test_compare_runs_sets_two_runs_side_by_side_on_their_seeds(runs, tmp_path):
+    picture = str(tmp_path / 'compare.png')
+    out = _study('studies.compare_runs', runs['fixed'], runs['adaptive'], '--picture', picture)
+    assert 'emptied' in out and os.path.basename(runs['fixed']) in out, out
+    with open(picture, 'rb') as f:
+        assert f.read(8) == b'\x89PNG\r\n\x1a\n'
+
+
+def test_replay_decisions_prices_an_adaptive_runs_decisions(runs):
+    out = _study('studies.replay_decisions', runs['adaptive'])
+    assert 'in all:' in out and 'worker-min replayed against' in out, out
+    assert 'bins:' in out and 'feeder:' in out
+
+
+def test_replay_race_replays_the_bins_race(runs):
+    out = _study('studies.replay_race', runs['adaptive'])
+    assert 'best bin' in out and 'looks' in out, out
+
+
+def test_feeder_decisions_tables_decisions_on_few_runs(runs, tmp_path):
+    out = _study('studies.feeder_decisions', 'table', runs['fixed'], '--draws', '20')
+    assert "time to the table's decision" in out, out
+    picture = str(tmp_path / 'fit.png')
+    assert _study('studies.feeder_decisions', 'plot', runs['fixed'], '--out',
+                  picture).strip() == picture
+    written = _study('studies.feeder_decisions', 'files', str(tmp_path / 'files')).split()
+    assert [os.path.basename(p) for p in written] == [
+        'feeder_pth0.yaml', 'feeder_pth1.yaml', 'feeder_pth2.yaml']
+    for path in written:
+        experiment_file.load(path)      # what it writes is a file a run reads
