@@ -1,4 +1,4 @@
-"""The table's verdict on few feeder runs against the verdict on many (issue 43, item 3).
+"""The table's verdict on few feeder runs against the verdict on many.
 
 Two steps:
   tools/ws python -m studies.feeder_decisions files DIR
@@ -35,7 +35,7 @@ one population of 50 scatters about that.
   tools/ws python -m studies.feeder_decisions plot RUN_DIR... --out PNG
 draws each part's probability plots: its runs' times to empty, ordered, against the Gumbel's
 quantiles, and their logarithms less the picks' time against the normal's (the lognormal the
-bound used before 2026-11-27; Gringorten's and Blom's plotting positions), each with the
+bound used before the Gumbel's; Gringorten's and Blom's plotting positions), each with the
 fitted line; where the points bend off a line at the top, that
 model's tail is too short for the runs.
 
@@ -199,7 +199,7 @@ def plot(run_dirs: list[str], out: str) -> None:
         location, scale = decisions.gumbel_fit(times)
         gumbel = decisions.gringorten(n)
         normal = stats.norm.ppf((np.arange(1, n + 1) - 0.375) / (n + 0.25))
-        # the lognormal before 2026-11-27 was of the time less the picks' (the same in every
+        # the lognormal was of the time less the picks' (the same in every
         # emptied run)
         picking = max(r['picks'] for r in rows) * file.cell.pick_time / 60.0
         logs = np.log(times - picking)

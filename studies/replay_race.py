@@ -1,9 +1,9 @@
 """Replay the bins' race of finished adaptive runs with a given BIN_TIE, on their recorded drops:
 the same batches (5 per bin, then 5 per bin still racing), each look deciding with
 running/sampling.ended as a run does, until the race ends or the recorded drops run out.
---overlap replays the rule before 2026-11-27 (a bin left when its 99.9 % interval lay below the
+--overlap replays the earlier rule (a bin left when its 99.9 % interval lay below the
 leader's, and a tie was the leader's upper bound less the bin's lower bound); with --overlap
---tie 0 it gives back the race the runs of 2026-11-27 ran (before the tie rule).
+--tie 0 it gives back the race as runs made before the tie rule ran it.
 
     tools/ws python -m studies.replay_race [--tie 0.05] [--overlap] RUN_DIR...
 
@@ -25,7 +25,7 @@ from . import replay_decisions
 
 
 def overlap_race(exp, rows: list[dict]) -> tuple[list[int], list[int]]:
-    """sampling.race before 2026-11-27: each bin's own interval at INTERIM_CONFIDENCE against
+    """The earlier sampling.race: each bin's own interval at INTERIM_CONFIDENCE against
     the leader's."""
     if len(groups(exp)) == 1:
         return [], []
@@ -72,7 +72,7 @@ def main() -> None:
                         help=f'BIN_TIE to replay with (default {sampling.BIN_TIE})')
     parser.add_argument('--batch', type=int, default=5, help="the runs' sampling.batch")
     parser.add_argument('--overlap', action='store_true',
-                        help='the rule before 2026-11-27: intervals that do not overlap')
+                        help='the earlier rule: intervals that do not overlap')
     args = parser.parse_args()
     sampling.BIN_TIE = args.tie
     if args.overlap:

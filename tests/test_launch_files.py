@@ -1,4 +1,4 @@
-"""The launch files (issue 23). ros2/launch is not on PyPI (ROS_WHEELS.md), so they cannot run
+"""The launch files. ros2/launch is not on PyPI (ROS_WHEELS.md), so they cannot run
 here; what can be checked without it is: every node of the graph has a launch file that starts
 it, a worker node's launch file defaults to the parameter file its package installs, and the
 graph's launch file has a launch argument for every parameter the manager declares, with the

@@ -1,6 +1,6 @@
 """Every package's package.xml declares what its code imports, and only keys that rosdep can
-resolve, so that `rosdep install --from-paths src --ignore-src` works on a full ROS install
-(issue 23). The imports are read with `ast` from each package's module, launch files and tests:
+resolve, so that `rosdep install --from-paths src --ignore-src` works on a full ROS install.
+The imports are read with `ast` from each package's module, launch files and tests:
 module and launch imports must be run dependencies (`exec_depend` or `depend`), test imports
 run or test dependencies."""
 
@@ -45,7 +45,7 @@ ROS_PACKAGES = {
 }
 # Keys a package.xml may name beyond the two sets above: the build tools of the interface
 # package, and the rosdep keys in IMPORT_KEYS. The pip keys are the names in rosdistro's
-# rosdep/python.yaml (`python3-pybullet` and `python3-fcl-pip` are not keys there: issue 23).
+# rosdep/python.yaml (`python3-pybullet` and `python3-fcl-pip` are not keys there).
 BUILD_KEYS = {'ament_cmake', 'rosidl_default_generators', 'rosidl_default_runtime'}
 ROSDEP_KEYS = {key for key in IMPORT_KEYS.values() if key}
 

@@ -6,7 +6,7 @@ crosses through shared memory). Each side names the other: a node announces itse
 peer's first four participants only (Fast DDS's initial peers range), and this side runs more
 than four (seen: with the static peer on the remote side alone, this side's test client never
 saw the remote worker in 120 s). The run gives the result files of the same file run on the
-cores in one process, and the remote worker's topics are in the recording (issue 22).
+cores in one process, and the remote worker's topics are in the recording.
 
 Needs root for `ip netns`; the test makes and removes its namespace and link itself.
 """
@@ -34,7 +34,7 @@ pytestmark = pytest.mark.graph
 FILE = """id: two_hosts
 seed: 13
 gripper: {body_diameter_mm: 8, jaw_depth_mm: 3}
-moves: [forward]          # what {direction: fixed} over spread was until 2026-11-27
+moves: [forward]          # {direction: fixed} over spread: conveying along +x
 experiments:
   - {id: bins, type: bin_static, iterations: 2, parts: 20, bins_mm: [[100, 100, 20]]}
   - {id: emptying, type: bin_emptying, iterations: 2, parts: 15, bin: [100, 100, 20]}

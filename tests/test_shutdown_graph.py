@@ -1,6 +1,6 @@
 """Every node stops cleanly on SIGINT and on SIGTERM, also with work in flight: exit code 0 and
 no native crash, many times over. (Under launch, `world` once died with SIGSEGV in librcl on
-SIGINT: issue 24.)"""
+SIGINT.)"""
 
 import signal
 import subprocess
@@ -92,7 +92,7 @@ def test_the_validity_node_stops_cleanly(client, signum):
 
 # A node whose start is cut short by a signal: the world publishes its first scene at the end
 # of its constructor, and a SIGINT that came just before made that publish fail ('publisher's
-# context is invalid'), which once read as a failed start (exit 2; CI, 2026-11-25).
+# context is invalid'), which once read as a failed start (exit 2, in CI).
 INTERRUPTED_START = """
 import os, signal, sys, time
 import rclpy
@@ -124,7 +124,7 @@ def make_node():
 
 class SignalInside:
     # A lock that sends the signal once while it is held: Python runs the handler at the
-    # main thread's next bytecode, as it did once inside Context.ok() (CI, 2026-11-25).
+    # main thread's next bytecode, as it did once inside Context.ok() (in CI).
     def __init__(self, lock):
         self.lock, self.armed = lock, True
     def __enter__(self):

@@ -1,4 +1,4 @@
-"""How honest the progress line's ETA is, replayed on a finished run (issue 43, item 7).
+"""How honest the progress line's ETA is, replayed on a finished run.
 
   tools/ws python -m bench.experiment.bench_eta RUN_DIR [--workers 2]
 
@@ -24,7 +24,7 @@ from experiment_manager.running.estimate import Costs, mean_units, units
 
 
 def before(done: dict, left: list, workers: int) -> float:
-    """The estimate before issue 43: seconds per weighed part of the experiment, its type or
+    """The earlier estimate: seconds per weighed part of the experiment, its type or
     all (a feeder run's part weighing 200), 0 (unknown) before anything finished."""
     weight = {FEEDER_EMPTYING: 200.0}
     total = 0.0

@@ -10,14 +10,14 @@ identical (they must be).
 
 --rounds R runs the three R times in turn and prints the ratio and the throughput of each
 round and their medians (the table sums the rounds): on this shared machine single runs of the
-same code spread by 10 % and more (docs/benchmarks.md, 2026-11-26), more than most levers.
+same code spread by 10 % and more (docs/benchmarks.md), more than most levers.
 
 --iterations N caps every experiment of FILE at N iterations (as `run --iterations` does), so
 that a test-case file can be the workload: e.g. `--iterations 2
 src/experiment_manager/config/test_case/pth2.yaml`, about 17 min.
 
 --paper-case adds the wall time of the paper's full test case from the run directories of a
-run made before (6.1 hours on this machine on 2026-11-23, so not run here: `make run
+run made before (6.1 hours on this machine, so not run here: `make run
 RUN_ARGS="--output DIR src/experiment_manager/config/test_case/pth0.yaml ...pth1.yaml
 ...pth2.yaml"`, resumed with `--resume RUN_DIR` if it was interrupted): the recordings' spans,
 summed over resumes.

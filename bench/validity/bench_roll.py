@@ -9,7 +9,7 @@ the floor) in the middle of the empty tray, rolled by 0..45 degrees about its bo
 checked with the file's gripper, grasps and settings (all four stages; no neighbours). Prints
 the stage each roll ends at (5 valid, 3 container: the gripper meets the tray) and the share of
 rolls that are valid, which is the share of lone lying parts a check finds valid when rolls
-are uniform. Found 2026-11-26 in the test case's sweeps (docs/paper-test-case.md): with the
+are uniform. Found in the test case's sweeps (docs/paper-test-case.md): with the
 grasp fixed to the part, 15 % (valid within 6 deg of a side grasp; the jaws met the floor
 beyond); with jaws that grip a round body at any roll (pick_validity README, Candidacy), 100 %.
 """

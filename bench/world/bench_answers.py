@@ -1,19 +1,19 @@
 """Do the answers a run reports hold at finer steps? The test case's own files (their gripper,
 their parts' loads) run on the cores at the default step, half and a quarter of it, on the same
-seeds, and the answers read from the run's summary as summary.json reports them (issue 44,
+seeds, and the answers read from the run's summary as summary.json reports them (
 item 3; bench_convergence.py checks the physics' own figures with a smaller gripper and loads):
 
 - pth0-sweep: PTH0 on the tray at 40 to 100 parts (step 10, around the full sweep's n* of
   71-72): n* and its 95 % bootstrap interval, the fit's valid parts at n*, valid per check at
   each count;
 - pth0-feeder: PTH0 feeder runs of the test case's 240 parts at [66, 76] (the adaptive run's
-  range of 2026-11-27): vibrations to empty, the cell's time to empty and the table's 90 %
+  range): vibrations to empty, the cell's time to empty and the table's 90 %
   bound (decisions.py), runs emptied, spilled;
 - pth1-bins: 480 TO-220s (the test case's load) into PTH1's three widest bins, whose means
   tied within the flat bin's step bias, and its tallest: the container-free fraction per bin
   with its 95 % interval and the ranking a run reports (best bin first);
 - pth1-feeder, pth2-feeder: feeder runs of the test case's 480 parts at the full sweeps' ranges
-  [40, 50] and [49, 59] (2026-11-26).
+  [40, 50] and [49, 59].
 
 A setting's mean is marked '*' when it lies outside the finest setting's 95 % interval, and
 n* when its interval misses the finest one's. Jobs (a setting and a workload) run dearest
@@ -57,7 +57,7 @@ WORKLOADS = {
     'pth1-feeder': _feeder('pth1.yaml', 480, [40, 50], 3),
     'pth2-feeder': _feeder('pth2.yaml', 480, [49, 59], 3),
 }
-# wall time of one seed at the default step, s (the adaptive run of 2026-11-27 and the
+# wall time of one seed at the default step, s (the adaptive run and the
 # convergence tables), to start the dearest jobs first
 COST = {'pth0-sweep': 6, 'pth0-feeder': 57, 'pth1-bins': 40, 'pth1-feeder': 115,
         'pth2-feeder': 85}

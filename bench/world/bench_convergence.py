@@ -51,18 +51,18 @@ SETTINGS = {
     'dt/4': replace(FINER, time_step=DEFAULT.time_step / 4),
     'dt/8': replace(FINER, time_step=DEFAULT.time_step / 8),
     '200-it': replace(DEFAULT, solver_iterations=200, tray_solver_iterations=200),
-    # a tray solved with a bin's 100 iterations: the default until 2026-11-26
+    # a tray solved with a bin's 100 iterations: an earlier default
     'tray-100-it': FINER,
     # fewer iterations at the default warm start: what a step costs is mostly the solver's
     '50-it': replace(DEFAULT, solver_iterations=50, tray_solver_iterations=50),
     '30-it-warm': replace(DEFAULT, solver_iterations=30, tray_solver_iterations=30),
-    'warm-1': replace(DEFAULT, warm_starting_factor=1.0),   # the default of 2026-11-23 to -25
-    # the defaults before issue 20's convergence study: 30 iterations, pybullet's warm start
+    'warm-1': replace(DEFAULT, warm_starting_factor=1.0),   # an earlier default
+    # the defaults before the convergence study: 30 iterations, pybullet's warm start
     '30-it': replace(DEFAULT, solver_iterations=30, tray_solver_iterations=30,
                      warm_starting_factor=0.1),
-    # the parts' rolling and spinning friction arms until 2026-11-25 (PART below)
+    # the parts' rolling and spinning friction arms of an earlier default (PART below)
     'arms-1mm': DEFAULT,
-    # every part stepped to the end of every settle: the default until 2026-11-26
+    # every part stepped to the end of every settle: an earlier default
     'no-freeze': replace(DEFAULT, settle_freeze=False),
     'dt/2-no-freeze': replace(FINER, time_step=DEFAULT.time_step / 2, settle_freeze=False),
 }
@@ -85,7 +85,7 @@ WORKLOADS = {
                                        'counts': {'first': 30, 'last': 90, 'step': 30}}],
               ('valid', 'tunnelled', 'max_penetration', 'wall_time')),
     'feeder': _feeder('pth0.yaml', [80, 90]),
-    # the other parts' feeder runs (the reduced test case's optimal ranges, 2026-11-22)
+    # the other parts' feeder runs (the reduced test case's optimal ranges)
     'feeder-pth1': _feeder('pth1.yaml', [39, 49]),
     'feeder-pth2': _feeder('pth2.yaml', [53, 63]),
     'bins': ('pth1.yaml', lambda n: [{'id': 'bins', 'type': 'bin_static', 'iterations': n,
@@ -122,11 +122,11 @@ WORKLOADS = {
 
 
 # Every workload checks with the smallest gripper that meets PTH0's yield (grippers_pth0.yaml,
-# docs/paper-test-case.md, "Which gripper"). Chosen on 2026-11-25, when with the test case's
-# 20 mm one (issue 21's validity) every PTH0 feeder run stopped at its vibration limit; since
-# round bodies are gripped at any roll (2026-11-26) they empty (PTH0: 50 of 50, 33 vibrations
-# on average), so that reason no longer holds: bench_answers.py checks the answers as reported
-# with the test case's own gripper and loads (issue 44).
+# docs/paper-test-case.md, "Which gripper"). Chosen when, with the test case's 20 mm one (and
+# the earlier validity check), every PTH0 feeder run stopped at its vibration limit; since round
+# bodies are gripped at any roll they empty (PTH0: 50 of 50, 33 vibrations on average), so that
+# reason no longer holds: bench_answers.py checks the answers as reported with the test case's
+# own gripper and loads.
 GRIPPER = {'body_diameter_mm': 8, 'body_length_mm': 60, 'jaw_height_mm': 15, 'jaw_depth_mm': 3}
 
 

@@ -28,7 +28,7 @@ from pick_sim_world.world import World
 
 from bench.paper_case import TEST_CASE
 
-# The defaults before issue 20's convergence study: 30 iterations, pybullet's warm start 0.1
+# The defaults before the convergence study: 30 iterations, pybullet's warm start 0.1
 # and step of 1/240 s. The probes for the cause of the creep ran on them first (world README,
 # "Piles that rest"); the probes that set Bullet's engine parameters, part dynamics or gravity
 # directly (ERP, split impulse, CFM, cone friction, SAT, friction anchors, damping, a scene
@@ -39,8 +39,8 @@ FORMER = {'solver_iterations': 30, 'warm_starting_factor': 0.1, 'time_step': 1 /
 # name: PhysicsConfig fields
 SETTINGS = {
     'default': {},                  # 1/480 s, 100 iterations, warm start 0.85 (Bullet's)
-    '1/240': {'time_step': 1 / 240},                # the default step until 2026-11-25
-    'warm-1': {'time_step': 1 / 240, 'warm_starting_factor': 1.0},   # 2026-11-23 to -25
+    '1/240': {'time_step': 1 / 240},                # an earlier default step
+    'warm-1': {'time_step': 1 / 240, 'warm_starting_factor': 1.0},   # an earlier default
     'dt/2': {'time_step': PhysicsConfig().time_step / 2},
     'dt/4': {'time_step': PhysicsConfig().time_step / 4},
     '200-it': {'solver_iterations': 200},
@@ -58,8 +58,8 @@ SETTINGS = {
     'former-warm-1': {**FORMER, 'warm_starting_factor': 1.0},
     'former-breaking-5mm': {**FORMER, 'contact_breaking_threshold': 0.005},
     'former-breaking-20mm': {**FORMER, 'contact_breaking_threshold': 0.02},   # Bullet's
-    # the parts' rolling and spinning friction arms (issue 20's cause of the creep): the
-    # defaults until 2026-11-25 (1 mm each), one of them at a time, and other arms
+    # the parts' rolling and spinning friction arms (the cause of the creep): the
+    # earlier defaults (1 mm each), one of them at a time, and other arms
     'former-arms-1mm': {},
     'rolling-1mm': {}, 'spinning-1mm': {},
     'rolling-0': {}, 'rolling-0.2mm': {}, 'rolling-0.3mm': {}, 'rolling-0.5mm': {},

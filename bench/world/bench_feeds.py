@@ -7,7 +7,7 @@ part origin above the floor's top.
     tools/ws python -m bench.world.bench_feeds [--feeds 50] [--loads pth0=90,pth1=55,pth2=54]
 
 The default loads are the upper ends of the optimal ranges the reduced test case found with
-issue 20's physics (n* 85, 50, 49, margin 5: docs/paper-test-case.md). Feeds are
+the earlier physics (n* 85, 50, 49, margin 5: docs/paper-test-case.md). Feeds are
 spread over a process per CPU; seed k of a part is the same feed at every call.
 """
 

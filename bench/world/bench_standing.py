@@ -7,7 +7,7 @@ seeds, to tell the physics from the step.
     tools/ws python -m bench.world.bench_standing [--file pth2] [--parts 100] [--moves 50]
         [--every 10] [--seeds 0,1] [--settings default,dt/2]
 
-In the reduced test case of 2026-11-25 PTH2's feeder run (8 mm capacitors, 95-105 on the tray)
+In an earlier reduced test case PTH2's feeder run (8 mm capacitors, 95-105 on the tray)
 picked 101 of 480 parts in 500 moves: 58 % of its capacitors stood on their heads at the
 checks, against 7 % of a dropped pile (the sweep's), and PTH0's (5 mm) 2 %. One process per
 setting, at most one per CPU.

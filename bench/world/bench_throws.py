@@ -26,12 +26,12 @@ from pick_sim_world.world import World
 
 SETTINGS = {
     'default': {},                          # 1/480 s, 50 iterations, warm start 0.85
-    '1/240': {'time_step': 1 / 240},        # the default step until 2026-11-25
-    'warm-1': {'time_step': 1 / 240, 'warm_starting_factor': 1.0},   # 2026-11-23 to -25
+    '1/240': {'time_step': 1 / 240},        # an earlier default step
+    'warm-1': {'time_step': 1 / 240, 'warm_starting_factor': 1.0},   # an earlier default
     'warm-0.5': {'warm_starting_factor': 0.5},
     'warm-0.1': {'warm_starting_factor': 0.1},       # pybullet's
     'dt/2': {'time_step': PhysicsConfig().time_step / 2},
-    'tray-100-it': {'tray_solver_iterations': 100},     # the default until 2026-11-26
+    'tray-100-it': {'tray_solver_iterations': 100},     # an earlier default
     '30-it': {'tray_solver_iterations': 30},
 }
 

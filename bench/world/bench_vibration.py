@@ -38,8 +38,8 @@ PROFILES = {
     'vertical 1 mm, 30 Hz, 1 s': Vibration((0.0, 0.0, 0.001), 30.0, 1.0, FIXED),
     'vertical 3 mm + 3 mm horizontal, 30 Hz, random direction (the former default)':
         Vibration((0.003, 0.0, 0.003), 30.0, 0.5, RANDOM),
-    ('vertical 1.4 mm + 1.4 mm horizontal, 26 Hz, random direction (spread, the default until '
-     '2026-11-27)'): MOVES['spread'],
+    'vertical 1.4 mm + 1.4 mm horizontal, 26 Hz, random direction (spread, a former default)':
+        MOVES['spread'],
 }
 FEEDER_PROFILES = {
     'vertical 3 mm (the former default)': Vibration((0.0, 0.0, 0.003), 30.0, 0.5, FIXED),
@@ -47,8 +47,8 @@ FEEDER_PROFILES = {
         Vibration((0.001, 0.0, 0.003), 30.0, 0.5, RANDOM),
     'vertical 3 mm + 3 mm horizontal, random direction (the former default)':
         Vibration((0.003, 0.0, 0.003), 30.0, 0.5, RANDOM),
-    ('vertical 1.4 mm + 1.4 mm horizontal, 26 Hz, random direction (spread, the default until '
-     '2026-11-27)'): MOVES['spread'],
+    'vertical 1.4 mm + 1.4 mm horizontal, 26 Hz, random direction (spread, a former default)':
+        MOVES['spread'],
     'vertical 1.5 mm + 3 mm horizontal, random direction':
         Vibration((0.003, 0.0, 0.0015), 30.0, 0.5, RANDOM),
 }

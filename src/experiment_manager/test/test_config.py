@@ -39,7 +39,7 @@ def test_the_default_file_parses_into_si_units():
 
 
 def test_the_default_file_s_containers_hold_a_refill_interval_s_parts():
-    # Otherwise its bin and table could never come out feasible (issue 23: it once loaded 150
+    # Otherwise its bin and table could never come out feasible (it once loaded 150
     # parts into a cell that needed 480).
     f = experiment_file.load(DEFAULT)
     loads = {e.id: e.parts for e in f.experiments

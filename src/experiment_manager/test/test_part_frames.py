@@ -58,7 +58,7 @@ def test_moving_the_file_s_origin_and_turning_its_axes_change_no_answer(tmp_path
     """The same box with its origin at its centre, 36 mm beside it, and beside it with its
     axes turned, grasps and placing written for each: the valid parts per check agree within
     their noise (8 seeds; the floating point of each frame makes the scenes differ, not their
-    statistics). Measured 2026-11-27: 8.0 +- 1.1 centred, 8.2 +- 1.0 moved, 7.5 +- 0.7 moved
+    statistics). Measured: 8.0 +- 1.1 centred, 8.2 +- 1.0 moved, 7.5 +- 0.7 moved
     and turned; with the mass centre at the file's origin, as the world had it before, the
     moved box gave 0.0 (its parts stood on end, pivoting about a point beside them)."""
     seeds = range(8)
@@ -83,7 +83,7 @@ def test_kicads_to220_as_step_stl_and_obj_anywhere_gives_the_same_answer(tmp_pat
     origin 40 mm away, and as an OBJ in mm turned about all three axes: the example's grasps
     and placing written for each frame give the same valid parts per check on the tray
     within their noise (CoACD cuts each file's mesh anew, in the part's own principal frame).
-    Measured 2026-11-27, 30 parts, 6 seeds: 24.0 +- 3.2, 24.0 +- 3.3, 25.0 +- 3.5; before the
+    Measured, 30 parts, 6 seeds: 24.0 +- 3.2, 24.0 +- 3.3, 25.0 +- 3.5; before the
     spawn sphere and the cut were taken about the mass centre and principal axes, the turned
     OBJ gave 20.0 and 19.2 against 23.0 and 24.7."""
     step = os.path.join(os.path.dirname(__file__), '..', 'config', 'parts',

@@ -112,7 +112,7 @@ def test_bins_leave_the_race_when_they_are_clearly_behind_the_leader():
 
 def test_a_bin_leaves_the_race_on_its_difference_from_the_leader():
     """Bins 5 points of 100 apart on 6 drops of +-2: their own 99.9 % intervals still overlap
-    (the rule before 2026-11-27 raced them on), but the one-sided bound of the difference, at
+    (an earlier rule raced them on), but the one-sided bound of the difference, at
     each interval's tail, lies below 0: the second leaves and the leader is the best."""
     file, exp = four_bins()
     rows = bin_rows(np.random.default_rng(0), [90, 85, 60, 30], 6)

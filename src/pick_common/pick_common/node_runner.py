@@ -211,7 +211,7 @@ def _leave_shutdown_to_rclpy(signum: int, frame) -> None:
     down is not lost. It calls nothing of rclpy: Python runs it between two bytecodes of the
     main thread, once inside Context.ok() with the context's lock held, and a handler that
     asked rclpy.ok() waited for that lock for ever (a world still up 30 s after SIGINT, its
-    stack in Context.ok twice; CI, 2026-11-25)."""
+    stack in Context.ok twice, in CI)."""
     _interrupts.append(signum)
 
 
@@ -234,8 +234,8 @@ def run(name: str, make_node: Callable[[], Node],
     # rclpy's signal handler shuts the context down and then calls the handler it found
     # installed; Python's own SIGINT handler raises KeyboardInterrupt wherever the main thread
     # is, and once that was inside threading's Thread.start (the executor starting a worker),
-    # which left a lock broken and the world exiting 1 ('release unlocked lock'; CI,
-    # 2026-11-25). A handler that does nothing lets the spin loop below see the shutdown.
+    # which left a lock broken and the world exiting 1 ('release unlocked lock', in CI). A
+    # handler that does nothing lets the spin loop below see the shutdown.
     signal.signal(signal.SIGINT, _leave_shutdown_to_rclpy)
     try:
         rclpy.init(args=args)
@@ -257,7 +257,7 @@ def run(name: str, make_node: Callable[[], Node],
             # A signal shut the context down while the node was starting, and the start then
             # failed on something the shutdown took: the world's first scene ('publisher's
             # context is invalid') or the executor's guard condition ('the given context is
-            # not valid'; CI, 2026-11-25, both). A stop, not a failure.
+            # not valid', both seen in CI). A stop, not a failure.
             _destroy_quietly(node)
             print(f'{name}: stopped while starting', file=sys.stderr)
             return
@@ -273,7 +273,7 @@ def run(name: str, make_node: Callable[[], Node],
         # Not rclpy.spin: on SIGTERM, rclpy's signal thread wakes the executor and only then
         # shuts the context down, so an executor that wakes in between sees the context still
         # up and waits again, for ever in a node that nothing else wakes (a validity node
-        # stopped 1 time in 48 under load, issue 24). A bounded wait sees the shutdown.
+        # stopped 1 time in 48 under load). A bounded wait sees the shutdown.
         while node.context.ok():
             executor.spin_once(timeout_sec=SPIN_WAKE)
     except (KeyboardInterrupt, ExternalShutdownException):

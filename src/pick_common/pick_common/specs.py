@@ -58,9 +58,9 @@ class Vibration:
     part, or the centroid at the centre, the tray does not move.
     The default is a flip (vertical only) at the vertical speed of a real feeder's: 1.4 mm at
     26 Hz is a peak vertical speed of 0.23 m/s (3.8 g), the SHOP4CF shakeit feeder's flip
-    (26 Hz, at most 0.23 m/s). Until 2026-11-27 it had an equal horizontal stroke in phase, in
-    a random direction (now the named move `spread`), which throws the pile along a 45 degree
-    line as a linear vibratory conveyor does (world README, "Vibration").
+    (26 Hz, at most 0.23 m/s). The named move `spread` adds an equal horizontal stroke in phase,
+    in a random direction, which throws the pile along a 45 degree line as a linear vibratory
+    conveyor does (world README, "Vibration").
     """
 
     amplitude: tuple[float, float, float] = (0.0, 0.0, 0.0014)
@@ -84,8 +84,8 @@ MOVES = {
 }                                                                   # no feeder documents it
 # The default vibration cycle of a feeder: the Asycube's typical vibration sequence after a
 # feed, "a centering action" then "flip: flip and spread the parts" (Asyril, EYE+ Studio
-# recipe wizard, "Vibration Sequence"); the wait after it is the world's settle. Until
-# 2026-11-27 the cycle was `spread` alone (docs/physics.md, "Feeder moves").
+# recipe wizard, "Vibration Sequence"); the wait after it is the world's settle
+# (docs/physics.md, "Feeder moves").
 DEFAULT_CYCLE = ('centre', 'flip')
 
 

@@ -103,7 +103,7 @@ def test_vibration_scatters_and_turns_parts_and_the_tray_returns_home():
 
 @pytest.mark.parametrize('time_step', [1 / 240, 1 / 480, 1 / 1000])
 def test_the_tray_delivers_its_commanded_motion_at_any_time_step(time_step):
-    """Issue 20: on a driven constraint the tray delivered 1.18 mm of a 3 mm command at 1/240 s.
+    """On a driven constraint the tray delivered 1.18 mm of a 3 mm command at 1/240 s.
     Read independently of the drive: the tray body's position at each progress call against
     the command at that time, with 50 parts on the tray."""
     vibration = Vibration(amplitude=(0.003, 0.0, 0.003), frequency=26.0, duration=1.0,
@@ -159,7 +159,7 @@ def test_a_spilled_and_a_tunnelled_part_are_told_apart():
 
 
 # The solver's warm start and step under test (os.environ lets the test be run at others to
-# see it fail: PICK_TEST_WARM_START=1 PICK_TEST_TIME_STEP=1/240, the defaults of 2026-11-23
+# see it fail: PICK_TEST_WARM_START=1 PICK_TEST_TIME_STEP=1/240, the defaults of an earlier version
 # to 25, throw a part at the 33rd move; warm start 1 at 1/480 s throws none in this scene, nor
 # does a step of 0.0041667 s: the scene is chaotic, and the exact step matters).
 WARM_START = float(os.environ.get('PICK_TEST_WARM_START', PhysicsConfig().warm_starting_factor))
@@ -408,7 +408,7 @@ def _lone_and_piled(world: World) -> tuple[list[int], list[int]]:
     """Ids of parts more than 5 mm from every other part, and of parts touching another (within
     0.05 mm: a resting contact's overlap or gap), by PyBullet's closest points (not the contacts
     the world reads). Not 0.5 mm: a part 0.36 mm from its neighbour touches nothing, and lifting
-    it out moves nothing (a scene of 2026-11-25)."""
+    it out moves nothing (a scene that once did)."""
     ids = world.snapshot().ids.tolist()
     bodies = [world._bodies[i] for i in ids]
 

@@ -25,7 +25,7 @@ from .validity import Validator
 
 # Validators (part model x gripper, grasps, placing, settings) kept: a gripper_sweep cycles
 # through up to 64 setups per scene. 64 PTH0 validators took 0.8 MB of RSS and 17 ms each to
-# build (2026-11-26), so keeping 64 costs little and spares a rebuild per check.
+# build, so keeping 64 costs little and spares a rebuild per check.
 CACHE_SIZE = 64
 
 

@@ -135,8 +135,8 @@ def test_the_gripper_stays_within_the_approach_cone():
 @pytest.mark.parametrize('roll', [0.0, 7.0, 20.0, 30.0, 44.0, -44.0, 130.0])
 def test_jaws_across_a_round_body_grip_it_at_any_roll(roll):
     # A capacitor lying alone on the floor: a cell's camera cannot see its roll, and its jaws
-    # close across the round body whatever it is. Found 2026-11-26: with the grasp fixed to
-    # the part, rolls beyond 6 deg of a side grasp tilted the jaws into the floor
+    # close across the round body whatever it is. With the grasp fixed to the part, rolls
+    # beyond 6 deg of a side grasp tilted the jaws into the floor
     # (bench/validity/bench_roll.py). The turned grasp is the side grasp nearest in roll.
     sides = [GraspPose(f'side{k}', (math.cos(k * math.pi / 2), math.sin(k * math.pi / 2), 0.0),
                        (-math.sin(k * math.pi / 2), math.cos(k * math.pi / 2), 0.0), 0.011)

@@ -1,5 +1,5 @@
 """Decisions on what each run measures, with one-sided bounds where the requirement is
-one-sided (issue 43).
+one-sided.
 
 The vibrating table. The requirement is a time: the cell must pick a refill's parts within the
 refill interval. Each feeder run measures its cell's time to empty the feeder (`feeder_runs`:
@@ -20,10 +20,10 @@ confidence (`table_time`):
   its p from the same simulation; used when every run emptied within the interval and the
   check does not reject at 5 % (with 3 runs the check is weak, and said so); FEASIBLE when the
   upper bound is within the interval; NOT FEASIBLE when the lower 95 % bound of the same
-  quantile is beyond it. Until 2026-11-27 a lognormal of the time less the robot's known part;
-  on 50 runs of each test-case part its bound on 3 to 12 of them said FEASIBLE at the 50's own
-  estimate of PTH1's 90 % quantile up to 7.4 % of the time (the runs are skewed to the right
-  beyond a lognormal's), the Gumbel's at most 4.6 % on any part (docs/paper-test-case.md,
+  quantile is beyond it. Not a lognormal: on 50 runs of each test-case part a lognormal's
+  bound (of the time less the robot's known part) on 3 to 12 of them said FEASIBLE at the
+  50's own estimate of PTH1's 90 % quantile up to 7.4 % of the time (the runs are skewed to
+  the right beyond a lognormal's), the Gumbel's at most 4.6 % on any part (docs/paper-test-case.md,
   "Deciding on few runs");
 - distribution-free, beside it: the runs over the interval (or not emptied) as a binomial
   count: FEASIBLE when the one-sided 95 % upper bound of their share is below 1 - success_rate

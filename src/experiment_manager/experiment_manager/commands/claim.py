@@ -15,7 +15,7 @@ from . import interrupt
 from .launcher import MANAGER, WORKER_NODES
 
 DISCOVERY_WAIT = 3.0    # s to discover a graph already running in the namespace (Fast DDS on
-                        # this 2-core host under full load: 0.2-2.0 s, measured 2026-11-23;
+                        # this 2-core host under full load: 0.2-2.0 s, measured;
                         # over 3 s once, with CI beside it)
 
 

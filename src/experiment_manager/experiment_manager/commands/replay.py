@@ -39,7 +39,7 @@ from tqdm import tqdm
 from ..graph.recording import channel_qos, recover
 from . import interrupt
 
-# Recordings made before channels carried offered_qos_profiles (2026-11-25): latched by name.
+# Recordings whose channels carry no offered_qos_profiles (older ones): latched by name.
 LATCHED_TOPICS = ('scene', 'markers')
 STREAM = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 MATCH_WAIT = 2.0     # s a new topic waits by default for a subscriber to match (--match-wait)

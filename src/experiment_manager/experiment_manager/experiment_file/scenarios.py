@@ -1,6 +1,6 @@
 """A sensitivity experiment's scenarios: the inputs nobody can measure before the hardware is
 bought, varied one at a time and jointly, each scenario a setup and table moves for the
-repeats of the experiments it names (issue 44).
+repeats of the experiments it names.
 
 The inputs (`INPUTS`), in the file's units: the part's friction, rolling and spinning arms,
 restitution and mass (part.*), the gripper's dimensions (gripper.*), and the table moves'

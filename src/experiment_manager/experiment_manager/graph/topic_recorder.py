@@ -34,7 +34,7 @@ class TopicRecorder:
     def __init__(self, name: str, namespace: str, context=None) -> None:
         # Not the process's global arguments: launch names a node with `-r __node:=NAME`,
         # which renames every node of the process, and this one then took the manager's name
-        # ('Publisher already registered for node name'; issue 23). Its namespace is given.
+        # ('Publisher already registered for node name'). Its namespace is given.
         self.node = Node(name, namespace=namespace, context=context,
                          use_global_arguments=False)
         self._lock = threading.Lock()

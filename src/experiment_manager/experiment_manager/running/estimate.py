@@ -8,9 +8,9 @@ finished, at its type's measured rate on this project's machine (PRIOR), scaled 
 faster or slower the run's finished iterations went than their own types' PRIOR said (this
 machine, this part); before any iteration has finished, at PRIOR itself. An iteration is not
 split between workers: the time left is at least the dearest iteration left. Counting
-iterations said 0:00:00 at 44 of 46 iterations, before two feeder runs that took 31 s (issue
-23); a feeder run weighed at 200 sweep parts a part (a file whose feeder vibrated to its
-limit) said 0:06:19 at 18 s into PTH2's reduced run, which ended at 1:46 (issue 43).
+iterations said 0:00:00 at 44 of 46 iterations, before two feeder runs that took 31 s; a
+feeder run weighed at 200 sweep parts a part (a file whose feeder vibrated to its limit) said
+0:06:19 at 18 s into PTH2's reduced run, which ended at 1:46.
 """
 
 from collections.abc import Iterable
@@ -26,9 +26,9 @@ from ..experiment_file import (
     TABLE_SWEEP,
 )
 
-# Seconds per cost unit of each type, measured: the reduced test case (make run before issue
-# 43, pth0/1/2.yaml with one iteration each, 2 workers on the project's 2-core machine,
-# 2026-11-27), iterations.csv wall_time over parts: sweep 149 s over 15,150 parts, static bins
+# Seconds per cost unit of each type, measured: the reduced test case (pth0/1/2.yaml with one
+# iteration each, 2 workers on the project's 2-core machine; docs/benchmarks.md),
+# iterations.csv wall_time over parts: sweep 149 s over 15,150 parts, static bins
 # 360 s over 11,760, emptying 42 s over 1,200, feeder runs 225 s over 1,200; gripper_sweep
 # from the small test file's run (0.1 s over 28 parts x 8 grippers).
 PRIOR = {TABLE_SWEEP: 0.0098, BIN_STATIC: 0.031, BIN_EMPTYING: 0.035, FEEDER_EMPTYING: 0.19,

@@ -26,9 +26,9 @@ What settles each decision, looked at after every batch:
   of the leader's lower bound), so whichever of them is taken gives at least 95 % of the best
   bin's container-free parts (the leader is named best; the summary lists the tie); or at the
   most iterations. 5 % is our choice, the same as FLAT_TOP's: PTH1's three widest bins lie
-  within 1 % of each other on 40 drops each and no race could part them. Until 2026-11-27 a
-  bin left when its own 99.9 % interval lay below the leader's: two intervals that do not
-  overlap ask for a difference of about the sum of their half-widths, where the difference's
+  within 1 % of each other on 40 drops each and no race could part them. Not two intervals
+  that must not overlap (a bin left when its own 99.9 % interval lay below the leader's): they
+  ask for a difference of about the sum of their half-widths, where the difference's
   own bound asks for about the root of the sum of their squares, and on 5 drops a t with 4
   degrees of freedom where Welch's has up to 8. The chance that the best bin leaves at a look
   is at most (bins - 1) x 0.05 % (a comparison with each bin that could lead), where the two

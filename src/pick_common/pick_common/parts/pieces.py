@@ -12,7 +12,7 @@ Its settings, and where they come from:
 - MAX_PIECES 32: the compound's limit that a mesh's connected bodies already had
   (`MAX_MESH_HULLS`).
 - MAX_PIECE_VERTICES 64: CoACD's decimation cap (`max_ch_vertex`, default 256) lowered, because
-  a 1,090-vertex hull made table drops 4 to 7 times slower (issue 42's measurement); a small
+  a 1,090-vertex hull made table drops 4 to 7 times slower (docs/benchmarks.md); a small
   part's piece rarely needs more than a few dozen (TO-220: at most 25).
 - SEED 0: CoACD's search is random; a fixed seed makes it give the same pieces each time
   (checked: three runs of the TO-220, the same nine pieces; their order and vertex order
