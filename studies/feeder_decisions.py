@@ -81,7 +81,7 @@ def write_files(directory: str, moves: list[str] | None = None) -> list[str]:
         path = os.path.join(directory, f'{name}.yaml')
         with open(path, 'w', encoding='utf-8') as f:
             f.write(f'# {RUNS} feeder runs of {part} at n* {n_star} +- {MARGIN} '
-                    '(bench/experiment/feeder_decisions.py)\n')
+                    '(studies/feeder_decisions.py)\n')
             yaml.safe_dump(data, f, sort_keys=False)
         paths.append(path)
     return paths

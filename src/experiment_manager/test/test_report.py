@@ -351,3 +351,16 @@ def test_why_parts_were_turned_down_is_counted_per_stage():
                                'container collision': 1, 'neighbour collision': 1, 'valid': 2}}
     text = '\n'.join(stages.lines(stops))
     assert '`sweep`: placeability stops most, 64.3 % of the parts in the container' in text
+
+
+def test_the_page_keeps_a_pipe_in_its_cell_and_escapes_raw_html(run_dir):
+    s = _summary(run_dir)
+    s['id'] = 'small <script>alert(1)</script>'
+    s['experiments']['grippers']['variants'][0]['grasp_set'] = 'side|upright'
+    page = report.to_html(_markdown(s), s['id'])
+    assert '<script>' not in page and '&lt;script&gt;' in page
+    # the grasp set's '|' stays in its cell: every row of the gripper table has nine cells
+    table = page.split('<h2>Gripper sweep')[1].split('</table>')[0]
+    rows = table.split('<tr>')[1:]
+    assert len(rows) == 9 and all(r.count('<td>') + r.count('<th>') == 9 for r in rows), table
+    assert 'grasps side|upright' in table

@@ -82,10 +82,8 @@ class Sampling(_Record):
     tied_bins: list[int] | None = None
     tie: list[int] | None = None
     tie_within: float | None = None
-    race_confidence: float | None = Field(None, description=(
-        "one-sided confidence of the bound of a bin's difference from the leader, where bins "
-        'tied or were left; absent there in a version-0 summary, whose race compared 99.9 % '
-        'intervals'))
+    race_confidence: float | None = Field(None, description=(  # version 0: 99.9 % intervals
+        "one-sided confidence of the bound of a bin's difference from the leader"))
 
 
 class GumbelFit(_Record):
@@ -103,7 +101,7 @@ class GumbelFit(_Record):
 
 class FreeBound(_Record):
     verdict: VERDICT
-    share_bounds: list[float]
+    share_bounds: list[float]   # of the share of runs over the interval, one-sided
 
 
 class Decision(_Record):
@@ -164,7 +162,7 @@ class BinEmptying(_Experiment):
 
 
 class Count(_Record):
-    n: int
+    n: int              # parts on the table
     valid: Stats
 
 
@@ -188,8 +186,8 @@ class Cell(_Record):
 
 
 class TableGrounds(_Record):
-    time: Decision
-    spills: Decision
+    time: Decision      # the cell's time to empty a refill against the refill interval
+    spills: Decision    # parts spilled per refill against requirements.max_spilled_parts
 
 
 class FeederEmptying(_Experiment):
@@ -327,9 +325,7 @@ class Summary(_Record):
     experiments: dict[str, Experiment]
     repeats: dict[str, Experiment] | None = None
 
-    def of_type(self, kind: str) -> list[tuple[str, BinStatic | BinEmptying | TableSweep
-                                                | FeederEmptying | GripperSweep
-                                                | Sensitivity]]:
+    def of_type(self, kind: str) -> list[tuple[str, _Experiment]]:
         """(id, summary) of the file's experiments of this type, in the file's order."""
         return [(k, v) for k, v in self.experiments.items() if v.type == kind]
 
@@ -341,10 +337,8 @@ class Summary(_Record):
 
 def migrate(raw: dict) -> dict:
     """A summary.json of any version as the current version's dict. Version 0 (no
-    `schema_version`): a feeder without its throughput (written before the cell's time was
-    measured) gets an empty one; a table's time ground decided on a lognormal keeps its
-    verdict, bound and reason and loses the lognormal's own figures (`lognormal`), which the
-    current model does not describe."""
+    `schema_version`): a feeder without its throughput gets an empty one; a time ground
+    decided on a lognormal keeps its verdict, bound and reason, not the lognormal's figures."""
     version = raw.get('schema_version', 0)
     if version > SCHEMA_VERSION:
         raise ValueError(f'summary.json: schema_version {version} is newer than this reader '
@@ -383,13 +377,9 @@ def read(path: str) -> Summary:
         return validate(migrate(json.load(f)))
 
 
-def schema() -> dict:
-    """The JSON Schema of summary.json (docs/summary.schema.json)."""
-    return Summary.model_json_schema(by_alias=True)
-
-
 def schema_text() -> str:
-    return json.dumps(schema(), indent=1, sort_keys=True) + '\n'
+    """The JSON Schema of summary.json, as docs/summary.schema.json holds it."""
+    return json.dumps(Summary.model_json_schema(by_alias=True), indent=1, sort_keys=True) + '\n'
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -399,9 +389,9 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.schema == '-':
         print(schema_text(), end='')
-    else:
-        with open(args.schema, 'w', encoding='utf-8') as f:
-            f.write(schema_text())
+        return 0
+    with open(args.schema, 'w', encoding='utf-8') as f:
+        f.write(schema_text())
     return 0
 
 
