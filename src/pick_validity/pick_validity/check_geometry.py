@@ -25,7 +25,7 @@ from .config import (
 )
 from .geometry import (
     contains,
-    CYLINDER,
+    CylinderShape,
     grasped_extent,
     gripper_shapes,
     part_shapes,
@@ -99,7 +99,7 @@ def _free_axis(part: PartGeometry, shapes: tuple[Shape, ...], grasp: Grasp) -> n
     for shape in shapes:
         axis = shape.rotation[:, 2]
         off = grasp.point - shape.center
-        if (shape.kind == CYLINDER and contains(shape, grasp.point)
+        if (isinstance(shape, CylinderShape) and contains(shape, grasp.point)
                 and abs(float(axis @ grasp.closing)) < 1e-6
                 and np.linalg.norm(off - (off @ axis) * axis) < 1e-9):
             return axis.copy()

@@ -1,8 +1,9 @@
 """Shapes for the checks: part primitives and the simplified gripper, their exact bounds, and
 their FCL collision objects.
 
-A `Shape` is a box, a cylinder (axis along its local z) or a convex hull, placed in a parent
-frame. Its FCL geometry is built once and shared; a query sets the object's transform.
+A `Shape` is a `BoxShape`, a `CylinderShape` (axis along its local z) or a `HullShape`, placed
+in a parent frame; a consumer tells them apart by type. Its FCL geometry is built once and
+shared; a query sets the object's transform.
 Rotations are (..., 3, 3) float64 arrays whose columns are the child axes; quaternions xyzw.
 """
 
@@ -19,17 +20,11 @@ import trimesh
 
 from .config import Gripper
 
-BOX, CYLINDER, HULL = 'box', 'cylinder', 'hull'
-
 
 @dataclass(frozen=True, eq=False)
 class Shape:
-    """kind; half: box half extents (3,) or cylinder (radius, half length); vertices: hull
-    (M, 3) in the shape frame; rotation (3, 3) and center (3,) in the parent frame, m."""
+    """rotation (3, 3) and center (3,) in the parent frame, m; its FCL geometry."""
 
-    kind: str
-    half: np.ndarray
-    vertices: np.ndarray | None
     rotation: np.ndarray
     center: np.ndarray
     geometry: fcl.CollisionGeometry
@@ -37,6 +32,22 @@ class Shape:
     def fcl_object(self) -> fcl.CollisionObject:
         """A new collision object on the shared geometry (one per query site, reused)."""
         return fcl.CollisionObject(self.geometry, fcl.Transform())
+
+
+@dataclass(frozen=True, eq=False)
+class BoxShape(Shape):
+    half: np.ndarray            # half extents (3,), m
+
+
+@dataclass(frozen=True, eq=False)
+class CylinderShape(Shape):
+    radius: float               # m
+    half_length: float          # m, along the shape's z
+
+
+@dataclass(frozen=True, eq=False)
+class HullShape(Shape):
+    vertices: np.ndarray        # (M, 3) in the shape frame, m
 
 
 def quaternions_to_matrices(q: np.ndarray) -> np.ndarray:
@@ -85,39 +96,40 @@ def part_shapes(part: PartGeometry) -> tuple[Shape, ...]:
         center = np.array(p.position, dtype=np.float64)
         if isinstance(p, Box):
             half = np.array(p.half, dtype=np.float64)
-            shapes.append(Shape(BOX, half, None, rotation, center, fcl.Box(*(2 * half))))
+            shapes.append(BoxShape(rotation, center, fcl.Box(*(2 * half)), half))
         elif isinstance(p, Cylinder):
-            radius, length = p.radius, p.length
-            shapes.append(Shape(CYLINDER, np.array([radius, length / 2]), None, rotation, center,
-                                fcl.Cylinder(radius, length)))
+            shapes.append(CylinderShape(rotation, center, fcl.Cylinder(p.radius, p.length),
+                                        p.radius, p.length / 2))
         else:
-            shapes.append(Shape(HULL, np.zeros(3), p.vertices, rotation, center,
-                                _convex(p.vertices, p.faces)))
+            shapes.append(HullShape(rotation, center, _convex(p.vertices, p.faces),
+                                    p.vertices))
     return tuple(shapes)
 
 
-def gripper_shapes(gripper: Gripper, opening: float, depth: float) -> tuple[Shape, Shape]:
+def gripper_shapes(gripper: Gripper, opening: float, depth: float
+                   ) -> tuple[BoxShape, CylinderShape]:
     """The jaws' workspace cuboid (U x W x V, z from -depth to V - depth: the fingertips
     `depth` below the grasp point) and the body cylinder (diameter D, from V - depth up
     body_length), in the gripper frame: origin at the grasp point (the point the jaws close
     on), x along the closing direction, z up the gripper."""
     v, length = gripper.jaw_height, gripper.body_length
-    jaws = Shape(BOX, np.array([opening / 2, gripper.jaw_depth / 2, v / 2]), None, np.eye(3),
-                 np.array([0.0, 0.0, v / 2 - depth]), fcl.Box(opening, gripper.jaw_depth, v))
-    body = Shape(CYLINDER, np.array([gripper.body_diameter / 2, length / 2]), None, np.eye(3),
-                 np.array([0.0, 0.0, v - depth + length / 2]),
-                 fcl.Cylinder(gripper.body_diameter / 2, length))
+    jaws = BoxShape(np.eye(3), np.array([0.0, 0.0, v / 2 - depth]),
+                    fcl.Box(opening, gripper.jaw_depth, v),
+                    np.array([opening / 2, gripper.jaw_depth / 2, v / 2]))
+    body = CylinderShape(np.eye(3), np.array([0.0, 0.0, v - depth + length / 2]),
+                         fcl.Cylinder(gripper.body_diameter / 2, length),
+                         gripper.body_diameter / 2, length / 2)
     return jaws, body
 
 
 def contains(shape: Shape, point: np.ndarray) -> bool:
     """Is the point (3,), in the parent frame, inside or on the shape?"""
     local = shape.rotation.T @ (np.asarray(point, dtype=np.float64) - shape.center)
-    if shape.kind == BOX:
+    if isinstance(shape, BoxShape):
         return bool((np.abs(local) <= shape.half + 1e-12).all())
-    if shape.kind == CYLINDER:
-        return bool(math.hypot(local[0], local[1]) <= shape.half[0] + 1e-12
-                    and abs(local[2]) <= shape.half[1] + 1e-12)
+    if isinstance(shape, CylinderShape):
+        return bool(math.hypot(local[0], local[1]) <= shape.radius + 1e-12
+                    and abs(local[2]) <= shape.half_length + 1e-12)
     return bool(Delaunay(shape.vertices).find_simplex(local) >= 0)
 
 
@@ -141,9 +153,9 @@ def place(shape: Shape, rotation: np.ndarray, translation: np.ndarray) -> tuple[
 def half_extents(shape: Shape, rotation: np.ndarray) -> np.ndarray:
     """Exact half extents (N, 3) of a box's or cylinder's axis-aligned bounds about its center,
     for rotations (N, 3, 3). Hulls: see `bounds`."""
-    if shape.kind == BOX:
+    if isinstance(shape, BoxShape):
         return np.abs(rotation) @ shape.half
-    radius, half_length = shape.half[0], shape.half[1]
+    radius, half_length = shape.radius, shape.half_length
     w = rotation[:, :, 2]
     return np.abs(w) * half_length + radius * np.sqrt(np.clip(1.0 - w * w, 0.0, 1.0))
 
@@ -152,7 +164,7 @@ def bounds(shape: Shape, rotation: np.ndarray, center: np.ndarray) -> tuple[np.n
                                                                            np.ndarray]:
     """Exact axis-aligned bounds (low (N, 3), high (N, 3)) of the shape at rotation and center
     (its own pose, as from `place`)."""
-    if shape.kind == HULL:
+    if isinstance(shape, HullShape):
         points = np.einsum('nij,mj->nmi', rotation, shape.vertices) + center[:, None, :]
         return points.min(axis=1), points.max(axis=1)
     half = half_extents(shape, rotation)
@@ -163,11 +175,11 @@ def support(shape: Shape, rotation: np.ndarray, center: np.ndarray,
             direction: np.ndarray) -> np.ndarray:
     """max over the shape of direction . x, (N,), for unit direction (3,)."""
     local = np.einsum('nji,j->ni', rotation, direction)   # direction in the shape frame
-    if shape.kind == HULL:
+    if isinstance(shape, HullShape):
         return (shape.vertices @ local.T).max(axis=0) + center @ direction
-    if shape.kind == BOX:
+    if isinstance(shape, BoxShape):
         return center @ direction + np.abs(local) @ shape.half
-    radius, half_length = shape.half[0], shape.half[1]
+    radius, half_length = shape.radius, shape.half_length
     along = local[:, 2]
     return (center @ direction + np.abs(along) * half_length
             + radius * np.sqrt(np.clip(1.0 - along * along, 0.0, 1.0)))

@@ -16,7 +16,7 @@ from pick_common.containers import ContainerSpec
 from scipy.spatial import cKDTree
 
 from .check_geometry import CheckGeometry
-from .geometry import bounds, BOX, collide, HULL, place, Shape
+from .geometry import bounds, BoxShape, collide, HullShape, place, Shape
 
 
 class Pairs:
@@ -147,8 +147,8 @@ class Pairs:
 
 def _radius(shape: Shape) -> float:
     """Radius of a sphere about the shape's center that encloses it, m."""
-    if shape.kind == HULL:
+    if isinstance(shape, HullShape):
         return float(np.linalg.norm(shape.vertices, axis=1).max())
-    if shape.kind == BOX:
+    if isinstance(shape, BoxShape):
         return float(np.linalg.norm(shape.half))
-    return float(math.hypot(shape.half[0], shape.half[1]))
+    return float(math.hypot(shape.radius, shape.half_length))

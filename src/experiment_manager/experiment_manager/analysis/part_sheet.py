@@ -21,7 +21,7 @@ import numpy as np
 from pick_common.parts.geometry import build_part
 from pick_common.parts.primitives import Hull
 from pick_common.parts.spec import states_units
-from pick_validity.geometry import part_shapes, place, Shape, support
+from pick_validity.geometry import BoxShape, CylinderShape, part_shapes, place, Shape, support
 from pick_validity.grasp_proposals import as_yaml, JAW_MARGIN, Proposal
 from pick_validity.validity import Validator
 import trimesh
@@ -97,10 +97,10 @@ def _hull_volume(primitive) -> float:
 
 def _shape_mesh(shape: Shape, rotation: np.ndarray, centre: np.ndarray) -> trimesh.Trimesh:
     """A validity shape as a mesh, placed with `rotation` (3, 3) and `centre` (3,)."""
-    if shape.kind == 'box':
+    if isinstance(shape, BoxShape):
         mesh = trimesh.creation.box(extents=2.0 * shape.half)
-    elif shape.kind == 'cylinder':
-        mesh = trimesh.creation.cylinder(radius=shape.half[0], height=2.0 * shape.half[1],
+    elif isinstance(shape, CylinderShape):
+        mesh = trimesh.creation.cylinder(radius=shape.radius, height=2.0 * shape.half_length,
                                          sections=24)
     else:
         mesh = trimesh.convex.convex_hull(shape.vertices)

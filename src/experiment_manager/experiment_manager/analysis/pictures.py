@@ -21,7 +21,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from pick_common.specs import SceneSpec
 from pick_sim_world.world import Overlay, World
-from pick_validity.geometry import BOX, Shape
+from pick_validity.geometry import BoxShape, Shape
 from pick_validity.results import STAGE_CONTAINER, STAGE_NEIGHBOUR, STAGE_PLACEABILITY
 from pick_validity.validity import Validator
 from scipy.spatial.transform import Rotation
@@ -48,9 +48,10 @@ def gripper_overlays(shapes: tuple[Shape, ...], pose, rgba) -> list[Overlay]:
     for shape in shapes:
         at = (*(pose[:3] + rotation.apply(shape.center)),
               *(rotation * Rotation.from_matrix(shape.rotation)).as_quat())
-        size = (tuple(shape.half) if shape.kind == BOX
-                else (shape.half[0], 2 * shape.half[1]))
-        overlays.append(Overlay(shape.kind, size, at, rgba))
+        if isinstance(shape, BoxShape):     # the gripper is a box (the jaws) and a cylinder
+            overlays.append(Overlay('box', tuple(shape.half), at, rgba))
+        else:
+            overlays.append(Overlay('cylinder', (shape.radius, 2 * shape.half_length), at, rgba))
     return overlays
 
 
