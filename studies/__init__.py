@@ -7,6 +7,7 @@ Each runs from the top of the workspace on run directories:
     tools/ws python -m studies.feeder_decisions table RUN_DIR...   # decisions on few runs
     tools/ws python -m studies.replay_decisions RUN_DIR...         # today's rules, replayed
     tools/ws python -m studies.replay_race RUN_DIR...              # the bins' race, replayed
+    tools/ws python -m studies.sweep_sampling RUN_DIR              # a sweep's looks, replayed
     tools/ws python -m studies.compare_runs RUN_A RUN_B            # two runs, the same seeds
     tools/ws python -m studies.run_stages RUN_DIR                  # where parts were stopped
 

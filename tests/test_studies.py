@@ -65,6 +65,11 @@ def test_replay_race_replays_the_bins_race(runs):
     assert 'best bin' in out and 'looks' in out, out
 
 
+def test_sweep_sampling_replays_a_sweeps_looks_two_ways(runs):
+    out = _study('studies.sweep_sampling', runs['fixed'], '--orders', '3', '--batch', '1')
+    assert 'a batch at every count: settled' in out and 'placed where n* narrows most' in out, out
+
+
 def test_feeder_decisions_tables_decisions_on_few_runs(runs, tmp_path):
     out = _study('studies.feeder_decisions', 'table', runs['fixed'], '--draws', '20')
     assert "time to the table's decision" in out, out

@@ -1,2 +1,3 @@
 """Experiment benchmarks: whole experiment files on the cores and through the graph, adaptive
-sampling against fixed counts, and what a finished run's directory says."""
+sampling against fixed counts, the progress line's estimate, and what reading an experiment
+file costs. Questions asked of finished runs are in studies/."""

@@ -5,7 +5,7 @@ sampling.unsettled places where they narrow n* most. Prints, per way, how many o
 settled, the looks, the iterations and the worker-minutes they took (the rows' own wall
 times), and the n* each reached, against the fixed counts' n* and 95 % interval.
 
-    tools/ws python -m bench.experiment.bench_sweep_sampling RUN_DIR [--orders 20] [--batch 5]
+    tools/ws python -m studies.sweep_sampling RUN_DIR [--orders 20] [--batch 5]
 
 RUN_DIR: a run directory whose file has a table_sweep run with its full counts (every count's
 `iterations` written). Each ordering shuffles the iterations within each count (they are
