@@ -292,7 +292,7 @@ def _run(node: Node, client: LockedActionClient, goal, given: str, graph: Graph,
     print(f'summary:   {os.path.join(result.results_path, "summary.json")}')
     if result.report_path:
         print(f'report:    {result.report_path}')
-    summary = summary_model.validate(json.loads(result.summary_json))
+    summary = summary_model.validate(summary_model.migrate(json.loads(result.summary_json)))
     print('\n'.join(headlines(summary)))
     # the manager's decisions, each with its first reason (the report gives them all)
     print('verdicts:\n' + '\n'.join(
