@@ -233,7 +233,7 @@ def test_the_run_s_verdicts_are_published_recorded_and_printed(graph_run):
         Verdict.FEASIBLE, Verdict.NOT_FEASIBLE, Verdict.UNDECIDED, Verdict.NOT_ANALYSED}
     printed = done.stdout[done.stdout.index('verdicts:\n'):].splitlines()[1:]
     for line, v in zip(printed, expected, strict=True):
-        assert line.startswith(f'  {v["option"].replace("`", "")}: {v["verdict"]} ('), line
+        assert line.startswith(f'  {v.option.replace("`", "")}: {v.verdict} ('), line
 
 
 SENSITIVITY = os.path.join(os.path.dirname(SMALL), 'sensitivity_experiment.yaml')
