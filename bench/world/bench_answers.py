@@ -1,7 +1,7 @@
 """Do the answers a run reports hold at finer steps? The test case's own files (their gripper,
 their parts' loads) run on the cores at the default step, half and a quarter of it, on the same
-seeds, and the answers read from the run's summary as summary.json reports them (
-item 3; bench_convergence.py checks the physics' own figures with a smaller gripper and loads):
+seeds, and the answers read from the run's summary as summary.json reports them
+(bench_convergence.py checks the physics' own figures with a smaller gripper and loads):
 
 - pth0-sweep: PTH0 on the tray at 40 to 100 parts (step 10, around the full sweep's n* of
   71-72): n* and its 95 % bootstrap interval, the fit's valid parts at n*, valid per check at
