@@ -64,8 +64,12 @@ def test_the_feeder_controller_stops_cleanly_while_a_cycle_runs(client, signum):
         world = NodeProcess('pick_sim_world', 'world', ['-r', f'__ns:={ns}', *WORLD])
         feeder = NodeProcess('feeder_controller', 'feeder_controller', ['-r', f'__ns:={ns}'])
         cycle = LockedActionClient(client.node, FeedCycle, f'{ns}/feed_cycle')
+        # The world must be up before the feed: the feeder (which no longer loads the mesh
+        # stack) serves long before the world has imported PyBullet, and a world stopped
+        # while it still imports is not what this test is about.
+        drop = LockedActionClient(client.node, DropParts, f'{ns}/drop_parts')
         try:
-            assert client.wait_for_servers(cycle, nodes=(world, feeder))
+            assert client.wait_for_servers(cycle, drop, nodes=(world, feeder))
             # A big feed: the cycle waits on the world's drop when the signal comes.
             _in_flight(client, cycle.send_goal_async(FeedCycle.Goal(
                 restart=True, feeder_parts=1000, min_count=300, max_count=300)))
@@ -73,6 +77,7 @@ def test_the_feeder_controller_stops_cleanly_while_a_cycle_runs(client, signum):
         finally:
             feeder.stop()
             cycle.destroy()
+            drop.destroy()
             assert world.stop() == 0, world.output(tail=40)
 
 
