@@ -22,7 +22,7 @@ setup(
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
-            'feeder_controller = feeder_controller.feeder_controller_node:main',
+            'feeder_controller = feeder_controller.start:main',
         ],
     },
 )

@@ -22,7 +22,7 @@ setup(
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
-            'world = pick_sim_world.world_node:main',
+            'world = pick_sim_world.start:main',
         ],
     },
 )

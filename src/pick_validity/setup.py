@@ -22,7 +22,7 @@ setup(
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
-            'validity = pick_validity.validity_node:main',
+            'validity = pick_validity.start:main',
         ],
     },
 )

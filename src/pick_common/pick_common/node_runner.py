@@ -28,6 +28,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
+from . import interrupts
 from .conversions import error_code, ERROR_INTERNAL
 from .errors import CodedError, Limit, PickError
 from .rclpy_adapter import LockedActionClient, RCLError
@@ -202,19 +203,6 @@ def declare_mesh_dirs(node: Node) -> list[str]:
         type=ParameterType.PARAMETER_STRING_ARRAY)).value or []
 
 
-_interrupts = []    # every SIGINT's Python handler call; run() reads it once, after rclpy.init
-
-
-def _leave_shutdown_to_rclpy(signum: int, frame) -> None:
-    """SIGINT's Python handler under rclpy's: nothing to do (the comment in run says why),
-    except to note the signal, so that one that came before rclpy's handler was there to shut
-    down is not lost. It calls nothing of rclpy: Python runs it between two bytecodes of the
-    main thread, once inside Context.ok() with the context's lock held, and a handler that
-    asked rclpy.ok() waited for that lock for ever (a world still up 30 s after SIGINT, its
-    stack in Context.ok twice, in CI)."""
-    _interrupts.append(signum)
-
-
 def _destroy_quietly(node: Node | None) -> None:
     """Destroy a node whose start failed; its handles may already be gone with the context."""
     if node is None:
@@ -236,13 +224,13 @@ def run(name: str, make_node: Callable[[], Node],
     # is, and once that was inside threading's Thread.start (the executor starting a worker),
     # which left a lock broken and the world exiting 1 ('release unlocked lock', in CI). A
     # handler that does nothing lets the spin loop below see the shutdown.
-    signal.signal(signal.SIGINT, _leave_shutdown_to_rclpy)
+    signal.signal(signal.SIGINT, interrupts.record)
     try:
         rclpy.init(args=args)
     except Exception as exc:  # rcl's RCLError: bad --ros-args, unreadable params file
         print(f'{name}: could not start: {exc}', file=sys.stderr)
         sys.exit(2)
-    if _interrupts:
+    if interrupts.received:
         # before rclpy's handler, or after it and already shut down by it: a stop either way
         rclpy.try_shutdown()
         print(f'{name}: stopped while starting', file=sys.stderr)
