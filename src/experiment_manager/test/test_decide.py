@@ -53,3 +53,12 @@ def test_a_directory_that_is_no_run_is_refused_by_name(tmp_path, capsys):
     err = capsys.readouterr().err
     assert f'run_dir: {str(tmp_path)!r}' in err or str(tmp_path) in err
     assert 'is not a run directory: it has no experiment.yaml, iterations.csv' in err
+
+
+def test_a_broken_summary_is_said_with_its_directory(small, tmp_path, capsys):
+    run_dir = _copy(small, tmp_path)
+    with open(os.path.join(run_dir, 'summary.json'), 'w', encoding='utf-8') as f:
+        f.write('{"schema_version": 7}')
+    assert main([run_dir]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f'decide: {run_dir}: ') and 'schema_version 7 is newer' in err

@@ -6,8 +6,9 @@ For each run directory, every experiment's summary is computed anew from the run
 files (analysis/redecide.py), and the headlines and verdicts are printed as `run` prints
 them, each verdict that differs from the one the run's summary.json holds marked with what it
 was. --write replaces summary.json (current schema version) and the report with today's. No
-graph is started. Exit 0, or 2 for a directory that is not a run directory or whose
-experiment file no longer reads.
+graph is started. Exit 0, or 2 for a directory that is not a run directory, whose experiment
+file no longer reads, or whose summary.json or result files are broken (each said with the
+directory).
 """
 
 import argparse
@@ -61,6 +62,9 @@ def main(argv: list[str] | None = None) -> int:
             print('\n'.join(decide(run_dir, args.write)))
         except InvalidArgument as exc:
             print(f'decide: {exc}', file=sys.stderr)
+            status = 2
+        except (OSError, ValueError) as exc:    # an unreadable or broken summary.json or CSV
+            print(f'decide: {run_dir}: {exc}', file=sys.stderr)
             status = 2
     return status
 

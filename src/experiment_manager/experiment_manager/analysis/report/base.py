@@ -5,19 +5,21 @@ has nothing for it."""
 from dataclasses import dataclass, field
 from functools import cached_property
 
+from ...experiment_file.schema import Part as PartKeys
 from ..summary import Summary
 from ..verdicts import PAPER, Verdict, verdicts
 
 
 @dataclass
 class Run:
-    """A finished run as the report reads it. summary: summary.json; part: the file's part
-    section as written (`schema.Part`); gripper: the gripper keys the file gave (mm);
-    figures: which plots were drawn, by name (plots.py); pictures: {image file: caption}
-    (pictures.py); account: the part's account (part_sheet.describe), with its sheet
-    `part.png`; stops: why parts were turned down, per experiment (stages.turned_down)."""
+    """A finished run as the report reads it. summary: summary.json; part_model and
+    part_dimensions_mm: the file's part section as written (`schema.Part`: the model's name,
+    the dimensions it gave); gripper: the gripper keys the file gave (mm); figures: which plots
+    were drawn, by name (plots.py); pictures: {image file: caption} (pictures.py); account:
+    the part's account (part_sheet.describe), with its sheet `part.png`; stops: why parts were
+    turned down, per experiment (stages.turned_down)."""
     summary: Summary
-    part_model: str = ''
+    part_model: str = PartKeys.model_fields['model'].default
     part_dimensions_mm: dict[str, float] = field(default_factory=dict)
     gripper: dict[str, float] = field(default_factory=dict)
     figures: dict[str, bool] = field(default_factory=dict)
