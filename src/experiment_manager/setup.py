@@ -28,7 +28,7 @@ setup(
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
-            'experiment_manager = experiment_manager.start:main',
+            'experiment_manager = experiment_manager.graph.start:main',
             'run = experiment_manager.commands.run:main',
             'replay = experiment_manager.commands.replay:main',
             'decide = experiment_manager.commands.decide:main',
