@@ -2,8 +2,8 @@
 them. A node's executable holds them (`hold`) before it imports anything heavy: a SIGINT that
 came while the world still imported PyBullet and SciPy raised KeyboardInterrupt inside an
 extension's initialisation, and the process died of SIGINT, of SIGSEGV or hung (4 of 4 tries
-with a signal 0.1 s after the start). node_runner.run reads `received` once after rclpy.init
-and stops the node cleanly if anything came. Standard library only."""
+with the signal sent while the world still imported). node_runner.run reads `received` once
+after rclpy.init and stops the node cleanly if anything came. Standard library only."""
 
 import importlib
 import signal
