@@ -15,9 +15,3 @@ tests/test_studies.py runs each on a small recorded run, so a study a page cites
 still runs. Re-deciding a finished run with today's rules is the `decide` command, not a
 study.
 """
-
-import os
-
-# The paper's test-case experiment files (docs/paper-test-case.md).
-TEST_CASE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src',
-                         'experiment_manager', 'config', 'test_case')

@@ -46,14 +46,13 @@ import argparse
 import os
 import sys
 
+from bench.paper_case import TEST_CASE
 from experiment_manager import experiment_file
 from experiment_manager.analysis import decisions, metrics
 from experiment_manager.analysis.results import read_csv
 from experiment_manager.running import sampling
 import numpy as np
 import yaml
-
-from . import TEST_CASE
 
 # the full-count sweeps' n* (docs/paper-test-case.md, "In short") and the files' margin
 N_STAR = {'pth0': 72, 'pth1': 45, 'pth2': 54}
