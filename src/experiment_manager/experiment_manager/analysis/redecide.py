@@ -14,14 +14,18 @@ from . import summary as summary_model
 from .results import read_csv
 
 
-def redecide(run_dir: str) -> dict:
+def redecide(run_dir: str, recorded: summary_model.Summary | None = None) -> dict:
     """The summary (summary.json's dict, current version) of the run in `run_dir` as today's
-    metrics and decisions give it. Raises InvalidArgument when its experiment.yaml no longer
-    reads, OSError when a result file is missing."""
+    metrics and decisions give it; `recorded`: the run's summary.json when the caller has read
+    it (read here otherwise, when there is one). Raises InvalidArgument when its
+    experiment.yaml no longer reads, OSError when a result file is missing."""
     file = experiment_file.load(os.path.join(run_dir, 'experiment.yaml'))
     rows, picks, checks = (read_csv(os.path.join(run_dir, f'{name}.csv'))
                            for name in ('iterations', 'picks', 'checks'))
-    sampled = _sampling(run_dir)
+    path = os.path.join(run_dir, 'summary.json')
+    if recorded is None and os.path.exists(path):
+        recorded = summary_model.read(path)
+    sampled = _sampling(recorded) if recorded is not None else {}
     summaries: dict[str, dict] = {}
     for exp in file.experiments:
         if exp.type == SENSITIVITY:
@@ -40,13 +44,8 @@ def redecide(run_dir: str) -> dict:
     return metrics.file_summary(file, summaries)
 
 
-def _sampling(run_dir: str) -> dict[str, dict]:
-    """Each adaptive experiment's sampling as the run's summary.json recorded it (any
-    version), by id; none without a summary."""
-    path = os.path.join(run_dir, 'summary.json')
-    if not os.path.exists(path):
-        return {}
-    old = summary_model.read(path)
-    every = {**old.experiments, **(old.repeats or {})}
+def _sampling(recorded: summary_model.Summary) -> dict[str, dict]:
+    """Each adaptive experiment's sampling as the run's summary recorded it, by id."""
+    every = {**recorded.experiments, **(recorded.repeats or {})}
     return {k: s.sampling.model_dump(exclude_unset=True) for k, s in every.items()
             if s.sampling is not None}

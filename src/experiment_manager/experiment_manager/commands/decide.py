@@ -35,9 +35,9 @@ def decide(run_dir: str, write: bool) -> list[str]:
         raise InvalidArgument('run_dir', run_dir, 'is not a run directory: it has no '
                               + ', '.join(missing))
     path = os.path.join(run_dir, 'summary.json')
-    before = ({v.kind: v.verdict for v in verdicts(summary_model.read(path))}
-              if os.path.exists(path) else {})
-    raw = redecide(run_dir)
+    recorded = summary_model.read(path) if os.path.exists(path) else None
+    before = {v.kind: v.verdict for v in verdicts(recorded)} if recorded is not None else {}
+    raw = redecide(run_dir, recorded)
     now = summary_model.validate(raw)
     lines = [run_dir, *headlines(now), 'verdicts:']
     for v in verdicts(now):
