@@ -60,14 +60,15 @@ SETTINGS = {
     # the defaults before the convergence study: 30 iterations, pybullet's warm start
     '30-it': replace(DEFAULT, solver_iterations=30, tray_solver_iterations=30,
                      warm_starting_factor=0.1),
-    # the parts' rolling and spinning friction arms of an earlier default (PART below)
+    # the parts' rolling and spinning friction arms of an earlier default (MATERIALS below)
     'arms-1mm': DEFAULT,
     # every part stepped to the end of every settle: an earlier default
     'no-freeze': replace(DEFAULT, settle_freeze=False),
     'dt/2-no-freeze': replace(FINER, time_step=DEFAULT.time_step / 2, settle_freeze=False),
 }
-# the part's changes of a setting (keys of an experiment file's part section)
-PART = {'arms-1mm': {'rolling_friction_mm': 1.0, 'spinning_friction_mm': 1.0}}
+# a setting's materials section (an experiment file's), for both pairs
+MATERIALS = {'arms-1mm': {pair: {'rolling_friction_mm': 1.0, 'spinning_friction_mm': 1.0}
+                          for pair in ('part_on_surface', 'part_on_part')}}
 FINEST = 'dt/4'         # the reference the others are marked against
 
 
@@ -133,8 +134,9 @@ GRIPPER = {'body_diameter_mm': 8, 'body_length_mm': 60, 'jaw_height_mm': 15, 'ja
 def job(args: tuple[str, str, int]) -> tuple[str, str, list[dict]]:
     setting, workload, seeds = args
     part_file, experiments, _ = WORKLOADS[workload]
+    materials = {'materials': MATERIALS[setting]} if setting in MATERIALS else {}
     rows, _ = run_on_cores(part_file, experiments(seeds), SETTINGS[setting], gripper=GRIPPER,
-                           part=PART.get(setting))
+                           **materials)
     return setting, workload, rows
 
 

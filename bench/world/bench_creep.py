@@ -78,8 +78,14 @@ def creep(name: str, parts: int, size: tuple[float, float, float], seed: int, ca
     part = load(os.path.join(TEST_CASE, f'{case}.yaml')).part
     rolling, spinning = ARMS.get(name, FORMER_ARMS if name.startswith('former') else
                                  (None, None))
-    part = replace(part, rolling_friction=part.rolling_friction if rolling is None else rolling,
-                   spinning_friction=part.spinning_friction if spinning is None else spinning)
+    pairs = {}
+    for pair in ('part_on_surface', 'part_on_part'):
+        contact = getattr(part, pair)
+        pairs[pair] = replace(contact, rolling_friction=contact.rolling_friction
+                              if rolling is None else rolling,
+                              spinning_friction=contact.spinning_friction
+                              if spinning is None else spinning)
+    part = replace(part, **pairs)
     spec = ContainerSpec(inner_size=size, wall_thickness=0.003)
     with World(SceneSpec(spec, part, 1, seed), PhysicsConfig(**physics)) as world:
         start = time.perf_counter()

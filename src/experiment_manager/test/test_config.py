@@ -25,7 +25,8 @@ def test_the_default_file_parses_into_si_units():
     assert f.id == 'capacitor_demo'
     assert [e.type for e in f.experiments if e.scenario is None] == list(experiment_file.TYPES)
     assert [e.id for e in f.experiments if e.scenario is not None] == [
-        'feeder@part_lateral_friction_low', 'feeder@part_lateral_friction_high']
+        'feeder@materials_part_on_surface_lateral_friction_low',
+        'feeder@materials_part_on_surface_lateral_friction_high']
     assert f.gripper.body_diameter == pytest.approx(0.020)
     assert f.check.tolerance == pytest.approx(math.radians(45))
     assert f.tray.inner_size == pytest.approx((0.195, 0.150, 0.027))

@@ -62,26 +62,28 @@ def sensitivity(text: str) -> str:
 def test_each_input_gets_a_low_and_a_high_scenario_and_the_repeats_keep_their_sources():
     f = experiment_file.parse(sensitivity(
         'iterations: 2, of: [emptying], joint: 3, inputs: {'
-        'part.lateral_friction: {low: 0.2, high: 0.9, source: tilting-plane tests}, '
+        'materials.part_on_surface.lateral_friction: '
+        '{low: 0.2, high: 0.9, source: tilting-plane tests}, '
         'gripper.jaw_depth_mm: {low: 2, high: 5, source: catalogue}, '
         'moves.duration_scale: {low: 0.5, high: 2, source: feeder manual}}'))
     robust = f.experiment('robust')
     names = [s.name for s in robust.scenarios]
-    assert names == ['part_lateral_friction_low', 'part_lateral_friction_high',
+    assert names == ['materials_part_on_surface_lateral_friction_low',
+                     'materials_part_on_surface_lateral_friction_high',
                      'gripper_jaw_depth_mm_low', 'gripper_jaw_depth_mm_high',
                      'moves_duration_scale_low', 'moves_duration_scale_high',
                      'joint_1', 'joint_2', 'joint_3']
-    assert [x.base for x in robust.inputs] == [0.5, 3.0, 1.0]
+    assert [x.base for x in robust.inputs] == [0.35, 3.0, 1.0]
     assert robust.inputs[0].source == 'tilting-plane tests'
     # the repeats come before the sensitivity experiment, capped at its iterations, and take
     # their bin from the file's `bins` (not repeated)
     assert [e.id for e in f.experiments][3:] == [f'emptying@{n}' for n in names] + ['robust']
-    low = f.experiment('emptying@part_lateral_friction_low')
+    low = f.experiment('emptying@materials_part_on_surface_lateral_friction_low')
     assert low.iterations == 2 and low.bin_from == 'bins'
     assert robust.sources[-1] == 'emptying@joint_3'
     # one input changed, the rest as in the file
     run = f.for_experiment(low)
-    assert run.part.lateral_friction == 0.2 and run.gripper == f.gripper
+    assert run.part.part_on_surface.lateral_friction == 0.2 and run.gripper == f.gripper
     assert run.moves == f.moves and f.for_experiment(f.experiment('emptying')) is f
     deep = f.for_experiment(f.experiment('emptying@gripper_jaw_depth_mm_high'))
     assert deep.gripper.jaw_depth == pytest.approx(0.005) and deep.part == f.part
@@ -97,14 +99,15 @@ def test_each_input_gets_a_low_and_a_high_scenario_and_the_repeats_keep_their_so
 def test_a_repeated_source_is_taken_from_the_same_scenario():
     f = experiment_file.parse(sensitivity(
         'iterations: 1, of: [bins, emptying], inputs: {'
-        'part.restitution: {low: 0, high: 0.3, source: guess}}'))
-    assert f.experiment('emptying@part_restitution_high').bin_from == 'bins@part_restitution_high'
+        'materials.part_on_surface.restitution: {low: 0, high: 0.6, source: guess}}'))
+    high = 'materials_part_on_surface_restitution_high'
+    assert f.experiment(f'emptying@{high}').bin_from == f'bins@{high}'
 
 
 def test_the_joint_scenarios_are_a_latin_hypercube():
     f = experiment_file.parse(sensitivity(
         'iterations: 1, of: [sweep], joint: 10, inputs: {'
-        'part.lateral_friction: {low: 0.2, high: 0.7, source: a}, '
+        'materials.part_on_surface.lateral_friction: {low: 0.2, high: 0.7, source: a}, '
         'part.mass_g: {low: 0.5, high: 1.5, source: b}}'))
     robust = f.experiment('robust')
     joint = [dict(s.values) for s in robust.scenarios if s.name.startswith('joint')]
@@ -116,17 +119,24 @@ def test_the_joint_scenarios_are_a_latin_hypercube():
     assert mass == pytest.approx(joint[0]['part.mass_g'] / 1000)
 
 
+RESTITUTION = r'experiments\[3\]\.inputs\.materials\.part_on_surface\.restitution'
+
+
 @pytest.mark.parametrize('text, field, rule', [
     ('iterations: 1, of: [sweep], inputs: {part.colour: {low: 0, high: 1, source: x}}',
      r'experiments\[3\]\.inputs\.part\.colour', 'is not an input a sensitivity experiment '
-     r'varies \(part\.lateral_friction'),
-    ('iterations: 1, of: [sweep], inputs: {part.restitution: {low: 0.5, high: 0.2, source: x}}',
-     r'experiments\[3\]\.inputs\.part\.restitution\.high', r'must be above low \(0\.5\)'),
-    ('iterations: 1, of: [sweep], inputs: {part.restitution: {low: 0.1, high: 0.2}}',
-     r'experiments\[3\]\.inputs\.part\.restitution\.source', 'is required|missing'),
-    ('iterations: 1, of: [sweep], inputs: {part.restitution: {low: 0.1, high: 1.5, source: x}}',
-     r'experiments\[3\]\.inputs\.part\.restitution\.high', r'1\.5'),
-    ('iterations: 1, of: [feeder], inputs: {part.restitution: {low: 0, high: 1, source: x}}',
+     r'varies \(materials\.part_on_surface\.lateral_friction'),
+    ('iterations: 1, of: [sweep], inputs: {materials.part_on_surface.restitution: '
+     '{low: 0.5, high: 0.2, source: x}}',
+     RESTITUTION + r'\.high', r'must be above low \(0\.5\)'),
+    ('iterations: 1, of: [sweep], inputs: {materials.part_on_surface.restitution: '
+     '{low: 0.1, high: 0.2}}', RESTITUTION + r'\.source', 'is required|missing'),
+    ('iterations: 1, of: [sweep], inputs: {materials.part_on_surface.restitution: '
+     '{low: 0.1, high: 1.5, source: x}}', RESTITUTION + r'\.high', r'1\.5'),
+    ('iterations: 1, of: [sweep], inputs: {part.restitution: {low: 0.1, high: 0.5, source: x}}',
+     r'experiments\[3\]\.inputs\.part\.restitution', 'has moved: vary materials'),
+    ('iterations: 1, of: [feeder], inputs: {materials.part_on_surface.restitution: '
+     '{low: 0, high: 1, source: x}}',
      r'experiments\[3\]\.of\[0\]', 'names no earlier experiment'),
     ('iterations: 1, of: [sweep], inputs: {gripper.jaw_depth_mm: {low: 1, high: 1200, '
      'source: x}}', r'experiments\[3\]\.inputs \(gripper_jaw_depth_mm_high\) '
@@ -148,11 +158,11 @@ def test_the_repeats_ran_with_their_scenario_and_the_summary_compares_them(sens)
     assert len({r['seed'] for r in by_id.values()}) == 1
     base = by_id['feeder']
     moved = [k for k, r in by_id.items() if k != 'feeder' and _run(r) != _run(base)]
-    assert set(moved) >= {'feeder@part_lateral_friction_low',
+    assert set(moved) >= {'feeder@materials_part_on_surface_lateral_friction_low',
                           'feeder@gripper_body_diameter_mm_high'}, moved
     s = summary['experiments']['robust']
     assert set(summary['repeats']) == {f'feeder@{x["name"]}' for x in s['scenarios']}
-    assert [x['name'] for x in s['inputs']] == ['part.lateral_friction',
+    assert [x['name'] for x in s['inputs']] == ['materials.part_on_surface.lateral_friction',
                                                 'gripper.body_diameter_mm',
                                                 'moves.amplitude_scale']
     assert s['inputs'][1]['base'] == 8.0 and s['inputs'][0]['source'] == 'a guess, for the tests'
@@ -161,9 +171,9 @@ def test_the_repeats_ran_with_their_scenario_and_the_summary_compares_them(sens)
         repeat = summary['repeats'][f'feeder@{x["name"]}']
         assert x['answers']['vibrations'] == repeat['vibrations_to_empty']['mean']
     scenario = {x['name']: x['answers'] for x in s['scenarios']}
-    assert s['tornado']['vibrations']['part.lateral_friction'] == {
-        'low': scenario['part_lateral_friction_low']['vibrations'],
-        'high': scenario['part_lateral_friction_high']['vibrations']}
+    assert s['tornado']['vibrations']['materials.part_on_surface.lateral_friction'] == {
+        'low': scenario['materials_part_on_surface_lateral_friction_low']['vibrations'],
+        'high': scenario['materials_part_on_surface_lateral_friction_high']['vibrations']}
     seen = [x['answers']['vibrations'] for x in [s['base'], *s['scenarios']]]
     assert s['ranges']['vibrations'] == [min(v for v in seen if v is not None),
                                          max(v for v in seen if v is not None)]
@@ -182,8 +192,10 @@ def test_the_report_draws_the_tornado_and_lists_the_scenarios(sens, tmp_path):
     text = report.markdown(Run(validate(summary), figures={'sensitivity_robust': True}))
     section = text.split('## How far the answers move (`robust`)')[1].split('\n## ')[0]
     assert '![tornado chart of robust](sensitivity_robust.png)' in section
-    assert '| `part.lateral_friction` | 0.5 | 0.3 | 0.8 | a guess, for the tests |' in section
-    assert '| part_lateral_friction_low | part.lateral_friction 0.3 |' in section
+    assert ('| `materials.part_on_surface.lateral_friction` | 0.35 | 0.3 | 0.8 | a guess, for '
+            'the tests |') in section
+    assert ('| materials_part_on_surface_lateral_friction_low | '
+            'materials.part_on_surface.lateral_friction 0.3 |') in section
     path = str(tmp_path / 'tornado.png')
     assert report.plot_tornado('robust', validate(summary).experiments['robust'], path)
     with open(path, 'rb') as f:
@@ -195,8 +207,11 @@ def test_an_end_with_no_value_is_drawn_on_top_and_named():
     # show it, and it is where the verdict flipped
     bars = report.tornado_bars({'gripper.jaw_depth_mm': {'low': 79.7, 'high': None},
                                 'moves.amplitude_scale': {'low': 224.0, 'high': 81.0},
-                                'part.restitution': {'low': 79.7, 'high': 75.3}}, 79.7)
-    assert [b[0] for b in bars] == ['part.restitution', 'moves.amplitude_scale',
+                                'materials.part_on_surface.restitution': {'low': 79.7,
+                                                                          'high': 75.3}},
+                                79.7)
+    assert [b[0] for b in bars] == ['materials.part_on_surface.restitution',
+                                    'moves.amplitude_scale',
                                     'gripper.jaw_depth_mm (high: no value)']
 
 
@@ -223,8 +238,8 @@ def _run(row: dict) -> tuple:
 def test_values_outside_a_range_are_not_drawn():
     f = experiment_file.parse(sensitivity(
         'iterations: 1, of: [sweep], joint: 64, inputs: {'
-        'part.spinning_friction_mm: {low: 0, high: 0.5, source: a}}'))
-    values = np.array([dict(s.values)['part.spinning_friction_mm']
+        'materials.part_on_surface.spinning_friction_mm: {low: 0.05, high: 0.5, source: a}}'))
+    values = np.array([dict(s.values)['materials.part_on_surface.spinning_friction_mm']
                        for s in f.experiment('robust').scenarios])
     assert values.min() >= 0 and values.max() <= 0.5
 
@@ -295,7 +310,7 @@ def test_a_grid_maps_the_verdicts_over_two_inputs():
             'iterations: 1, of: [emptying], grid: 9, inputs: {'
             'gripper.body_diameter_mm: {low: 12, high: 30, source: a}, '
             'gripper.jaw_depth_mm: {low: 3, high: 6, source: b}, '
-            'part.restitution: {low: 0, high: 0.2, source: c}}'))
+            'materials.part_on_surface.restitution: {low: 0, high: 0.2, source: c}}'))
 
 
 def test_only_the_options_whose_runs_are_repeated_are_said_to_hold(small):
@@ -306,7 +321,7 @@ def test_only_the_options_whose_runs_are_repeated_are_said_to_hold(small):
         text = f.read()
     file = experiment_file.parse(text + (
         '  - {id: robust, type: sensitivity, iterations: 1, of: [feeder], inputs: '
-        '{part.restitution: {low: 0, high: 0.2, source: a}}}\n'))
+        '{materials.part_on_surface.restitution: {low: 0, high: 0.2, source: a}}}\n'))
     robust = file.experiment('robust')
     summaries = {**summary['experiments'], **{
         f'feeder@{s.name}': summary['experiments']['feeder'] for s in robust.scenarios}}
@@ -332,8 +347,9 @@ def test_a_gripper_input_is_refused_for_a_gripper_sweep_whose_grippers_are_its_o
     with pytest.raises(InvalidArgument, match=r'experiments\[4\]\.inputs\.gripper\.jaw_depth_mm'
                        r'.*cannot reach the gripper_sweep g'):
         experiment_file.parse(text)
-    assert experiment_file.parse(text.replace('gripper.jaw_depth_mm: {low: 2, high: 4',
-                                              'part.restitution: {low: 0, high: 0.2'))
+    assert experiment_file.parse(text.replace(
+        'gripper.jaw_depth_mm: {low: 2, high: 4',
+        'materials.part_on_surface.restitution: {low: 0, high: 0.2'))
 
 
 def test_run_check_says_what_the_scenarios_add(tmp_path, capsys):
@@ -347,7 +363,8 @@ def test_run_check_says_what_the_scenarios_add(tmp_path, capsys):
     assert '  feeder (feeder_emptying): 1 iterations\n' in out
     assert '  robust (sensitivity of feeder): 3 input(s), 8 scenario(s), 8 repeat(s) of 8 ' \
         'iterations\n' in out
-    assert '    part_lateral_friction_low: part.lateral_friction 0.3\n' in out
+    assert ('    materials_part_on_surface_lateral_friction_low: '
+            'materials.part_on_surface.lateral_friction 0.3\n') in out
     assert out.count('    joint_') == 2
     assert 'feeder cycle, one vibration: forward (1.4, 0, 1.4 mm at 26 Hz for 0.5 s, as ' \
         'given)\n' in out

@@ -11,7 +11,14 @@ from collections.abc import Sequence
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Point, Pose, Quaternion, Vector3
 import numpy as np
-from pick_msgs.msg import ContainerGeometry, Part, PartArray, PartModel, PhysicsProgress
+from pick_msgs.msg import (
+    ContactMaterial,
+    ContainerGeometry,
+    Part,
+    PartArray,
+    PartModel,
+    PhysicsProgress,
+)
 from pick_msgs.msg import SettleReport as SettleReportMsg
 from pick_msgs.msg import TrayMotion as TrayMotionMsg
 from pick_msgs.msg import Vibration as VibrationMsg
@@ -29,6 +36,8 @@ from .errors import (
     UnknownInstance,
     UnknownPart,
 )
+from .parts.materials import Contact
+from .parts.materials import FIELDS as CONTACT_FIELDS
 from .parts.spec import PartSpec
 from .specs import CENTRE, FIXED, RANDOM, Vibration
 from .states import PartStates, Progress, SettleReport, TrayMotion
@@ -98,7 +107,8 @@ def container_from_msg(msg: ContainerGeometry) -> ContainerSpec:
         kind=MSG_TO_KIND[msg.type], inner_size=(size.x, size.y, size.z),
         wall_thickness=msg.wall_thickness, floor_thickness=msg.floor_thickness,
         feeder_zone_center=(msg.feeder_zone_center.x, msg.feeder_zone_center.y),
-        feeder_zone_size=(msg.feeder_zone_size.x, msg.feeder_zone_size.y))
+        feeder_zone_size=(msg.feeder_zone_size.x, msg.feeder_zone_size.y),
+        drop_height=or_default('container.drop_height', msg.drop_height, None))
 
 
 def container_to_msg(spec: ContainerSpec) -> ContainerGeometry:
@@ -107,12 +117,14 @@ def container_to_msg(spec: ContainerSpec) -> ContainerGeometry:
         type=KIND_TO_MSG[spec.kind], inner_size=Vector3(x=x, y=y, z=z),
         wall_thickness=spec.wall_thickness, floor_thickness=spec.floor_thickness,
         feeder_zone_center=Point(x=spec.feeder_zone_center[0], y=spec.feeder_zone_center[1]),
-        feeder_zone_size=Vector3(x=spec.feeder_zone_size[0], y=spec.feeder_zone_size[1]))
+        feeder_zone_size=Vector3(x=spec.feeder_zone_size[0], y=spec.feeder_zone_size[1]),
+        drop_height=float(containers.drop_height(spec)))
 
 
 # ----------------------------------------------------------------------------- parts
 def part_spec_from_msg(msg: PartModel, mesh_dirs: Sequence[str] = ()) -> PartSpec:
-    """A PartSpec from a message. 0 in mass, scale or a friction field means the default.
+    """A PartSpec from a message. 0 in mass or scale means the default, and so does a contact
+    material whose four fields are all 0 (contact_from_msg).
     A mesh file must lie in one of `mesh_dirs` (the node's parameter of that name): a request
     cannot make a node read elsewhere."""
     mesh = msg.mesh_path and check_inside('part_model.mesh_path', msg.mesh_path, mesh_dirs,
@@ -127,15 +139,21 @@ def part_spec_from_msg(msg: PartModel, mesh_dirs: Sequence[str] = ()) -> PartSpe
     return PartSpec(
         model=msg.name, dimensions=dict(zip(names, values, strict=True)),
         mass=or_default('part_model.mass', msg.mass, None),
-        lateral_friction=or_default('part_model.lateral_friction', msg.lateral_friction,
-                                    defaults.lateral_friction),
-        rolling_friction=or_default('part_model.rolling_friction', msg.rolling_friction,
-                                    defaults.rolling_friction),
-        spinning_friction=or_default('part_model.spinning_friction', msg.spinning_friction,
-                                     defaults.spinning_friction),
-        restitution=or_default('part_model.restitution', msg.restitution,
-                               defaults.restitution),
+        part_on_surface=contact_from_msg(msg.part_on_surface, defaults.part_on_surface),
+        part_on_part=contact_from_msg(msg.part_on_part, defaults.part_on_part),
         mesh_path=mesh, scale=or_default('part_model.scale', msg.scale, 1.0))
+
+
+def contact_from_msg(msg: ContactMaterial, default: Contact) -> Contact:
+    """A pair's contact material; `default` when all four fields are 0 (a request that leaves
+    the pair out). Each value as given otherwise, 0 included (checked where the part is
+    built)."""
+    values = {name: float(getattr(msg, name)) for name in CONTACT_FIELDS}
+    return default if not any(values.values()) else Contact(**values)
+
+
+def contact_to_msg(contact: Contact) -> ContactMaterial:
+    return ContactMaterial(**{name: float(getattr(contact, name)) for name in CONTACT_FIELDS})
 
 
 def part_spec_to_msg(spec: PartSpec) -> PartModel:
@@ -145,10 +163,9 @@ def part_spec_to_msg(spec: PartSpec) -> PartModel:
     return PartModel(name=spec.model, mesh_path=spec.mesh_path, scale=float(spec.scale),
                      dimension_names=names,
                      dimension_values=[float(spec.dimensions[n]) for n in names],
-                     mass=float(spec.mass or 0.0), lateral_friction=float(spec.lateral_friction),
-                     rolling_friction=float(spec.rolling_friction),
-                     spinning_friction=float(spec.spinning_friction),
-                     restitution=float(spec.restitution))
+                     mass=float(spec.mass or 0.0),
+                     part_on_surface=contact_to_msg(spec.part_on_surface),
+                     part_on_part=contact_to_msg(spec.part_on_part))
 
 
 # ----------------------------------------------------------------------------- snapshots

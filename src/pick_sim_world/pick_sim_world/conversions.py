@@ -12,7 +12,7 @@ from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Point, Quaternion, Transform, TransformStamped, Vector3
 import numpy as np
 from pick_common import containers
-from pick_common.conversions import container_to_msg, instance_frame, pose_msg
+from pick_common.conversions import contact_to_msg, container_to_msg, instance_frame, pose_msg
 from pick_common.parts.geometry import PartGeometry
 from pick_common.parts.primitives import Box, Cylinder
 from pick_common.states import PartStates, rotate
@@ -39,9 +39,8 @@ def part_model_to_msg(part: PartGeometry) -> PartModel:
         name=spec.model, mesh_path=spec.mesh_path, scale=float(spec.scale),
         dimension_names=list(part.dimensions), dimension_values=[
             float(v) for v in part.dimensions.values()],
-        mass=float(part.mass), lateral_friction=float(spec.lateral_friction),
-        rolling_friction=float(spec.rolling_friction),
-        spinning_friction=float(spec.spinning_friction), restitution=float(spec.restitution),
+        mass=float(part.mass), part_on_surface=contact_to_msg(spec.part_on_surface),
+        part_on_part=contact_to_msg(spec.part_on_part),
         bounding_radius=float(part.radius + np.linalg.norm(part.center)))
     for p in part.primitives:
         if isinstance(p, Box):

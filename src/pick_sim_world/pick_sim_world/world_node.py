@@ -24,6 +24,8 @@ from pick_common.node_runner import (
     RESULT_KEEP,
     run,
 )
+from pick_common.parts.materials import Contact
+from pick_common.parts.materials import LIMITS as CONTACT_LIMITS
 from pick_common.parts.models import BUILTIN_MODELS
 from pick_common.parts.spec import LIMITS as PART_LIMITS
 from pick_common.parts.spec import PartSpec
@@ -115,7 +117,10 @@ class WorldNode(Node):
                                          'centre x, y of the tray feeder zone, m')),
             feeder_zone_size=tuple(get('container.feeder_zone_size',
                                        list(base.feeder_zone_size),
-                                       'x, y extent of the tray feeder zone, m')))
+                                       'x, y extent of the tray feeder zone, m')),
+            drop_height=get('container.drop_height', containers.DROP_HEIGHT[kind],
+                            "how high over the floor parts arrive from, m (a bin's pour, a "
+                            "tray's hopper lip)", walls['container.drop_height']))
         model = get('part.model', 'radial_capacitor',
                     f'built-in model ({", ".join(BUILTIN_MODELS)}) or mesh')
         dims, default_mass = {}, 0.0
@@ -126,20 +131,22 @@ class WorldNode(Node):
                     for name, value in defaults.items()}
         mass = get('part.mass', default_mass, 'kg; 0 for the model default (checked when the '
                    'part is built)')
-        spec, material = PartSpec(), PART_LIMITS
+        spec = PartSpec()
+
+        def contact(pair: str, default: Contact) -> Contact:
+            texts = {'lateral_friction': 'Coulomb coefficient',
+                     'rolling_friction': 'rolling resistance arm, m',
+                     'spinning_friction': 'torsional friction arm, m', 'restitution': '1'}
+            return Contact(**{name: get(f'materials.{pair}.{name}', getattr(default, name),
+                                        f'{texts[name]}, the part {pair.replace("_", " ")}',
+                                        CONTACT_LIMITS[name]) for name in texts})
+
         part = PartSpec(
             model=model, dimensions=dims, mass=mass or None,
-            lateral_friction=get('part.lateral_friction', spec.lateral_friction,
-                                 'Coulomb coefficient', material['part.lateral_friction']),
-            rolling_friction=get('part.rolling_friction', spec.rolling_friction,
-                                 'rolling resistance arm, m', material['part.rolling_friction']),
-            spinning_friction=get('part.spinning_friction', spec.spinning_friction,
-                                  'torsional friction arm, m',
-                                  material['part.spinning_friction']),
-            restitution=get('part.restitution', spec.restitution, '1',
-                            material['part.restitution']),
+            part_on_surface=contact('part_on_surface', spec.part_on_surface),
+            part_on_part=contact('part_on_part', spec.part_on_part),
             mesh_path=get('part.mesh_path', '', 'STL/OBJ/PLY file for part.model mesh'),
-            scale=get('part.scale', 1.0, 'mesh scale to metres', material['part.scale']))
+            scale=get('part.scale', 1.0, 'mesh scale to metres', PART_LIMITS['part.scale']))
         scene = SceneSpec(container, part,
                           get('instances', 1, 'independent instances',
                               specs.LIMITS['instance_count']),

@@ -8,6 +8,7 @@ from hypothesis import strategies as st
 import numpy as np
 from pick_common.containers import ContainerSpec
 from pick_common.errors import check_inside, InvalidArgument, UnknownInstance
+from pick_common.parts.materials import Contact
 from pick_common.parts.spec import PartSpec
 from pick_common.specs import SceneSpec, Vibration
 from pick_sim_world.world import World
@@ -40,7 +41,7 @@ def test_any_scene_and_count_works_or_names_the_field(world, size, wall, floor, 
                                                       friction, count):
     scene = SceneSpec(ContainerSpec(inner_size=size, wall_thickness=wall, floor_thickness=floor),
                       PartSpec(dimensions={'body_diameter': diameter}, mass=mass,
-                               lateral_friction=friction))
+                               part_on_surface=Contact(friction, 1e-4, 1e-4, 0.3)))
     try:
         world.reset(scene)
         world.drop(count, max_settle_time=0.3)
@@ -48,7 +49,7 @@ def test_any_scene_and_count_works_or_names_the_field(world, size, wall, floor, 
         assert exc.field.split('[')[0] in (
             'container.inner_size', 'container.wall_thickness', 'container.floor_thickness',
             'part.dimensions.body_diameter', 'part.dimensions.lead_pitch', 'part.mass',
-            'part.lateral_friction', 'count'), exc
+            'materials.part_on_surface.lateral_friction', 'count'), exc
     else:
         assert np.isfinite(world.snapshot().poses).all()
     _still_works(world)

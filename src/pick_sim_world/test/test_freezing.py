@@ -8,6 +8,7 @@ hovering where their support went, or a pile that moves on once its parts are dy
 import numpy as np
 from pick_common.containers import ContainerSpec
 from pick_common.errors import InvalidArgument
+from pick_common.parts.materials import arms
 from pick_common.parts.spec import PartSpec
 from pick_common.specs import MOVES, SceneSpec
 from pick_sim_world.config import PhysicsConfig
@@ -15,7 +16,7 @@ from pick_sim_world.world import World
 import pybullet as pb
 import pytest
 
-ARM = PartSpec().rolling_friction
+ARM = PartSpec().part_on_surface.rolling_friction
 T = 0.0045                       # the TO-220's body thickness, m
 FLAT = (np.sin(np.pi / 4), 0.0, 0.0, np.cos(np.pi / 4))    # its back (-Y) down
 
@@ -32,8 +33,7 @@ def test_a_column_falls_as_one_when_its_lowest_part_is_picked(freeze):
     than a part's length), and only waking part by part up the column brings them down. Every
     one must come down a part's thickness, and end dynamic again."""
     channel = ContainerSpec(inner_size=(0.012, 0.031, 0.1))
-    scene = SceneSpec(channel, PartSpec(model='to220', rolling_friction=ARM,
-                                        spinning_friction=ARM), 1, 0)
+    scene = SceneSpec(channel, PartSpec(model='to220', **arms(ARM)), 1, 0)
     with World(scene, PhysicsConfig(settle_freeze=freeze)) as world:
         poses = np.array([[0.0, -0.00325, T / 2 + k * (T + 0.0001), *FLAT] for k in range(12)])
         ids = world._add_parts(world.instances[0], poses)
@@ -55,7 +55,7 @@ def test_a_pile_picked_from_stays_put_once_every_part_is_dynamic():
     starting with only the parts the pick touched awake: a further second with every part
     dynamic moves at most as many parts as it does after the drop alone
     (test_world.test_a_settled_pile_stays_put: 7)."""
-    part = PartSpec(model='to220', rolling_friction=ARM, spinning_friction=ARM)
+    part = PartSpec(model='to220', **arms(ARM))
     scene = SceneSpec(ContainerSpec(inner_size=(0.075, 0.075, 0.06)), part, 1, 0)
     with World(scene, PhysicsConfig()) as world:
         _, report = world.drop(150)

@@ -80,9 +80,10 @@ class _Context:
     the experiments read before it."""
 
     def __init__(self, geometry: PartGeometry, tray: ContainerSpec, bin_wall: float,
-                 max_dimension: float, setup: Setup, moves: tuple[Vibration, ...],
-                 seed: int) -> None:
+                 bin_drop: float, max_dimension: float, setup: Setup,
+                 moves: tuple[Vibration, ...], seed: int) -> None:
         self.geometry, self.tray, self.bin_wall = geometry, tray, bin_wall
+        self.bin_drop = bin_drop
         self.max_dimension, self.setup, self.moves, self.seed = max_dimension, setup, moves, seed
         self.gripper, self.grasps = setup.gripper, setup.grasps
         self.earlier: dict[str, Experiment] = {}
@@ -95,7 +96,7 @@ def _bin(size_mm: tuple[float, ...], where: str, c: _Context) -> ContainerSpec:
             raise InvalidArgument(f'{where}[{i}]', round(s / MM, 6),
                                   f'mm is over the size limit requirements.max_dimension_mm '
                                   f'= {c.max_dimension / MM:g}')
-    spec = ContainerSpec(inner_size=size, wall_thickness=c.bin_wall)
+    spec = ContainerSpec(inner_size=size, wall_thickness=c.bin_wall, drop_height=c.bin_drop)
     checked_as(check_container, spec, where)
     return spec
 
@@ -177,6 +178,11 @@ def _sensitivity(e: schema.SensitivityKeys, where: str, c: _Context) -> list[Exp
     inputs = []
     for name, r in e.inputs.items():
         at = f'{where}.inputs.{name}'
+        moved = name.removeprefix('part.')
+        if name.startswith('part.') and moved in schema.MOVED_KEYS:
+            raise InvalidArgument(at, name, f'has moved: vary materials.part_on_surface.{moved} '
+                                  f'(the part on the bin or tray) or materials.part_on_part.'
+                                  f'{moved} (on another part)')
         if name not in scenario_inputs.INPUTS:
             raise InvalidArgument(at, name, 'is not an input a sensitivity experiment varies ('
                                   + ', '.join(scenario_inputs.INPUTS) + ')')
@@ -287,7 +293,8 @@ def parse(text: str, path: str = '') -> ExperimentFile:
 
     top = read(schema.FileKeys, data, '')
     s = {key: read(model, data.get(key, {}), key) for key, model in schema.SECTIONS.items()}
-    read_part = checked(lambda: part_section.read_part(s['part'], base_dir)) if s['part'] else None
+    read_part = checked(lambda: part_section.read_part(s['part'], s['materials'], base_dir)
+                        ) if s['part'] else None
     part, grasps, place = read_part or (None, None, None)
     gripper = sections.gripper(s['gripper']) if s['gripper'] else None
     check = sections.check(s['check']) if s['check'] else None
@@ -312,7 +319,8 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         checked(lambda: part_section.check_fits(geometry, grasps))
     context = None
     if None not in (top, geometry, tray, moves, requirements, gripper, grasps, check):
-        context = _Context(geometry, tray, MM * top.bin_wall_mm, requirements.max_dimension,
+        context = _Context(geometry, tray, MM * top.bin_wall_mm, MM * top.bin_drop_mm,
+                           requirements.max_dimension,
                            Setup(part, gripper, grasps, place, check), moves, top.seed)
     raw = data.get('experiments')
     for i, item in enumerate(raw if isinstance(raw, list) and len(raw) <= MAX_EXPERIMENTS

@@ -3,9 +3,11 @@ material, its grasps and how it is placed, in SI units; and its geometry, with t
 each grasp's jaws close on it, every error named by the file's keys."""
 
 import os
+from typing import Any
 
 from pick_common.errors import InvalidArgument
 from pick_common.parts.geometry import build_part, PartGeometry
+from pick_common.parts.materials import body_values, Contact
 from pick_common.parts.spec import PartSpec, states_units, UNITS
 from pick_validity.config import CAPACITOR_GRASPS, GraspPose, PlaceSpec
 from pick_validity.grasp_fit import check_grasps_fit
@@ -42,10 +44,18 @@ def mesh_file(p: schema.Part, base_dir: str) -> tuple[str, float]:
     return mesh, UNITS[p.units] if p.units is not None else p.mesh_scale
 
 
-def read_part(p: schema.Part, base_dir: str
+def contact(pair: Any) -> Contact:
+    """A pair of the materials section in SI units."""
+    return Contact(lateral_friction=pair.lateral_friction,
+                   rolling_friction=MM * pair.rolling_friction_mm,
+                   spinning_friction=MM * pair.spinning_friction_mm,
+                   restitution=pair.restitution)
+
+
+def read_part(p: schema.Part, m: schema.MaterialsSection, base_dir: str
               ) -> tuple[PartSpec, tuple[GraspPose, ...] | str, PlaceSpec]:
-    """The part's spec, its grasps (AUTO when the file leaves them to `proposed`) and its
-    placing, in SI units."""
+    """The part's spec (its contact materials from `m`), its grasps (AUTO when the file
+    leaves them to `proposed`) and its placing, in SI units."""
     mesh, scale, mass = '', 1.0, G * p.mass_g
     if p.model == 'mesh':
         if mass == 0.0:
@@ -75,9 +85,9 @@ def read_part(p: schema.Part, base_dir: str
         dimensions['pins_per_row'] = p.pins_per_row
     spec = PartSpec(
         model=p.model, dimensions=dimensions, mass=mass or None,
-        lateral_friction=p.lateral_friction, rolling_friction=MM * p.rolling_friction_mm,
-        spinning_friction=MM * p.spinning_friction_mm, restitution=p.restitution,
+        part_on_surface=contact(m.part_on_surface), part_on_part=contact(m.part_on_part),
         mesh_path=mesh, scale=scale)
+    body_values(spec.part_on_surface, spec.part_on_part)     # a pair Bullet cannot apply
     place = PlaceSpec(place_axis=p.place.axis, seat_offset=MM * p.place.seat_offset_mm)
     if p.grasps is None:
         return spec, CAPACITOR_GRASPS, place

@@ -2,8 +2,9 @@
 bought, varied one at a time and jointly, each scenario a setup and table moves for the
 repeats of the experiments it names.
 
-The inputs (`INPUTS`), in the file's units: the part's friction, rolling and spinning arms,
-restitution and mass (part.*), the gripper's dimensions (gripper.*), and the table moves'
+The inputs (`INPUTS`), in the file's units: each contact pair's friction, rolling and
+spinning arms and restitution (materials.part_on_surface.*, materials.part_on_part.*), the
+part's mass (part.mass_g), the gripper's dimensions (gripper.*), and the table moves'
 amplitude, frequency and duration as factors on every move of the cycle (moves.*_scale: the
 cycle may mix moves, so one number in Hz or s would not say which). The design:
 - one at a time: a scenario at each input's low and one at its high, the others at the file's
@@ -28,6 +29,7 @@ import zlib
 
 import numpy as np
 from pick_common.errors import check_number
+from pick_common.parts.materials import body_values
 from pick_common.specs import check_vibration, Vibration
 from pick_validity.config import check_gripper, Setup
 
@@ -36,10 +38,12 @@ from .model import G, Input, MM, Scenario
 
 # name -> (section, attribute, the file unit in SI, low limit, high limit, low open)
 INPUTS = {
-    'part.lateral_friction': ('part', 'lateral_friction', 1.0, 0.0, 10.0, False),
-    'part.rolling_friction_mm': ('part', 'rolling_friction', MM, 0.0, 100.0, False),
-    'part.spinning_friction_mm': ('part', 'spinning_friction', MM, 0.0, 100.0, False),
-    'part.restitution': ('part', 'restitution', 1.0, 0.0, 1.0, False),
+    **{f'materials.{pair}.{key}': ('materials', f'{pair}.{attr}', unit, 0.0, high, False)
+       for pair in ('part_on_surface', 'part_on_part')
+       for key, attr, unit, high in (('lateral_friction', 'lateral_friction', 1.0, 10.0),
+                                     ('rolling_friction_mm', 'rolling_friction', MM, 100.0),
+                                     ('spinning_friction_mm', 'spinning_friction', MM, 100.0),
+                                     ('restitution', 'restitution', 1.0, 1.0))},
     'part.mass_g': ('part', 'mass', G, 0.0, 10_000.0, True),
     'gripper.body_diameter_mm': ('gripper', 'body_diameter', MM, 0.0, None, True),
     'gripper.body_length_mm': ('gripper', 'body_length', MM, 0.0, None, True),
@@ -61,6 +65,9 @@ def base_value(name: str, setup: Setup, mass: float) -> float:
         return 1.0
     if attr == 'mass':
         return mass / unit
+    if section == 'materials':
+        pair, attr = attr.split('.')
+        return getattr(getattr(setup.part, pair), attr) / unit
     return getattr(getattr(setup, section), attr) / unit
 
 
@@ -75,9 +82,20 @@ def apply(values: dict[str, float], setup: Setup, moves: tuple[Vibration, ...], 
     """The setup and moves with `values` (input name -> file units) set, each checked by the
     core's rules, named at `where`."""
     part, gripper, scale = {}, {}, {}
+    pairs = {'part_on_surface': {}, 'part_on_part': {}}
     for name, value in values.items():
         section, attr, unit = INPUTS[name][:3]
+        if section == 'materials':
+            pair, attr = attr.split('.')
+            pairs[pair][attr] = value * unit
+            continue
         {'part': part, 'gripper': gripper, 'moves': scale}[section][attr] = value * unit
+    for pair, changed in pairs.items():
+        if changed:
+            part[pair] = replace(getattr(setup.part, pair), **changed)
+    if any(pairs.values()):
+        new_part = replace(setup.part, **part)
+        checked(lambda p: body_values(p.part_on_surface, p.part_on_part), new_part, where)
     new_gripper = checked(check_gripper, replace(setup.gripper, **gripper), where)
     new_moves = [checked(check_vibration, Vibration(
         tuple(a * scale.get('amplitude', 1.0) for a in m.amplitude),

@@ -11,9 +11,10 @@ from collections.abc import Mapping
 from functools import partial
 from typing import Annotated, Any
 
-from pick_common.containers import TRAY_DEFAULT_SIZE
+from pick_common.containers import BIN, DROP_HEIGHT, TRAY, TRAY_DEFAULT_SIZE
+from pick_common.parts import materials
 from pick_common.parts.models import BUILTIN_MODELS
-from pick_common.parts.spec import PartSpec, UNITS
+from pick_common.parts.spec import UNITS
 from pick_common.specs import (
     DEFAULT_CYCLE,
     DIRECTIONS,
@@ -90,10 +91,6 @@ class Part(Section):
     dimensions_mm: Annotated[dict[str, Number(0.0, low_open=True)],
                              BeforeValidator(mapping)] = {}
     pins_per_row: Int(1, 64) | None = None
-    lateral_friction: Number(0.0, 10.0) = 0.5
-    rolling_friction_mm: Number(0.0, 100.0) = PartSpec.rolling_friction / MM
-    spinning_friction_mm: Number(0.0, 100.0) = PartSpec.spinning_friction / MM
-    restitution: Number(0.0, 1.0) = 0.0
     units: Text(*UNITS) | None = None                 # a mesh file's length unit
     mesh_scale: Number(0.0, 1000.0, low_open=True) | None = None   # or its scale to metres
     place: Place = Place()
@@ -101,6 +98,40 @@ class Part(Section):
     # (a WrapValidator, so that a list's errors are not joined by 'auto' as a union's are)
     grasps: Annotated[list[GraspEntry] | None, WrapValidator(grasp_list)] = \
         Field(default=None, validate_default=False)
+
+
+    @model_validator(mode='before')
+    @classmethod
+    def _moved(cls, data: Any) -> Any:
+        for key in MOVED_KEYS:
+            if isinstance(data, Mapping) and key in data:
+                fail(f'has moved: a material belongs to a pair of surfaces; give '
+                     f'materials.part_on_surface.{key} (the part on the bin or tray) and '
+                     f'materials.part_on_part.{key} (on another part)', data[key], f'.{key}')
+        return data
+
+
+MOVED_KEYS = ('lateral_friction', 'rolling_friction_mm', 'spinning_friction_mm',
+              'restitution')
+
+
+# ------------------------------------------------------------------------- materials
+def _contact(default: materials.Contact) -> type[Section]:
+    """A pair's section (materials.Contact in the file's units), `default`'s values."""
+    class Pair(Section):
+        lateral_friction: Number(0.0, materials.MAX_COMBINED) = default.lateral_friction
+        rolling_friction_mm: Number(0.0, 100.0) = default.rolling_friction / MM
+        spinning_friction_mm: Number(0.0, 100.0) = default.spinning_friction / MM
+        restitution: Number(0.0, 1.0) = default.restitution
+        source: Text() = ''                     # where the values come from (measured, ...)
+    return Pair
+
+
+class MaterialsSection(Section):
+    """The part's contact materials as pairs (pick_common.parts.materials)."""
+
+    part_on_surface: _contact(materials.PART_ON_SURFACE) = {}
+    part_on_part: _contact(materials.PART_ON_PART) = {}
 
 
 # ------------------------------------------------------------------ gripper and check
@@ -172,6 +203,7 @@ class FileKeys(Section):
     seed: Int(0, MAX_SEED) = 0
     output_dir: Text() = 'results'
     part: Any = None
+    materials: Any = None
     gripper: Any = None
     check: Any = None
     requirements: Any = None
@@ -182,12 +214,15 @@ class FileKeys(Section):
         partial(list_of, low=1, high=MAX_MOVES, what=f'1 to {MAX_MOVES} moves'))] = list(
             DEFAULT_CYCLE)
     bin_wall_mm: Number(0.5, 100.0) = 3.0
+    # how high over the floor parts arrive from: a bin's pour, the tray's hopper lip
+    bin_drop_mm: Number(0.0, 1000.0) = DROP_HEIGHT[BIN] / MM
+    hopper_lip_mm: Number(0.0, 1000.0) = DROP_HEIGHT[TRAY] / MM
     experiments: Annotated[list[Any], BeforeValidator(partial(
         list_of, low=1, high=MAX_EXPERIMENTS, what=f'1..{MAX_EXPERIMENTS} experiments'))]
 
 
 SECTIONS: dict[str, type[Section]] = {
-    'part': Part, 'gripper': GripperSection, 'check': CheckSection,
+    'part': Part, 'materials': MaterialsSection, 'gripper': GripperSection, 'check': CheckSection,
     'requirements': RequirementsSection, 'sampling': SamplingSection, 'cell': CellSection}
 
 

@@ -3,6 +3,8 @@ to m and rad), the requirements (hours to s), the tray and the table's moves (mm
 move's unset keys from the named move of pick_common.specs.MOVES), each checked by its core's
 rule under the file's key names."""
 
+from dataclasses import replace
+
 from pick_common.containers import check_container, ContainerSpec
 from pick_common.specs import check_vibration, MOVES, Vibration
 from pick_validity.config import CheckConfig, Gripper
@@ -32,7 +34,8 @@ def requirements(r: schema.RequirementsSection) -> Requirements:
 
 
 def tray(top: schema.FileKeys) -> ContainerSpec:
-    tray = ContainerSpec.tray(tuple(MM * s for s in top.tray_mm))
+    tray = replace(ContainerSpec.tray(tuple(MM * s for s in top.tray_mm)),
+                   drop_height=MM * top.hopper_lip_mm)
     checked_as(check_container, tray, 'tray_mm')
     return tray
 

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import os
 
 from ..errors import Limit
+from .materials import body_values, Contact, PART_ON_PART, PART_ON_SURFACE
 
 # Largest part accepted: a sanity limit well above small parts, in metres.
 MAX_PART_SIZE = 0.5
@@ -20,10 +21,6 @@ STATED_UNITS = ('.step', '.stp', '.glb', '.gltf')
 # parameters of the same names state them).
 LIMITS = {
     'part.mass': Limit(0.0, 10.0, low_open=True),                 # kg
-    'part.lateral_friction': Limit(0.0, 10.0),                    # Coulomb coefficient
-    'part.rolling_friction': Limit(0.0, 0.1),                     # m
-    'part.spinning_friction': Limit(0.0, 0.1),                    # m
-    'part.restitution': Limit(0.0, 1.0),
     'part.scale': Limit(0.0, 1e3, low_open=True),                 # mesh units to m
 }
 
@@ -33,18 +30,16 @@ class PartSpec:
     """What a user says about a part: a model name or a mesh, its size and material.
 
     dimensions: overrides of the built-in model's defaults, metres (see
-    `models.BUILTIN_MODELS`). mass: kg; None takes the model's default. Friction: lateral is a
-    Coulomb coefficient; rolling and spinning are resistance arms in metres (torque = arm *
-    normal force).
+    `models.BUILTIN_MODELS`). mass: kg; None takes the model's default. part_on_surface,
+    part_on_part: the contact materials of the part against the container's floor and walls
+    and against another part (materials.Contact; the physics applies exactly these pairs).
     """
 
     model: str = 'radial_capacitor'
     dimensions: Mapping[str, float] = field(default_factory=dict)
     mass: float | None = None
-    lateral_friction: float = 0.5
-    rolling_friction: float = 0.0001
-    spinning_friction: float = 0.0001
-    restitution: float = 0.0
+    part_on_surface: Contact = PART_ON_SURFACE
+    part_on_part: Contact = PART_ON_PART
     mesh_path: str = ''
     scale: float = 1.0
 
@@ -55,10 +50,10 @@ def geometry_key(spec: PartSpec) -> tuple:
 
 
 def check_material(spec: PartSpec, default_mass: float) -> float:
-    """Check the spec's friction and restitution against LIMITS; its mass, kg (the model's
-    `default_mass` when it gives none). Raises InvalidArgument naming the field."""
-    for name in ('lateral_friction', 'rolling_friction', 'spinning_friction', 'restitution'):
-        LIMITS[f'part.{name}'].check(f'part.{name}', getattr(spec, name))
+    """Check the spec's contact materials (their limits, and that the physics can apply
+    both pairs: materials.body_values); its mass, kg (the model's `default_mass` when it
+    gives none). Raises InvalidArgument naming the field."""
+    body_values(spec.part_on_surface, spec.part_on_part)
     if spec.mass is None:
         return default_mass
     return LIMITS['part.mass'].check('part.mass', spec.mass)
