@@ -21,7 +21,12 @@ TRAY_DEFAULT_SIZE = (0.195, 0.150, 0.027)
 LIMITS = {    # m
     'container.wall_thickness': Limit(0.0005, MAX_WALL),
     'container.floor_thickness': Limit(0.001, MAX_FLOOR),
+    'container.drop_height': Limit(0.0, 1.0),
 }
+# How high over the floor parts arrive from, by kind, m. Assumed: no maker's figure found for
+# either. A bin is filled by pouring from a box held about 100 mm over its floor; a flexible
+# feeder's hopper lip stands about 30 mm over the tray's plate.
+DROP_HEIGHT = {BIN: 0.1, TRAY: 0.03}
 PACKING_LIMIT = 0.4     # largest fraction of a container's inner volume parts may fill
 
 
@@ -32,6 +37,9 @@ class ContainerSpec:
     inner_size: inner length x, width y, wall height z, m.
     wall_thickness, floor_thickness: m. The floor is thick so that fast parts cannot tunnel.
     feeder_zone_center, feeder_zone_size: the tray's feeder drop zone on its floor (x, y), m.
+    drop_height: how high over the floor parts arrive from, m: the box a bin is poured from,
+    the lip of the hopper that feeds a tray (parts fall from there, or from just above the
+    pile where it stands higher); None takes the kind's DROP_HEIGHT.
     """
 
     kind: str = BIN
@@ -40,6 +48,7 @@ class ContainerSpec:
     floor_thickness: float = 0.01
     feeder_zone_center: tuple[float, float] = (0.0, 0.0)
     feeder_zone_size: tuple[float, float] = (0.0, 0.0)
+    drop_height: float | None = None
 
     @staticmethod
     def tray(inner_size: tuple[float, float, float] = TRAY_DEFAULT_SIZE) -> 'ContainerSpec':
@@ -50,6 +59,11 @@ class ContainerSpec:
                              feeder_zone_size=(x / 4, 0.8 * y))
 
 
+def drop_height(spec: ContainerSpec) -> float:
+    """How high over the floor parts arrive from, m (the spec's, or its kind's default)."""
+    return DROP_HEIGHT[spec.kind] if spec.drop_height is None else spec.drop_height
+
+
 def check_container(spec: ContainerSpec) -> ContainerSpec:
     """Check every field; raise InvalidArgument naming the first that is wrong."""
     if spec.kind not in KINDS:
@@ -58,6 +72,8 @@ def check_container(spec: ContainerSpec) -> ContainerSpec:
     LIMITS['container.wall_thickness'].check('container.wall_thickness', spec.wall_thickness)
     LIMITS['container.floor_thickness'].check('container.floor_thickness',
                                               spec.floor_thickness)
+    if spec.drop_height is not None:
+        LIMITS['container.drop_height'].check('container.drop_height', spec.drop_height)
     if spec.kind == TRAY:
         cx, cy = check_vector('container.feeder_zone_center', spec.feeder_zone_center, 2)
         sx, sy = check_vector('container.feeder_zone_size', spec.feeder_zone_size, 2,

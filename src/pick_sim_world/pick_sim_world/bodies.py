@@ -5,22 +5,34 @@ Every function takes the PyBullet client it works on; the World owns the client.
 """
 
 from collections.abc import Mapping, Sequence
+import hashlib
 import os
 
 import numpy as np
 from pick_common import containers
 from pick_common.containers import ContainerSpec
 from pick_common.parts.geometry import PartGeometry
-from pick_common.parts.primitives import Box, Cylinder
+from pick_common.parts.materials import BodyValues
+from pick_common.parts.primitives import Box, Cylinder, Hull
 from pick_common.states import quaternion_multiply, rotate
 import pybullet as pb
+from scipy.optimize import linprog
+from scipy.spatial import HalfspaceIntersection
 import trimesh
 
 from .config import GRAVITY, PhysicsConfig, solver_iterations
 
 INSTANCE_GAP = 0.05             # m between the outer walls of neighbouring instances
 TRAY_MASS = 3.0                 # kg; the tray is a dynamic body whose motion is prescribed
-CONTAINER_FRICTION = 0.5        # Coulomb coefficient of the bin and tray walls and floors
+# Bullet collides a convex hull grown by its collision margin, and pybullet gives every hull
+# of a compound 1 mm (URDF and shape importers' fixed default; changeDynamics' collisionMargin
+# sets only the compound's own, measured: a hull's bounds do not move), which made every mesh
+# part 2 mm larger in the physics than in the checks. Each hull is inset by the margin, so that
+# hull + margin is the part's surface again, its edges rounded by 1 mm; a piece thinner than
+# 2 mm can be inset only by INSET_SHARE of the largest ball inside it and stays swollen by the
+# rest (hull_swelling).
+HULL_MARGIN = 1e-3              # m, pybullet's margin of a compound's convex hull
+INSET_SHARE = 0.45              # of a piece's inner diameter: the most it is inset
 
 
 def instance_seed(seed: int, index: int) -> int:
@@ -45,11 +57,59 @@ def configure(client: int, physics: PhysicsConfig, kind: str) -> None:
         deterministicOverlappingPairs=1, physicsClientId=client)
 
 
+def hull_inset(vertices: np.ndarray, faces: np.ndarray) -> float:
+    """How far a hull is inset, m: HULL_MARGIN, or INSET_SHARE of the radius of the largest
+    ball inside it when that is less."""
+    return min(HULL_MARGIN, INSET_SHARE * 2.0 * _inner_ball(vertices, faces)[1])
+
+
+def hull_swelling(part: PartGeometry) -> float:
+    """How far the physics' surface of a part lies outside its geometry at most, m: 0 when
+    every hull is inset by the whole margin (and for boxes and cylinders, whose margins
+    Bullet keeps inside their extents)."""
+    return max((HULL_MARGIN - hull_inset(p.vertices, p.faces) for p in part.primitives
+                if isinstance(p, Hull)), default=0.0)
+
+
+def _planes(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The hull's face planes: unit outward normals (F, 3) and offsets (F,), n.x <= d inside;
+    faces of no area left out."""
+    mesh = trimesh.Trimesh(vertices, faces, process=False)
+    cross = mesh.triangles_cross
+    area = np.linalg.norm(cross, axis=1)
+    keep = area > 1e-12 * max(area.max(), 1e-300)
+    normals = cross[keep] / area[keep, None]
+    if mesh.volume < 0:          # faces wound inwards
+        normals = -normals
+    return normals, np.einsum('ij,ij->i', normals, mesh.triangles[keep, 0])
+
+
+def _inner_ball(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, float]:
+    """The centre (3,) and radius, m, of the largest ball inside the hull (its Chebyshev
+    centre: a linear programme over its face planes)."""
+    normals, offsets = _planes(vertices, faces)
+    # maximise r: n.c + r <= d for every face
+    rows = np.column_stack([normals, np.ones(len(normals))])
+    result = linprog(c=[0.0, 0.0, 0.0, -1.0], A_ub=rows, b_ub=offsets, bounds=[(None, None)] * 3 + [(0.0, None)], method='highs')
+    return result.x[:3], float(result.x[3])
+
+
+def inset_hull(vertices: np.ndarray, faces: np.ndarray, margin: float) -> np.ndarray:
+    """The vertices of the convex hull whose faces lie `margin` (m, less than the radius of
+    the largest ball inside it) inside those of the hull (vertices (K, 3), triangles faces),
+    so that Bullet's hull grown by `margin` is the hull."""
+    normals, offsets = _planes(vertices, faces)
+    inside = HalfspaceIntersection(np.column_stack([normals, -(offsets - margin)]),
+                                   _inner_ball(vertices, faces)[0])
+    return inside.intersections
+
+
 def create_part_shape(client: int, part: PartGeometry, directory: str) -> int:
-    """The part's collision compound as one PyBullet shape. Convex hulls are written as OBJ
-    files into `directory` (pybullet takes hull vertices only from a file, one hull each)."""
+    """The part's collision compound as one PyBullet shape. Convex hulls are inset by
+    hull_inset and written as OBJ files into `directory` (pybullet takes hull vertices only
+    from a file, one hull each)."""
     kinds, radii, lengths, halves, files, positions, orientations = [], [], [], [], [], [], []
-    for i, p in enumerate(part.primitives):
+    for p in part.primitives:
         radius = length = 0.0
         half = [0.0, 0.0, 0.0]
         path = ''
@@ -59,8 +119,13 @@ def create_part_shape(client: int, part: PartGeometry, directory: str) -> int:
             kind, radius, length = pb.GEOM_CYLINDER, p.radius, p.length
         else:
             kind = pb.GEOM_MESH
-            path = os.path.join(directory, f'hull_{i}.obj')
-            trimesh.Trimesh(p.vertices, p.faces, process=False).export(path)
+            hull = trimesh.convex.convex_hull(
+                inset_hull(p.vertices, p.faces, hull_inset(p.vertices, p.faces)))
+            # named by its content: pybullet keeps a file's mesh by its path for the life of
+            # the process, resets included, so a reused name would bring back an old part
+            digest = hashlib.sha256(hull.vertices.tobytes() + hull.faces.tobytes())
+            path = os.path.join(directory, f'hull_{digest.hexdigest()[:20]}.obj')
+            hull.export(path)
         kinds.append(kind)
         radii.append(radius)
         lengths.append(length)
@@ -74,9 +139,11 @@ def create_part_shape(client: int, part: PartGeometry, directory: str) -> int:
         collisionFrameOrientations=orientations, physicsClientId=client)
 
 
-def create_container(client: int, spec: ContainerSpec, origin: np.ndarray) -> int:
+def create_container(client: int, spec: ContainerSpec, origin: np.ndarray,
+                     surface: BodyValues) -> int:
     """The container's body at `origin` (world frame, m): a static bin, or a tray of TRAY_MASS
-    whose state tray.TrayDrive prescribes before every step (so parts feel its velocity)."""
+    whose state tray.TrayDrive prescribes before every step (so parts feel its velocity); its
+    coefficients `surface` (materials.body_values: with the part's, the file's pairs)."""
     boxes = containers.wall_boxes(spec)
     shape = pb.createCollisionShapeArray(
         [pb.GEOM_BOX] * len(boxes), halfExtents=[list(h) for h, _ in boxes],
@@ -84,21 +151,28 @@ def create_container(client: int, spec: ContainerSpec, origin: np.ndarray) -> in
     mass = 0.0 if spec.kind == containers.BIN else TRAY_MASS
     body = pb.createMultiBody(mass, shape, basePosition=origin.tolist(),
                               useMaximalCoordinates=True, physicsClientId=client)
-    pb.changeDynamics(body, -1, lateralFriction=CONTAINER_FRICTION, linearDamping=0.0,
-                      angularDamping=0.0, activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING,
-                      physicsClientId=client)
+    pb.changeDynamics(body, -1, linearDamping=0.0, angularDamping=0.0,
+                      activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING,
+                      physicsClientId=client, **_coefficients(surface))
     return body
 
 
-def create_part(client: int, shape: int, part: PartGeometry, pose: np.ndarray) -> int:
-    """A part body of `shape` at `pose` (7,) in the world frame, with the part's material.
+def _coefficients(values: BodyValues) -> dict[str, float]:
+    return {'lateralFriction': values.lateral_friction,
+            'rollingFriction': values.rolling_friction,
+            'spinningFriction': values.spinning_friction, 'restitution': values.restitution}
+
+
+def create_part(client: int, shape: int, part: PartGeometry, pose: np.ndarray,
+                values: BodyValues) -> int:
+    """A part body of `shape` at `pose` (7,) in the world frame, with the part's coefficients
+    `values` (materials.body_values).
 
     No continuous collision detection: Bullet sweeps only convex shapes
     (btDiscreteDynamicsWorld's createPredictiveContactsInternal and integrateTransformsInternal
     test isConvex()), and a part is a compound, so a swept sphere changed no pose (tested bit
     for bit, world README "Thrown parts"). Streamed drops keep falls short instead, and the
     world reports parts that tunnel or are thrown."""
-    spec = part.spec
     inertial = {}
     if part.mass_frame is not None:     # a mesh's own mass centre and principal axes
         centre, axes = part.mass_frame
@@ -107,10 +181,8 @@ def create_part(client: int, shape: int, part: PartGeometry, pose: np.ndarray) -
     body = pb.createMultiBody(part.mass, shape, basePosition=pose[:3].tolist(),
                               baseOrientation=pose[3:].tolist(), useMaximalCoordinates=True,
                               physicsClientId=client, **inertial)
-    pb.changeDynamics(
-        body, -1, lateralFriction=spec.lateral_friction, rollingFriction=spec.rolling_friction,
-        spinningFriction=spec.spinning_friction, restitution=spec.restitution,
-        activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING, physicsClientId=client)
+    pb.changeDynamics(body, -1, activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING,
+                      physicsClientId=client, **_coefficients(values))
     return body
 
 

@@ -57,11 +57,11 @@ def grid(part: PartGeometry, region: tuple[float, float, float, float],
     return int(span_x // (2.0 * r)) + 1, int(span_y // (2.0 * r)) + 1
 
 
-def layer_interval(part: PartGeometry) -> float:
-    """Simulated time between two spawn layers of a drop, s: the free fall of one layer's
-    height (a bounding-sphere diameter) plus a fifth of it again, so that each layer has landed
-    on the pile before the next one appears just above it."""
-    return 1.2 * math.sqrt(2.0 * 2.0 * (part.radius + SPAWN_GAP) / GRAVITY)
+def layer_interval(part: PartGeometry, fall: float = 0.0) -> float:
+    """Simulated time between two spawn layers of a drop, s: the free fall of `fall` (m, the
+    arrival height over the floor) and one layer's height (a bounding-sphere diameter), plus a
+    fifth of it again, so that each layer has landed before the next one appears."""
+    return 1.2 * math.sqrt(2.0 * (fall + 2.0 * (part.radius + SPAWN_GAP)) / GRAVITY)
 
 
 def check_count(count: int, held: dict[int, int], part: PartGeometry,
@@ -100,7 +100,8 @@ def spawn_poses(rng: np.random.Generator, part: PartGeometry,
     """Random, non-overlapping spawn poses (count, 7) in the instance frame.
 
     Parts spawn in layers of a grid of cells as wide as the part's bounding sphere, from `top`
-    (m, the highest point of the parts already there, 0 for none) up, each with a uniformly
+    (m, the arrival height over the floor, or the highest point of the parts already there
+    where that is higher) up, each with a uniformly
     random orientation. The grid is shifted at random within its slack and each layer takes a
     random subset of cells. No two spawn spheres overlap, so nothing is blown apart (the
     paper's first problem).

@@ -23,6 +23,7 @@ import numpy as np
 from pick_common import containers
 from pick_common.errors import check_number, InvalidArgument, PhysicsFault
 from pick_common.parts.geometry import build_part, PartGeometry
+from pick_common.parts.materials import body_values
 from pick_common.specs import CENTRE, check_scene, check_vibration, SceneSpec, Vibration
 from pick_common.states import PartStates, Progress, SettleReport
 import pybullet as pb
@@ -113,10 +114,12 @@ class World:
         shutil.rmtree(self._tmp, ignore_errors=True)
         os.makedirs(self._tmp)
         self._part_shape = bodies.create_part_shape(c, part, self._tmp)
+        self._part_values, surface = body_values(part.spec.part_on_surface,
+                                                 part.spec.part_on_part)
         pitch = bodies.instance_pitch(scene.container)
         for k in range(scene.instance_count):
             origin = np.array([k * pitch, 0.0, 0.0])
-            body = bodies.create_container(c, scene.container, origin)
+            body = bodies.create_container(c, scene.container, origin, surface)
             seed = bodies.instance_seed(scene.seed, k)
             self._instances.append(Instance(k, seed, origin, body, np.random.default_rng(seed)))
         self._drive = None
@@ -184,7 +187,9 @@ class World:
         already over the region (spawning.spawn_poses)."""
         region = self.drop_region(instance, zone)
         state = self.snapshot([instance])
-        top = spawning.pile_top(self._part, region, bodies.part_centres(state.poses, self._part))
+        top = max(spawning.pile_top(self._part, region,
+                                    bodies.part_centres(state.poses, self._part)),
+                  containers.drop_height(self._scene.container))
         return spawning.spawn_poses(self._instances[instance].rng, self._part, region, top,
                                     count, zone)
 
@@ -193,10 +198,10 @@ class World:
              progress: ProgressCallback | None = None) -> tuple[list[int], SettleReport]:
         """Drop `count` parts into each instance (or its feeder zone) as a stream, then settle.
 
-        The parts come one spawn layer at a time, each layer just above the parts already over
-        the region, the next one when it has landed (spawning.layer_interval): nothing falls
-        from higher than about a layer above the pile, as from a hopper's lip, never from a
-        tall column (which at 1/240 s sent parts through a 10 mm floor). Returns the new part
+        One spawn layer at a time from the container's drop height (containers.drop_height)
+        or just above the parts there where higher, the next when it has landed
+        (spawning.layer_interval), never a tall column (which at 1/240 s sent parts through a
+        10 mm floor). Returns the new part
         ids and the report of the whole operation. Raises InvalidArgument when the count is
         out of range or the parts do not fit, UnknownInstance for a bad instance id.
         """
@@ -218,7 +223,8 @@ class World:
                         left[k] -= n
                 if not any(left.values()):
                     break
-                stream.append(self._run('dropping', spawning.layer_interval(self._part),
+                stream.append(self._run('dropping', spawning.layer_interval(
+                    self._part, containers.drop_height(self._scene.container)),
                                         progress, stop_when_settled=False, freezer=freezer))
                 if stream[-1].canceled:
                     break
@@ -231,7 +237,8 @@ class World:
         self._at_rest = False
         for pose in poses:
             world_pose = np.concatenate([pose[:3] + inst.origin, pose[3:]])
-            body = bodies.create_part(self._client, self._part_shape, self._part, world_pose)
+            body = bodies.create_part(self._client, self._part_shape, self._part, world_pose,
+                                      self._part_values)
             pid = self._next_id
             self._next_id += 1
             self._bodies[pid] = body

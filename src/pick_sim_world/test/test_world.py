@@ -8,6 +8,7 @@ import numpy as np
 from pick_common import containers
 from pick_common.containers import ContainerSpec
 from pick_common.errors import InvalidArgument, PhysicsFault, UnknownInstance, UnknownPart
+from pick_common.parts.materials import arms, Contact
 from pick_common.parts.models import BUILTIN_MODELS
 from pick_common.parts.primitives import Hull
 from pick_common.parts.spec import PartSpec
@@ -227,14 +228,15 @@ def test_parts_settled_on_a_tray_stay_put():
 
 # The parts' rolling and spinning friction arms, m (see the next two tests fail with the
 # former 1 mm: PICK_TEST_FRICTION_ARM=0.001; and the second with 0).
-ARM = float(os.environ.get('PICK_TEST_FRICTION_ARM', PartSpec().rolling_friction))
+ARM = float(os.environ.get('PICK_TEST_FRICTION_ARM',
+                           PartSpec().part_on_surface.rolling_friction))
 
 
 def test_a_settled_pile_stays_put():
     """150 TO-220s settled in a 75 x 75 x 60 mm bin (seed 0): in a further second at most 5 %
     of them move more than the settle tolerance. With the former 1 mm friction arms 62 did,
     second after second (world README, "Piles that rest")."""
-    part = PartSpec(model='to220', rolling_friction=ARM, spinning_friction=ARM)
+    part = PartSpec(model='to220', **arms(ARM))
     scene = SceneSpec(ContainerSpec(inner_size=(0.075, 0.075, 0.06)), part, 1, 0)
     with World(scene, PhysicsConfig()) as world:
         movers = _movers_after_settling(world, 150)
@@ -246,7 +248,7 @@ def test_a_rolling_capacitor_rolls_on_and_stops_before_the_wall():
     stops, 71 mm away at the default arms. With no rolling resistance it reaches the wall
     140 mm away and still rolls 4 s later; with the former 1 mm arms it stopped within 3 mm,
     as if rolled into sand."""
-    part = PartSpec(rolling_friction=ARM, spinning_friction=ARM)
+    part = PartSpec(**arms(ARM))
     scene = SceneSpec(ContainerSpec(inner_size=(0.3, 0.3, 0.03)), part, 1, 2)
     with World(scene, PhysicsConfig()) as world:
         (pid,), _ = world.drop(1)
@@ -437,7 +439,9 @@ def test_picking_a_lone_part_from_a_resting_scene_skips_the_settle_and_loses_not
         _, report = world.remove([piled[0]])
         assert report.steps > 0
         # A scene left unsettled (a removal without a settle): even a lone part settles it.
-        world.remove([piled[1]], settle=False)
+        # (a part that still touches another: the one it touched may have been piled[0])
+        _, piled = _lone_and_piled(world)
+        world.remove([piled[0]], settle=False)
         _, report = world.remove([lone[1]])
         assert report.steps > 0
 
@@ -462,7 +466,8 @@ def test_instances_are_independent_with_their_own_frames_and_seeds():
 def test_time_cap_is_reported_when_hit():
     with _world(max_settle_time=10.0) as world:
         per_layer = np.prod(spawning.grid(world.part, world.drop_region(0, 'container')))
-        stream = (math.ceil(60 / per_layer) - 1) * spawning.layer_interval(world.part)
+        stream = (math.ceil(60 / per_layer) - 1) * spawning.layer_interval(
+            world.part, containers.drop_height(SMALL_BIN))
         _, report = world.drop(60, max_settle_time=0.25)
     # The cap is on the settle after the stream of spawn layers; the report covers both.
     assert stream > 0 and not report.settled
@@ -502,7 +507,8 @@ def test_nan_state_is_detected_and_the_scene_reset():
     (dict(part=PartSpec(dimensions={'body_diamter': 0.005})),
      'part.dimensions.body_diamter: 0.005 is not a dimension of radial_capacitor'),
     (dict(part=PartSpec(mass=math.nan)), 'part.mass: nan must be finite'),
-    (dict(part=PartSpec(lateral_friction=-1.0)), 'part.lateral_friction'),
+    (dict(part=PartSpec(part_on_part=Contact(-1.0, 1e-4, 1e-4, 0.3))),
+     'materials.part_on_part.lateral_friction'),
     (dict(instance_count=0), 'instance_count: 0 must be within'),
     (dict(seed=-1), 'seed'),
 ])
