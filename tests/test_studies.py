@@ -81,3 +81,13 @@ def test_feeder_decisions_tables_decisions_on_few_runs(runs, tmp_path):
         'feeder_pth0.yaml', 'feeder_pth1.yaml', 'feeder_pth2.yaml']
     for path in written:
         experiment_file.load(path)      # what it writes is a file a run reads
+
+
+def test_drop_tests_set_published_drops_beside_the_simulation(tmp_path):
+    picture = str(tmp_path / 'drops.png')
+    out = _study('studies.drop_tests', '--drops', '64', '--only', 'murray_thick', 'binom4',
+                 '--figure', picture)
+    assert 'murray_thick (' in out and 'binom4 (' in out and 'G-test p' in out, out
+    assert out.count('measured') >= 7 and 'quasi-static' in out
+    with open(picture, 'rb') as f:
+        assert f.read(8) == b'\x89PNG\r\n\x1a\n'

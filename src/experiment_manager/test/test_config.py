@@ -192,7 +192,7 @@ def test_a_reduced_copy_caps_iterations_and_keeps_the_rest(tmp_path):
     f = experiment_file.load(DEFAULT)
     small = experiment_file.parse(experiment_file.reduced(f, 1))
     # the sensitivity experiment caps its two repeats of `feeder` at 1 too
-    assert [e.iterations for e in small.experiments] == [1] * 8
+    assert [e.iterations for e in small.experiments] == [1] * 9
     assert small.experiment('sweep').counts == f.experiment('sweep').counts
     assert (small.part, small.gripper, small.grasps) == (f.part, f.gripper, f.grasps)
     with pytest.raises(InvalidArgument, match=r'max_iterations: 0 must be within \[1, '):

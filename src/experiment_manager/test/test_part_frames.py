@@ -47,8 +47,14 @@ def _valid_on_tray(setup: Setup, parts: int, seeds) -> np.ndarray:
                    PhysicsConfig()) as world:
             world.drop(parts)
             state = world.snapshot()
-            report = Validator(setup, world.part).check(ContainerSpec.tray(), state.ids,
-                                                        state.poses)
+            # the parts still in the tray, as a run checks them (the broken physics of the
+            # last case throws them out)
+            inside = state.inside
+            if not inside.any():
+                valid.append(0)
+                continue
+            report = Validator(setup, world.part).check(ContainerSpec.tray(), state.ids[inside],
+                                                        state.poses[inside])
         valid.append(report.counts['valid'])
     return np.array(valid, dtype=float)
 

@@ -90,7 +90,8 @@ def _inner_ball(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, fl
     normals, offsets = _planes(vertices, faces)
     # maximise r: n.c + r <= d for every face
     rows = np.column_stack([normals, np.ones(len(normals))])
-    result = linprog(c=[0.0, 0.0, 0.0, -1.0], A_ub=rows, b_ub=offsets, bounds=[(None, None)] * 3 + [(0.0, None)], method='highs')
+    result = linprog(c=[0.0, 0.0, 0.0, -1.0], A_ub=rows, b_ub=offsets,
+                     bounds=[(None, None)] * 3 + [(0.0, None)], method='highs')
     return result.x[:3], float(result.x[3])
 
 

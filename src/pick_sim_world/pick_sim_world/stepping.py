@@ -14,6 +14,7 @@ import math
 import time
 
 import numpy as np
+from pick_common import containers
 from pick_common.containers import ContainerSpec
 from pick_common.errors import PhysicsFault
 from pick_common.parts.geometry import PartGeometry
@@ -31,10 +32,12 @@ def speed_limit(container: ContainerSpec, part: PartGeometry,
                 tray_speed: float = 0.0) -> float:
     """The fastest gravity and the tray can move a part's centre, m/s: a free fall from the
     highest a part can be and still count as in its container (twice the walls' height,
-    containers.inside) plus a part's bounding diameter (where a drop's next layer spawns) to
-    the floor's underside, plus twice the tray's peak speed (a bounce off a moving wall). A
-    part faster than this got its energy from the solver (world README, "Thrown parts")."""
-    height = 2.0 * container.inner_size[2] + 2.0 * part.radius + container.floor_thickness
+    containers.inside) or the drop height parts arrive from, whichever is higher, plus a
+    part's bounding diameter (where a drop's next layer spawns) to the floor's underside, plus
+    twice the tray's peak speed (a bounce off a moving wall). A part faster than this got its
+    energy from the solver (world README, "Thrown parts")."""
+    height = (max(2.0 * container.inner_size[2], containers.drop_height(container))
+              + 2.0 * part.radius + container.floor_thickness)
     return math.sqrt(2.0 * GRAVITY * height) + 2.0 * tray_speed
 
 

@@ -80,7 +80,10 @@ def test_spawn_poses_do_not_overlap_and_respect_the_region():
 
 
 def test_480_capacitors_settle_in_the_paper_bin_without_escapes():
-    with _world(ContainerSpec(inner_size=(0.3, 0.3, 0.026)), seed=0) as world:
+    # from 30 mm: poured from the default 100 mm over the whole floor, 3 of 480 bounce over
+    # the 26 mm walls at restitution 0.3 (a spill, not a fault; none at 0.1)
+    with _world(ContainerSpec(inner_size=(0.3, 0.3, 0.026), drop_height=0.03),
+                seed=0) as world:
         _, report = world.drop(480)
     assert report.settled and report.escaped_ids == []
 
@@ -245,9 +248,10 @@ def test_a_settled_pile_stays_put():
 
 def test_a_rolling_capacitor_rolls_on_and_stops_before_the_wall():
     """A lying capacitor set rolling at 0.1 m/s across a 300 mm square bin rolls on and
-    stops, 71 mm away at the default arms. With no rolling resistance it reaches the wall
-    140 mm away and still rolls 4 s later; with the former 1 mm arms it stopped within 3 mm,
-    as if rolled into sand."""
+    stops, 18 mm away at the default 0.1 mm arm against the floor (71 mm when the floor's
+    coefficient halved every arm: materials.py). With no rolling resistance it reaches the
+    wall 140 mm away and still rolls 4 s later; with the former 1 mm arms it stopped within
+    3 mm, as if rolled into sand."""
     part = PartSpec(**arms(ARM))
     scene = SceneSpec(ContainerSpec(inner_size=(0.3, 0.3, 0.03)), part, 1, 2)
     with World(scene, PhysicsConfig()) as world:
@@ -265,7 +269,7 @@ def test_a_rolling_capacitor_rolls_on_and_stops_before_the_wall():
         report = world.settle(max_settle_time=4.0)
         end = world.snapshot().poses[0]
     travelled = np.linalg.norm(end[:2] - start[:2])
-    assert report.settled and 0.02 < travelled < 0.12, f'rolled {travelled * 1000:.0f} mm'
+    assert report.settled and 0.01 < travelled < 0.12, f'rolled {travelled * 1000:.0f} mm'
 
 
 def test_a_part_thrown_faster_than_gravity_and_the_tray_allow_is_a_fault():

@@ -17,6 +17,7 @@ from scipy import stats as scipy_stats
 from ..experiment_file import (
     BIN_EMPTYING,
     BIN_STATIC,
+    DROP_TEST,
     Experiment,
     ExperimentFile,
     GRIPPER_KEYS,
@@ -24,7 +25,7 @@ from ..experiment_file import (
     MM,
     TABLE_SWEEP,
 )
-from . import decisions
+from . import decisions, drop_tests
 from .summary import SCHEMA_VERSION
 
 # The physics faults an iteration is flagged with (procedures.faults); the first three leave it
@@ -352,6 +353,8 @@ def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: li
         out = table_sweep(file, exp, rows)
     elif exp.type == GRIPPER_SWEEP:
         out = gripper_sweep(exp, rows, checks)
+    elif exp.type == DROP_TEST:
+        out = drop_tests.summary(file, exp, rows)
     else:
         low_high = exp.optimal_range or (earlier or {})[exp.range_from]['optimal_range']
         out = feeder_emptying(file, exp, rows, low_high)

@@ -18,6 +18,7 @@ matplotlib.use('Agg')
 import matplotlib.pyplot as plt
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 import numpy as np
+from pick_common.parts.aspects import part_aspects
 from pick_common.parts.geometry import build_part
 from pick_common.parts.primitives import Hull
 from pick_common.parts.spec import states_units
@@ -69,6 +70,9 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
         lines.append(f'    made as: {part.collision_note}')
     else:
         lines.append(f'  collision: {len(part.primitives)} piece(s) (boxes and cylinders)')
+    lines.append("  aspects it can rest on (a drop test's `measured` names them; quasi-static "
+                 'share): ' + ', '.join(f'{a.name} {100 * a.quasi_static:.1f} %' for a in
+                                        part_aspects(part)))
     for g, fit, axis in zip(file.grasps, checks.grasp_fits, checks.free_axes, strict=True):
         what = fit.problem() or (f'closes on {fit.width * MM:.2f} mm of part '
                                  f'({-fit.span[0] * MM:.2f} and {fit.span[1] * MM:.2f} mm '

@@ -16,7 +16,7 @@ ITERATION_COLUMNS = (
     'container_z', 'parts', 'checked', 'outside', 'candidates', 'placeable', 'container_free',
     'valid', 'checks', 'picks', 'settled', 'unsettled', 'spilled', 'tunnelled', 'thrown',
     'max_penetration', 'max_speed', 'tray_error', 'emptied', 'vibrations', 'feeds', 'stop',
-    'fault', 'table_time', 'wall_time')
+    'fault', 'table_time', 'wall_time', 'aspect')
 CHECK_COLUMNS = (*KEY, 'check', 'parts_on_table', 'checked', 'outside', 'candidates',
                  'placeable', 'container_free', 'valid', 'picked_id', 'searches', 'vibrations',
                  'wall_time')
@@ -25,7 +25,7 @@ PICK_COLUMNS = (*KEY, 'pick', 'check', 'part_id', 'searches', 'vibrations', 'gra
                 *GRIPPER_POSE)
 FILES = {'iterations': ITERATION_COLUMNS, 'checks': CHECK_COLUMNS, 'parts': PART_COLUMNS,
          'picks': PICK_COLUMNS}
-TEXT = {'experiment', 'type', 'stop', 'fault'}
+TEXT = {'experiment', 'type', 'stop', 'fault', 'aspect'}
 FLOAT = {'container_x', 'container_y', 'container_z', 'max_penetration', 'max_speed',
          'tray_error', 'table_time', 'wall_time', *POSE, *GRIPPER_POSE}
 BOOL = {'settled', 'emptied', 'inside'}

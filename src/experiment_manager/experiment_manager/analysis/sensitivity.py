@@ -19,7 +19,7 @@ Pure: no rclpy, no files.
 from ..experiment_file import ExperimentFile
 from ..experiment_file.model import Experiment
 from ..experiment_file.scenarios import grid_levels, point_key
-from . import metrics
+from . import calibration, metrics
 from . import summary as summary_model
 from .verdicts import NOT_ANALYSED, UNDECIDED, verdicts
 from .wording import fmt
@@ -110,7 +110,24 @@ def summarise(file: ExperimentFile, exp: Experiment, summaries: dict) -> dict:
             'ranges': _ranges(base_said, scenarios),
             'robustness': _held_said(_robustness(exp, base_said, scenarios), held),
             **({'map': m} if (m := _map(exp, base_said, scenarios)) else {}),
+            **({'calibration': c} if (c := _calibrations(file, exp, base, summaries)) else {}),
             'faults': _faults(repeats), 'physics': _physics(repeats)}
+
+
+def _calibrations(file: ExperimentFile, exp: Experiment, base: dict, summaries: dict
+                  ) -> list[dict]:
+    """Each repeated drop test with measured counts fitted over the scenarios (and the
+    file's own values): calibration.calibrate."""
+    out = []
+    for e in exp.of:
+        measured = dict(file.experiment(e).measured)
+        if base[e]['type'] != 'drop_test' or not measured:
+            continue
+        points = [({x.name: x.base for x in exp.inputs}, calibration.counts_of(base[e]))]
+        points += [({**{x.name: x.base for x in exp.inputs}, **dict(sc.values)},
+                    calibration.counts_of(summaries[f'{e}@{sc.name}'])) for sc in exp.scenarios]
+        out.append(calibration.calibrate(e, measured, points))
+    return out
 
 
 def _map(exp: Experiment, base: dict, scenarios: list[dict]) -> dict | None:

@@ -15,75 +15,10 @@ import argparse
 import json
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import ConfigDict, Field
 
-SCHEMA_VERSION = 1
-VERDICT = Literal['FEASIBLE', 'NOT FEASIBLE', 'UNDECIDED']
-
-
-class _Record(BaseModel):
-    """A record of summary.json: no key besides its fields, read-only once made."""
-    model_config = ConfigDict(extra='forbid', frozen=True, populate_by_name=True)
-
-
-class Stats(_Record):
-    """A list of numbers as metrics.stats says it: None for an empty list."""
-    n: int
-    mean: float | None
-    min: float | None
-    max: float | None
-    std: float | None = Field(description='sample standard deviation (n - 1); 0 for one value')
-
-
-class Fractions(_Record):
-    """Per iteration, the share of the checked parts that passed each stage."""
-    candidates: Stats
-    placeable: Stats
-    container_free: Stats
-    valid: Stats
-
-
-class Flagged(_Record):
-    group: int
-    iteration: int
-    fault: str = Field(description="procedures.faults' names joined by '+'")
-    experiment: str | None = Field(None, description='a sensitivity summary: the repeat')
-
-
-class Faults(_Record):
-    """How many iterations each physics fault flagged; the first three leave an iteration out
-    of the figures."""
-    physics_fault: int
-    tunnelled: int
-    thrown: int
-    unsettled: int
-    flagged: list[Flagged]
-
-
-class Physics(_Record):
-    """The physics health of every iteration, left-out ones too."""
-    spilled: int
-    tunnelled: int
-    thrown: int
-    max_speed: float = Field(description='m/s')
-    unsettled: int
-    max_penetration: float = Field(description='m')
-    tray_error: float = Field(description='fraction of the commanded motion')
-
-
-class Sampling(_Record):
-    """An adaptive experiment's sampling (running/sampling.py)."""
-    mode: str
-    batch: int
-    batches: int
-    iterations_run: int
-    most: int
-    settled: bool
-    tied_bins: list[int] | None = None
-    tie: list[int] | None = None
-    tie_within: float | None = None
-    race_confidence: float | None = Field(None, description=(  # version 0: 99.9 % intervals
-        "one-sided confidence of the bound of a bin's difference from the leader"))
+from .migration import migrate, SCHEMA_VERSION
+from .records import _Record, Faults, Fractions, Physics, Sampling, Stats, VERDICT
 
 
 class GumbelFit(_Record):
@@ -288,6 +223,22 @@ class VerdictMap(_Record):
     verdicts: dict[str, list[list[str | None]]]
 
 
+class Point(_Record):
+    values: dict[str, float]
+    log_likelihood: float
+
+
+class Calibration(_Record):
+    """A drop test's measured counts fitted over a sensitivity's scenarios (calibration.py):
+    the likeliest inputs, each one's 95 % interval, the G-test p there, the file keys."""
+    experiment: str
+    best: dict[str, float]
+    intervals: dict[str, list[float]]
+    p: float
+    points: list[Point]
+    keys: list[str]
+
+
 class Sensitivity(_Experiment):
     type: Literal['sensitivity']
     of: list[str]
@@ -300,10 +251,41 @@ class Sensitivity(_Experiment):
     ranges: dict[str, list[ANSWER]]
     robustness: list[Robustness]
     map: VerdictMap | None = None
+    calibration: list[Calibration] | None = None
+
+
+class AspectCount(_Record):
+    """An aspect of a drop test: `normal` the unit outward normal, in the part file's frame,
+    of the face the part rests on; `difference`: the simulated share less the measured."""
+    name: str
+    normal: list[float]
+    count: int
+    share: float | None
+    ci95: list[float]
+    quasi_static: float
+    measured: int | None = None
+    measured_share: float | None = None
+    difference: float | None = None
+
+
+class Measured(_Record):
+    """A real drop test's counts against the simulated ones: the G-test's p."""
+    drops: int
+    p: float
+    agrees: bool
+
+
+class DropTest(_Experiment):
+    type: Literal['drop_test']
+    drops: int
+    height_mm: float
+    aspects: list[AspectCount]
+    other: int
+    measured: Measured | None = None
 
 
 Experiment = Annotated[BinStatic | BinEmptying | TableSweep | FeederEmptying | GripperSweep
-                       | Sensitivity, Field(discriminator='type')]
+                       | DropTest | Sensitivity, Field(discriminator='type')]
 
 
 class Requirements(_Record):
@@ -333,36 +315,6 @@ class Summary(_Record):
         """The file's last experiment of this type (the one a report shows), or None."""
         found = self.of_type(kind)
         return found[-1][1] if found else None
-
-
-def migrate(raw: dict) -> dict:
-    """A summary.json of any version as the current version's dict. Version 0 (no
-    `schema_version`): a feeder without its throughput gets an empty one; a time ground
-    decided on a lognormal keeps its verdict, bound and reason, not the lognormal's figures."""
-    version = raw.get('schema_version', 0)
-    if version > SCHEMA_VERSION:
-        raise ValueError(f'summary.json: schema_version {version} is newer than this reader '
-                         f'({SCHEMA_VERSION})')
-    if version == SCHEMA_VERSION:
-        return raw
-    out = {**raw, 'schema_version': SCHEMA_VERSION}
-    for group in ('experiments', 'repeats'):
-        if group in raw:
-            out[group] = {k: _migrate_experiment(v) for k, v in raw[group].items()}
-    return out
-
-
-def _migrate_experiment(s: dict) -> dict:
-    if s.get('type') != 'feeder_emptying':
-        return s
-    s = dict(s)
-    empty = {'n': 0, 'mean': None, 'min': None, 'max': None, 'std': None}
-    s.setdefault('parts_per_hour', empty)
-    s.setdefault('parts_per_hour_ci95', [None, None])
-    grounds = dict(s['decision'])
-    grounds['time'] = {k: v for k, v in grounds['time'].items() if k != 'lognormal'}
-    s['decision'] = grounds
-    return s
 
 
 def validate(raw: dict) -> Summary:

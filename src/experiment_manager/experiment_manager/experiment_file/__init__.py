@@ -15,6 +15,7 @@ from .model import (
     BIN_EMPTYING,
     BIN_STATIC,
     Cell,
+    DROP_TEST,
     Experiment,
     ExperimentFile,
     FEEDER_EMPTYING,
@@ -33,7 +34,7 @@ from .model import (
 from .schema import GRIPPER_KEYS
 
 __all__ = [
-    'ADAPTIVE', 'BIN_EMPTYING', 'BIN_STATIC', 'Cell', 'Experiment', 'ExperimentFile',
+    'ADAPTIVE', 'BIN_EMPTYING', 'BIN_STATIC', 'Cell', 'DROP_TEST', 'Experiment', 'ExperimentFile',
     'FEEDER_EMPTYING', 'FIXED', 'GRIPPER_KEYS', 'GRIPPER_SWEEP', 'GripperVariant', 'InvalidFile',
     'load', 'MAX_ITERATIONS', 'MM', 'parse', 'reduced', 'Requirements', 'Sampling', 'SEARCH_ORDERS',
     'SENSITIVITY', 'TABLE_SWEEP', 'TYPES',

@@ -12,7 +12,9 @@ from pick_validity.config import CheckConfig, GraspPose, Gripper, PlaceSpec, Set
 BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING, GRIPPER_SWEEP, SENSITIVITY = (
     'bin_static', 'bin_emptying', 'table_sweep', 'feeder_emptying', 'gripper_sweep',
     'sensitivity')
-TYPES = (BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING, GRIPPER_SWEEP, SENSITIVITY)
+DROP_TEST = 'drop_test'
+TYPES = (BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING, GRIPPER_SWEEP, DROP_TEST,
+         SENSITIVITY)
 SEARCH_ORDERS = ('top_first', 'random', 'id')
 FIXED, ADAPTIVE = 'fixed', 'adaptive'
 SAMPLING_MODES = (FIXED, ADAPTIVE)
@@ -23,6 +25,7 @@ MAX_VARIANTS = 64         # grippers x grasp sets of one gripper_sweep
 MAX_FILE_BYTES = 1_000_000
 ID_CHARS = set('abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-')
 MM, G, DEG = 1e-3, 1e-3, math.pi / 180.0   # the file's mm, g and degrees in SI
+DROP_PLATE = 12.0           # a drop test's plate, across, in part radii (a bounce stays on it)
 
 
 @dataclass(frozen=True)
@@ -149,6 +152,7 @@ class Experiment:
     scenarios: tuple[Scenario, ...] = ()
     scenario: Scenario | None = None
     grid: int = 0
+    measured: tuple[tuple[str, int], ...] = ()
 
     @property
     def sources(self) -> tuple[str, ...]:

@@ -16,6 +16,7 @@ from pick_common.specs import MAX_SEED
 from .model import (
     BIN_EMPTYING,
     BIN_STATIC,
+    DROP_TEST,
     Experiment,
     ExperimentFile,
     GRIPPER_SWEEP,
@@ -98,7 +99,7 @@ def plan(file: ExperimentFile, exp: Experiment, summary: dict) -> list[Unit]:
     if exp.type == BIN_STATIC:
         for b, container in enumerate(exp.bins):
             units += [unit(b, i, container, exp.parts) for i in range(exp.iterations)]
-    elif exp.type in (BIN_EMPTYING, GRIPPER_SWEEP):
+    elif exp.type in (BIN_EMPTYING, GRIPPER_SWEEP, DROP_TEST):
         container = exp.bin
         if exp.bin_from:
             best = summary[exp.bin_from]['best_bin']

@@ -32,6 +32,7 @@ from .model import (
     BIN_STATIC,
     Cell,
     DEG,
+    DROP_TEST,
     FEEDER_EMPTYING,
     FIXED,
     GRIPPER_SWEEP,
@@ -328,6 +329,15 @@ class GripperSweepKeys(ExperimentKeys):
     min_valid: Number(0.0, MAX_PARTS_PER_INSTANCE) = 1.0
 
 
+class DropTestKeys(ExperimentKeys):
+    """iterations: the drops, one part each, from height_mm over the plate, onto a plate of
+    the container's surface (its material: materials.part_on_surface); measured: the counts of
+    the user's own drop test by aspect name (run --check names the aspects)."""
+
+    height_mm: Number(0.0, 1000.0) = 100.0
+    measured: Annotated[dict[str, Int(0, 1_000_000)], BeforeValidator(mapping)] = {}
+
+
 class InputRange(Section):
     """One uncertain input of a sensitivity experiment: the range to try, in the key's units,
     and where the range comes from (a datasheet, a measurement, a colleague's guess: said)."""
@@ -366,7 +376,7 @@ class SensitivityKeys(ExperimentKeys):
 EXPERIMENTS: dict[str, type[ExperimentKeys]] = {
     BIN_STATIC: BinStaticKeys, BIN_EMPTYING: BinEmptyingKeys, TABLE_SWEEP: TableSweepKeys,
     FEEDER_EMPTYING: FeederEmptyingKeys, GRIPPER_SWEEP: GripperSweepKeys,
-    SENSITIVITY: SensitivityKeys}
+    DROP_TEST: DropTestKeys, SENSITIVITY: SensitivityKeys}
 
 
 def experiment_model(item: Any) -> type[Section]:

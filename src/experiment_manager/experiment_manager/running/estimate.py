@@ -20,6 +20,7 @@ import numpy as np
 from ..experiment_file import (
     BIN_EMPTYING,
     BIN_STATIC,
+    DROP_TEST,
     Experiment,
     FEEDER_EMPTYING,
     GRIPPER_SWEEP,
@@ -32,7 +33,7 @@ from ..experiment_file import (
 # 360 s over 11,760, emptying 42 s over 1,200, feeder runs 225 s over 1,200; gripper_sweep
 # from the small test file's run (0.1 s over 28 parts x 8 grippers).
 PRIOR = {TABLE_SWEEP: 0.0098, BIN_STATIC: 0.031, BIN_EMPTYING: 0.035, FEEDER_EMPTYING: 0.19,
-         GRIPPER_SWEEP: 0.00045}
+         GRIPPER_SWEEP: 0.00045, DROP_TEST: 0.031}     # a drop as a part of a static bin's
 
 
 def units(exp: Experiment, parts: float) -> float:

@@ -12,6 +12,7 @@ from feeder_controller.policy import NAMES as DECISION_NAMES
 from feeder_controller.policy import PICK, STOP_EMPTY, STOP_VIBRATION_LIMIT
 import numpy as np
 from pick_common.errors import PhysicsFault
+from pick_common.parts.aspects import classify, spec_aspects
 from pick_common.states import PartStates, SettleReport
 from pick_validity.results import Report, STAGE_NONE
 
@@ -20,6 +21,7 @@ from ..analysis.rows import GRIPPER_POSE, POSE, Record
 from ..experiment_file import (
     BIN_EMPTYING,
     BIN_STATIC,
+    DROP_TEST,
     ExperimentFile,
     FEEDER_EMPTYING,
     GRIPPER_SWEEP,
@@ -66,7 +68,7 @@ def run_unit(file: ExperimentFile, u: Unit, backend: Backend) -> Record:
     iteration = Iteration(file, u, backend)
     run = {BIN_STATIC: iteration.static, TABLE_SWEEP: iteration.static,
            BIN_EMPTYING: iteration.emptying, FEEDER_EMPTYING: iteration.feeder,
-           GRIPPER_SWEEP: iteration.grippers}
+           GRIPPER_SWEEP: iteration.grippers, DROP_TEST: iteration.drop_test}
     try:
         row = run[u.experiment.type]()
     except PhysicsFault as exc:    # its seed would fault again: marked, not run again
@@ -83,7 +85,7 @@ def run_unit(file: ExperimentFile, u: Unit, backend: Backend) -> Record:
                                          'container_free', 'valid')},
         'checks': len(record.checks), 'picks': len(record.picks),
         **row, 'fault': faults(row), 'table_time': iteration.table_time,
-        'wall_time': time.monotonic() - start}
+        'wall_time': time.monotonic() - start, 'aspect': row.get('aspect', '')}
     return record
 
 
@@ -171,6 +173,17 @@ class Iteration:
         self.reports.append(settle)
         self.check(states, neighbours=self.u.experiment.type == TABLE_SWEEP)
         return {**self.health(), 'emptied': False, 'vibrations': 0, 'feeds': 0, 'stop': ''}
+
+    def drop_test(self) -> dict:
+        """drop_test: one part dropped from the plate's drop height, at rest, checked (all four
+        stages, as it landed); the aspect it rests on (pick_common.parts.aspects)."""
+        states, settle = self.backend.drop(1, 'container')
+        self.reports.append(settle)
+        self.check(states, neighbours=False)
+        inside = states.poses[states.inside]
+        aspect = classify(spec_aspects(self.file.part), inside[:, 3:])[0] if len(inside) else ''
+        return {**self.health(), 'emptied': False, 'vibrations': 0, 'feeds': 0, 'stop': '',
+                'aspect': aspect}
 
     def grippers(self) -> dict:
         """gripper_sweep: drop and settle one scene, then check it (all four stages) with each

@@ -63,6 +63,7 @@ from ..analysis import decisions, metrics
 from ..experiment_file import (
     BIN_EMPTYING,
     BIN_STATIC,
+    DROP_TEST,
     Experiment,
     ExperimentFile,
     FEEDER_EMPTYING,
@@ -94,6 +95,8 @@ def ended(file: ExperimentFile, exp: Experiment, rows: list[dict],
     if out and exp.type in (BIN_EMPTYING, FEEDER_EMPTYING):
         return [], []       # a left-out iteration makes the option NOT FEASIBLE: settled
     kept = [r for r in rows if (r['group'], r['iteration']) not in out]
+    if exp.type == DROP_TEST:
+        return groups(exp), []      # no decision: every drop asked for is made
     if exp.type == BIN_STATIC:
         return race(exp, kept)
     if exp.type == TABLE_SWEEP:

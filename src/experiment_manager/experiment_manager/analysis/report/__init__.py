@@ -20,6 +20,7 @@ from .. import summary as summary_model
 from ..results import read_csv
 from .base import Run, Section
 from .bins import BinEmptying, StaticBins
+from .drop_tests import DropTests
 from .grippers import Grippers
 from .health import Health
 from .page import to_html, VERDICT_CLASS
@@ -33,7 +34,8 @@ from .table import Feeder, Sweep
 from .verdict import Head
 
 SECTIONS: tuple[Section, ...] = (Head(), Part(), Sampling(), StaticBins(), BinEmptying(),
-                                 Sweep(), Feeder(), Grippers(), Sensitivity(), AgainstPaper(),
+                                 Sweep(), Feeder(), Grippers(), DropTests(), Sensitivity(),
+                                 AgainstPaper(),
                                  Health(), Pictures(), TurnedDown())
 
 __all__ = ['markdown', 'plot_tornado', 'Run', 'SECTIONS', 'to_html', 'tornado_bars',

@@ -27,6 +27,7 @@ class Health(Section):
              'fastest part (m/s)', 'worst tray tracking error'],
             rows) + ['', 'Tunnelled: a part ended in or under the floor or in a wall, which '
                      'solid bodies cannot do; thrown: a part moved faster than a fall from '
-                     "twice the walls' height plus a bounce off the tray can make it, so the "
-                     'solver gave it energy; spilled: a part went over a wall. Each flagged '
-                     'iteration has its fault in the `fault` column of `iterations.csv`.']
+                     "twice the walls' height or its drop height plus a bounce off the tray can "
+                     'make it, so the solver gave it energy; spilled: a part went over a wall. '
+                     'Each flagged iteration has its fault in the `fault` column of '
+                     '`iterations.csv`.']

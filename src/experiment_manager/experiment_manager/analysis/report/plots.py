@@ -27,7 +27,35 @@ def draw_all(summary: Summary, path) -> dict[str, bool]:
     for exp_id, s in summary.of_type('sensitivity'):
         figures[f'sensitivity_{exp_id}'] = plot_tornado(exp_id, s,
                                                         path(f'sensitivity_{exp_id}.png'))
+    for exp_id, s in summary.of_type('drop_test'):
+        figures[f'drop_{exp_id}'] = plot_drop_test(exp_id, s, path(f'drop_{exp_id}.png'))
     return figures
+
+
+def plot_drop_test(exp_id: str, s, path: str) -> bool:
+    """A drop test's shares per aspect: simulated (with its 95 % interval), quasi-static and
+    measured, side by side."""
+    if not s.drops:
+        return False
+    names = [a.name for a in s.aspects]
+    x = np.arange(len(names))
+    series = [('simulated', [a.share or 0.0 for a in s.aspects]),
+              ('quasi-static', [a.quasi_static for a in s.aspects])]
+    if s.measured is not None:
+        series.append(('measured', [a.measured_share or 0.0 for a in s.aspects]))
+    width = 0.8 / len(series)
+    fig, ax = plt.subplots(figsize=FIGSIZE)
+    for k, (label, values) in enumerate(series):
+        ax.bar(x + (k - (len(series) - 1) / 2) * width, values, width, label=label)
+    low = [a.share - a.ci95[0] if a.share is not None else 0.0 for a in s.aspects]
+    high = [a.ci95[1] - a.share if a.share is not None else 0.0 for a in s.aspects]
+    ax.errorbar(x - (len(series) - 1) / 2 * width, [a.share or 0.0 for a in s.aspects],
+                yerr=[low, high], fmt='none', ecolor='black', capsize=3)
+    ax.set_xticks(x, names)
+    ax.set_ylim(0, 1)
+    _finish(fig, ax, path, f'{exp_id}: resting aspects of {s.drops} drops from '
+            f'{s.height_mm:g} mm', 'aspect: the face the part rests on', 'share of drops')
+    return True
 
 
 def plot_bins(summary: Summary, path: str) -> bool:

@@ -63,4 +63,13 @@ def section(exp_id: str, s: SensitivitySummary, plotted: bool) -> list[str]:
               + '; '.join(f'{ANSWERS[k][0]}' + (f', {ANSWERS[k][1]}' if ANSWERS[k][1] else '')
                           for k in keys) + ') and verdicts:', '']
     lines += table(['scenario', 'inputs set'] + [ANSWERS[k][0] for k in keys] + options, rows)
+    for c in s.calibration or ():
+        lines += ['', f'**Calibrated on `{c.experiment}`\'s measured counts**: the likeliest '
+                  f'of the {len(c.points)} scenarios (G-test p there {c.p:.3g}; '
+                  + ('the simulation agrees' if c.p >= 0.05 else 'even the likeliest '
+                     'disagrees: the ranges may not hold the value, or the physics cannot '
+                     'make the measured shares') + "), each input's 95 % interval the "
+                  'scenarios within 1.92 of its log likelihood (no finer than the grid). '
+                  'File keys to paste (the interval as a sensitivity range):', '', '```']
+        lines += c.keys + ['```']
     return lines

@@ -1,0 +1,64 @@
+"""A drop test calibrated: the inputs of a sensitivity experiment's scenarios (a grid over the
+contact materials, say) fitted to the user's own measured counts by likelihood.
+
+Each scenario's repeat of the drop test gives the simulated counts of each aspect; the
+measured counts' multinomial log likelihood under the scenario's shares (each count plus
+SMOOTH, so that an aspect the simulation never showed is unlikely, not impossible) ranks the
+scenarios. The fit is the likeliest; an input's 95 % interval spans the scenarios within
+CHI2_HALF of it in log likelihood (the profile likelihood's chi-square(1) rule, at the grid's
+resolution: the interval is no finer than the grid). Pure: no rclpy.
+"""
+
+import math
+
+from pick_common.parts.aspects import agreement
+
+SMOOTH = 0.5            # added to every simulated count
+CHI2_HALF = 1.920729    # half the 95 % quantile of chi-square with one degree of freedom
+
+
+def log_likelihood(measured: dict[str, int], simulated: dict[str, int]) -> float:
+    """The measured counts' multinomial log likelihood (up to a constant) under the simulated
+    shares, smoothed."""
+    names = set(measured) | set(simulated)
+    total = sum(simulated.values()) + SMOOTH * len(names)
+    return sum(m * math.log((simulated.get(n, 0) + SMOOTH) / total)
+               for n, m in measured.items() if m)
+
+
+def counts_of(drop_summary: dict) -> dict[str, int]:
+    """A drop test's summary's counts by aspect."""
+    return {a['name']: a['count'] for a in drop_summary['aspects']}
+
+
+def calibrate(experiment: str, measured: dict[str, int],
+              points: list[tuple[dict[str, float], dict[str, int]]]) -> dict:
+    """The fit of `points` ((input values, simulated counts) per scenario) to `measured`: the
+    likeliest values, each input's 95 % interval, the G-test p there, every point's log
+    likelihood, and the file keys to paste (file_keys)."""
+    scored = [(log_likelihood(measured, counts), values, counts) for values, counts in points]
+    best_ll, best, best_counts = max(scored, key=lambda s: s[0])
+    near = [values for ll, values, _ in scored if ll >= best_ll - CHI2_HALF]
+    intervals = {name: [min(v[name] for v in near), max(v[name] for v in near)]
+                 for name in best}
+    return {'experiment': experiment, 'best': best, 'intervals': intervals,
+            'p': agreement(best_counts, measured),
+            'points': [{'values': v, 'log_likelihood': ll} for ll, v, _ in scored],
+            'keys': file_keys({name: (best[name], *intervals[name]) for name in best})}
+
+
+def file_keys(values: dict[str, tuple[float, float, float]]) -> list[str]:
+    """YAML lines that set each dotted key (an input's name: its file key) to its value,
+    nested as the file nests them, the interval in a comment: {name: (value, low, high)}."""
+    lines: list[str] = []
+    open_path: list[str] = []
+    for name, (value, low, high) in sorted(values.items()):
+        *path, key = name.split('.')
+        common = 0
+        while common < min(len(path), len(open_path)) and path[common] == open_path[common]:
+            common += 1
+        for depth in range(common, len(path)):
+            lines.append('  ' * depth + f'{path[depth]}:')
+        open_path = path
+        lines.append('  ' * len(path) + f'{key}: {value:.4g}    # 95 %: {low:.4g} to {high:.4g}')
+    return lines

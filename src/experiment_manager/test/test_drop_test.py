@@ -1,0 +1,105 @@
+"""The drop_test experiment: single parts dropped onto a plate, the aspects they rest on
+against the quasi-static prediction and a real drop test's counts, and a sensitivity grid that
+calibrates the materials on those counts; and the file's contact materials as pairs."""
+
+import os
+
+from experiment_manager import experiment_file
+from experiment_manager.analysis import report
+from experiment_manager.analysis.calibration import calibrate, file_keys, log_likelihood
+from experiment_manager.analysis.results import read_csv, ResultsWriter
+from experiment_manager.running.local_backend import LocalBackend
+from experiment_manager.running.scheduler import Runner
+from pick_common.errors import InvalidArgument
+import pytest
+
+FILE = """id: drops
+seed: 3
+part: {model: to220}
+experiments:
+  - {id: drop, type: drop_test, iterations: 30, height_mm: 80,
+     measured: {'+y': 11, '-y': 12, '+x': 3, '-x': 4}}
+"""
+
+
+def _run(text: str, directory: str) -> dict:
+    file = experiment_file.parse(text)
+    with LocalBackend() as backend, ResultsWriter(directory, file.text) as writer:
+        return Runner(file, [backend], writer).run()
+
+
+def test_a_drop_test_counts_the_aspects_its_parts_rest_on_beside_the_measured(tmp_path):
+    summary = _run(FILE, str(tmp_path))
+    s = summary['experiments']['drop']
+    assert s['height_mm'] == 80.0 and s['drops'] + s['other'] == 30
+    names = [a['name'] for a in s['aspects']]
+    assert names[:2] == ['+y', '-y']        # a TO-220 lies on its broad faces most often
+    counts = {a['name']: a['count'] for a in s['aspects']}
+    for a in s['aspects']:
+        assert a['ci95'][0] <= a['share'] <= a['ci95'][1]
+        assert a['measured'] == {'+y': 11, '-y': 12, '+x': 3, '-x': 4}.get(a['name'])
+    assert sum(counts.values()) == s['drops']
+    assert s['measured']['drops'] == 30 and 0.0 <= s['measured']['p'] <= 1.0
+    # each iteration's row names the aspect its part came to rest on
+    rows = read_csv(os.path.join(str(tmp_path), 'iterations.csv'))
+    assert sorted(r['aspect'] for r in rows if r['aspect'] != 'other') == sorted(
+        name for name, k in counts.items() for _ in range(k))
+    report.write(str(tmp_path))
+    text = open(os.path.join(str(tmp_path), 'report.md'), encoding='utf-8').read()
+    assert '## Drop test (`drop`)' in text and 'G-test p' in text
+    assert os.path.exists(os.path.join(str(tmp_path), 'drop_drop.png'))
+
+
+def test_measured_counts_must_name_the_part_s_aspects():
+    with pytest.raises(InvalidArgument) as err:
+        experiment_file.parse(FILE.replace("'+x': 3", "'top': 3"))
+    assert err.value.field == 'experiments[0].measured.top'
+    assert "+y" in err.value.rule and '-x' in err.value.rule
+
+
+def test_calibration_picks_the_scenario_whose_shares_made_the_counts():
+    made = {'a': 60, 'b': 30, 'c': 10}
+    points = [({'e': 0.1}, {'a': 20, 'b': 40, 'c': 40}), ({'e': 0.3}, {'a': 58, 'b': 32, 'c': 10}),
+              ({'e': 0.5}, {'a': 62, 'b': 28, 'c': 10}), ({'e': 0.7}, {'a': 90, 'b': 10, 'c': 0})]
+    fit = calibrate('drop', made, points)
+    assert fit['best'] == {'e': 0.3} or fit['best'] == {'e': 0.5}
+    # the far scenarios lie outside the interval; the two alike ones inside it
+    assert fit['intervals']['e'] == [0.3, 0.5]
+    assert log_likelihood(made, points[3][1]) > float('-inf')     # smoothed: 0 counts allowed
+    assert fit['p'] > 0.5
+
+
+def test_file_keys_nest_as_the_file_does():
+    assert file_keys({'materials.part_on_surface.restitution': (0.2, 0.1, 0.3),
+                      'materials.part_on_surface.lateral_friction': (0.4, 0.3, 0.5)}) == [
+        'materials:', '  part_on_surface:',
+        '    lateral_friction: 0.4    # 95 %: 0.3 to 0.5',
+        '    restitution: 0.2    # 95 %: 0.1 to 0.3']
+
+
+def test_a_sensitivity_grid_over_a_measured_drop_test_calibrates_it(tmp_path):
+    text = FILE + """  - id: fit
+    type: sensitivity
+    of: [drop]
+    iterations: 30
+    grid: 2
+    inputs:
+      materials.part_on_surface.restitution: {low: 0.1, high: 0.6, source: to fit}
+"""
+    summary = _run(text, str(tmp_path))
+    (fit,) = summary['experiments']['fit']['calibration']
+    values = [p['values']['materials.part_on_surface.restitution'] for p in fit['points']]
+    assert sorted(values) == [0.1, 0.3, 0.6]     # the file's 0.3 and the grid's ends
+    low, high = fit['intervals']['materials.part_on_surface.restitution']
+    assert low <= fit['best']['materials.part_on_surface.restitution'] <= high
+    assert fit['keys'][:2] == ['materials:', '  part_on_surface:']
+
+
+@pytest.mark.parametrize('key', ['lateral_friction', 'restitution', 'rolling_friction_mm'])
+def test_a_part_s_former_material_key_is_refused_naming_the_pairs(key):
+    with pytest.raises(InvalidArgument) as err:
+        experiment_file.parse(FILE.replace('part: {model: to220}',
+                                           f'part: {{model: to220, {key}: 0.3}}'))
+    assert err.value.field == f'part.{key}'
+    assert f'materials.part_on_surface.{key}' in err.value.rule
+    assert f'materials.part_on_part.{key}' in err.value.rule
