@@ -54,7 +54,7 @@ def test_measured_counts_must_name_the_part_s_aspects():
     with pytest.raises(InvalidArgument) as err:
         experiment_file.parse(FILE.replace("'+x': 3", "'top': 3"))
     assert err.value.field == 'experiments[0].measured.top'
-    assert "+y" in err.value.rule and '-x' in err.value.rule
+    assert '+y' in err.value.rule and '-x' in err.value.rule
 
 
 def test_calibration_picks_the_scenario_whose_shares_made_the_counts():

@@ -64,7 +64,7 @@ def section(exp_id: str, s: SensitivitySummary, plotted: bool) -> list[str]:
                           for k in keys) + ') and verdicts:', '']
     lines += table(['scenario', 'inputs set'] + [ANSWERS[k][0] for k in keys] + options, rows)
     for c in s.calibration or ():
-        lines += ['', f'**Calibrated on `{c.experiment}`\'s measured counts**: the likeliest '
+        lines += ['', f"**Calibrated on `{c.experiment}`'s measured counts**: the likeliest "
                   f'of the {len(c.points)} scenarios (G-test p there {c.p:.3g}; '
                   + ('the simulation agrees' if c.p >= 0.05 else 'even the likeliest '
                      'disagrees: the ranges may not hold the value, or the physics cannot '
