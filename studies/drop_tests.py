@@ -12,8 +12,8 @@ Data sets (each with its source; see docs/drop-tests.md):
 - dice_3pct: a 16 mm die (size assumed) one axis 3 % short: each of its two large faces about
   0.177 (same group, 6th Experimental Chaos Conference, 2001; share);
 - binom3, binom4: Baktash et al.'s 3D-printed polyhedra (SIGGRAPH 2025, data MIT-licensed in
-  src/experiment_manager/config/parts/resting_rigid_bodies), with counts; printed size and material assumed (40 mm
-  longest, PLA).
+  src/experiment_manager/config/parts/resting_rigid_bodies), with counts; printed size and
+  material assumed (40 mm longest, PLA).
 Each is dropped `--drops` times from `--height-mm` (the sources do not say from how high) with
 a uniformly random orientation, one part per bin, 64 bins side by side in one world, and left
 to rest. --calibrate fits the restitution against the floor on murray_thick (a grid of 0.1 to
