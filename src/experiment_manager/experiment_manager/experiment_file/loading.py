@@ -18,10 +18,8 @@ import os
 from typing import Any
 
 from feeder_controller.policy import check_feeder, FeederConfig
-import numpy as np
 from pick_common.containers import check_container, check_fits, ContainerSpec
 from pick_common.errors import check_int, check_number, InvalidArgument
-from pick_common.parts.aspects import part_aspects
 from pick_common.parts.geometry import PartGeometry
 from pick_common.specs import Vibration
 from pick_validity.config import (
@@ -37,6 +35,7 @@ import yaml
 from . import part as part_section
 from . import scenarios as scenario_inputs
 from . import schema, sections
+from .drop_test import drop_test
 from .errors import checked as checked_as
 from .errors import read as read_keys
 from .model import (
@@ -44,7 +43,6 @@ from .model import (
     BIN_EMPTYING,
     BIN_STATIC,
     Cell,
-    DROP_PLATE,
     DROP_TEST,
     Experiment,
     ExperimentFile,
@@ -223,24 +221,6 @@ def _sensitivity(e: schema.SensitivityKeys, where: str, c: _Context) -> list[Exp
                                  grid=e.grid)]
 
 
-def _drop_test(e: schema.DropTestKeys, where: str, c: _Context) -> dict[str, Any]:
-    """A drop test's plate (a bin DROP_PLATE part radii wide, its walls only there to keep a
-    bouncing part, from its drop height) and its measured counts, each aspect name one of
-    the part's."""
-    width = DROP_PLATE * (c.geometry.radius + float(np.linalg.norm(c.geometry.center)))
-    plate = ContainerSpec(inner_size=(width, width, 0.02), wall_thickness=c.bin_wall,
-                          drop_height=MM * e.height_mm)
-    checked_as(check_container, plate, f'{where}.height_mm')
-    if e.measured:
-        names = [a.name for a in part_aspects(c.geometry)]
-        for name in e.measured:
-            if name not in names:
-                raise InvalidArgument(f'{where}.measured.{name}', e.measured[name],
-                                      f'is not an aspect of the part (its aspects: '
-                                      f'{", ".join(names)})')
-    return {'parts': 1, 'bin': plate, 'measured': tuple(e.measured.items())}
-
-
 def _experiment(e: schema.ExperimentKeys, where: str, c: _Context) -> list[Experiment]:
     """The experiment read at `where` (with, for a sensitivity experiment, its repeats)."""
     if e.id in c.earlier:
@@ -250,7 +230,7 @@ def _experiment(e: schema.ExperimentKeys, where: str, c: _Context) -> list[Exper
     volume, tray = c.geometry.volume, c.tray
     out: dict[str, Any] = {'id': e.id, 'type': e.type, 'iterations': e.iterations}
     if e.type == DROP_TEST:
-        return [Experiment(**out, **_drop_test(e, where, c))]
+        return [Experiment(**out, **drop_test(e, where, c.geometry, c.bin_wall))]
     if e.type != TABLE_SWEEP:
         out['parts'] = e.parts
     if e.type == BIN_STATIC:
