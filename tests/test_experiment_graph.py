@@ -270,6 +270,36 @@ def test_a_sensitivity_run_through_the_graph_gives_the_cores_answers_and_records
     assert json.loads(attached['summary.json'])['experiments']['robust'] == robust
 
 
+DROPS = """id: drops
+seed: 3
+part: {model: to220}
+hopper_lip_mm: 30
+experiments:
+  - {id: drop, type: drop_test, iterations: 12, height_mm: 80,
+     measured: {'+y': 5, '-y': 5, '+x': 1, '-x': 1}}
+"""
+
+
+def test_a_drop_test_through_the_graph_gives_the_cores_aspects(tmp_path, private_ros_domain):
+    """A drop test on two workers: the world drops each part from the plate's height (which
+    reaches it in ContainerGeometry) and the rows, aspects and G-test are the cores'."""
+    path = tmp_path / 'drops.yaml'
+    path.write_text(DROPS)
+    done = run_command(str(path), '--output', str(tmp_path / 'out'), '--namespace',
+                       unique_namespace('drops'), '--workers', '2')
+    assert done.returncode == 0, done.stderr
+    run_dir = re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1)
+    file = experiment_file.load(str(path))
+    cores = str(tmp_path / 'cores')
+    with LocalBackend() as backend, ResultsWriter(cores, file.text) as writer:
+        expected = Runner(file, [backend], writer).run()
+    assert rows(run_dir, 'iterations') == rows(cores, 'iterations')
+    with open(os.path.join(run_dir, 'summary.json')) as f:
+        got = json.load(f)['experiments']['drop']
+    assert got == expected['experiments']['drop'] and got['drops'] + got['other'] == 12
+    assert '## Drop test (`drop`)' in open(os.path.join(run_dir, 'report.md')).read()
+
+
 def start_replay(client, recording: str, name: str, rate: str) -> tuple[subprocess.Popen, list]:
     """`replay` of worker_0's results at `rate` under the prefix `name` (one per test: no test
     hears another's replay), and the list that receives what it publishes. The replay waits

@@ -1,4 +1,5 @@
 from glob import glob
+import os
 
 from setuptools import find_packages, setup
 
@@ -15,7 +16,10 @@ setup(
         # the paper's test case, so that an installed workspace can run it by its share path
         ('share/' + package_name + '/config/test_case', sorted(glob('config/test_case/*.yaml'))),
         # parts from real CAD files, with their source and licence
-        ('share/' + package_name + '/config/parts', sorted(glob('config/parts/*'))),
+        ('share/' + package_name + '/config/parts',
+         sorted(p for p in glob('config/parts/*') if os.path.isfile(p))),
+        ('share/' + package_name + '/config/parts/resting_rigid_bodies',
+         sorted(glob('config/parts/resting_rigid_bodies/*'))),
         ('share/' + package_name + '/launch', ['launch/experiment_launch.py']),
         # the Foxglove layout for recordings of a run in the root namespace (README)
         ('share/' + package_name + '/foxglove', ['foxglove/pick_sim_layout.json']),

@@ -6,7 +6,9 @@ import os
 
 from experiment_manager import experiment_file
 from experiment_manager.analysis import report
+from experiment_manager.analysis import summary as summary_model
 from experiment_manager.analysis.calibration import calibrate, file_keys, log_likelihood
+from experiment_manager.analysis.headlines import headlines
 from experiment_manager.analysis.results import read_csv, ResultsWriter
 from experiment_manager.running.local_backend import LocalBackend
 from experiment_manager.running.scheduler import Runner
@@ -48,6 +50,9 @@ def test_a_drop_test_counts_the_aspects_its_parts_rest_on_beside_the_measured(tm
     text = open(os.path.join(str(tmp_path), 'report.md'), encoding='utf-8').read()
     assert '## Drop test (`drop`)' in text and 'G-test p' in text
     assert os.path.exists(os.path.join(str(tmp_path), 'drop_drop.png'))
+    (line,) = headlines(summary_model.validate(summary))
+    assert line.startswith(f'  drop (drop_test): {s["drops"]} drops at rest on +y ')
+    assert 'against 30 measured: G-test p' in line
 
 
 def test_measured_counts_must_name_the_part_s_aspects():
@@ -93,6 +98,9 @@ def test_a_sensitivity_grid_over_a_measured_drop_test_calibrates_it(tmp_path):
     low, high = fit['intervals']['materials.part_on_surface.restitution']
     assert low <= fit['best']['materials.part_on_surface.restitution'] <= high
     assert fit['keys'][:2] == ['materials:', '  part_on_surface:']
+    printed = headlines(summary_model.validate(summary))
+    assert '    calibrated on drop (G-test p' in '\n'.join(printed)
+    assert printed[-1].startswith('          restitution: ')
 
 
 @pytest.mark.parametrize('key', ['lateral_friction', 'restitution', 'rolling_friction_mm'])

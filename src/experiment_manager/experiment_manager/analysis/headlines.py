@@ -29,10 +29,22 @@ def headlines(summary: Summary) -> list[str]:
                 f'smallest meeting {s.min_valid:g} valid per check: '
                 f'{gripper_label(s.variants[found])}' if found is not None else
                 f'no gripper of {len(s.variants)} meets {s.min_valid:g} valid per check'))
+        elif kind == 'drop_test':
+            lines.append(f'  {exp_id} (drop_test): {s.drops} drops at rest on '
+                         + ', '.join(f'{a.name} {100 * (a.share or 0):.1f} %'
+                                     for a in s.aspects if a.count)
+                         + (f'; against {s.measured.drops} measured: G-test p '
+                            f'{s.measured.p:.3g}, '
+                            + ('agrees' if s.measured.agrees else 'disagrees')
+                            if s.measured is not None else ''))
         elif kind == 'sensitivity':
             lines.append(f'  {exp_id} (sensitivity): {len(s.scenarios)} scenarios over '
                          + ', '.join(x.name for x in s.inputs) + ':')
             lines += [f'    {r.line}' for r in s.robustness]
+            for c in s.calibration or ():
+                lines.append(f'    calibrated on {c.experiment} (G-test p {c.p:.3g} there); '
+                             'the file keys, with 95 % intervals:')
+                lines += [f'      {k}' for k in c.keys]
         else:
             v = s.vibrations_to_empty.mean
             rate = s.parts_per_hour.mean
