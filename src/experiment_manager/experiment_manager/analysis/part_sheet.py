@@ -70,9 +70,10 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
         lines.append(f'    made as: {part.collision_note}')
     else:
         lines.append(f'  collision: {len(part.primitives)} piece(s) (boxes and cylinders)')
-    lines.append("  aspects it can rest on (a drop test's `measured` names them; quasi-static "
-                 'share): ' + ', '.join(f'{a.name} {100 * a.quasi_static:.1f} %' for a in
-                                        part_aspects(part)))
+    lines.append("  aspects it can rest on (a drop test's `measured` names them), each with the "
+                 "outward normal of its face in the file's frame and its quasi-static share:")
+    lines += [f'    {a.name}: ({", ".join(f"{v:.2f}" for v in a.normal)}), '
+              f'{100 * a.quasi_static:.1f} %' for a in part_aspects(part)]
     for g, fit, axis in zip(file.grasps, checks.grasp_fits, checks.free_axes, strict=True):
         what = fit.problem() or (f'closes on {fit.width * MM:.2f} mm of part '
                                  f'({-fit.span[0] * MM:.2f} and {fit.span[1] * MM:.2f} mm '
