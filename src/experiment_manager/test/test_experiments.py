@@ -551,3 +551,34 @@ def test_the_bootstrap_gives_a_mean_of_few_iterations_its_whole_variance():
     assert means[0].var() == pytest.approx(0.25, rel=0.05)
     assert means[0].mean() == pytest.approx(0.5, abs=0.02)
     assert (means[1] == 2.0).all()
+
+
+EXTENDING = """id: ext
+seed: 4
+part: {model: radial_capacitor}
+gripper: {body_diameter_mm: 8, jaw_depth_mm: 3}
+tray_mm: [60, 50, 27]
+experiments:
+  - {id: sweep, type: table_sweep, iterations: 1, counts: {first: 1, last: 3, step: 1},
+     margin: 1}
+"""
+
+
+@pytest.mark.parametrize('mode', ['fixed', 'adaptive'])
+def test_a_sweep_still_rising_at_its_last_count_sweeps_on_until_its_peak_is_inside(tmp_path,
+                                                                                  mode):
+    text = EXTENDING + f'sampling: {{mode: {mode}, batch: 1}}\n'
+    with LocalBackend() as backend, ResultsWriter(str(tmp_path), text) as writer:
+        summary = Runner(experiment_file.parse(text), [backend], writer).run()
+    s = summary['experiments']['sweep']
+    counts = [p['n'] for p in s['per_n']]
+    assert counts[:3] == [1, 2, 3] and len(counts) > 3
+    assert counts == list(range(1, counts[-1] + 1))        # on at the sweep's step
+    assert s['n_star'] < counts[-1], 'the fitted peak lies inside the counts swept'
+    rows = read(str(tmp_path), 'iterations')
+    assert [int(r['group']) for r in rows] == counts        # written in the plan's order
+    # told not to, it stops at its last count
+    text = text.replace('margin: 1}', 'margin: 1, extend: false}')
+    with LocalBackend() as backend, ResultsWriter(str(tmp_path / 'no'), text) as writer:
+        summary = Runner(experiment_file.parse(text), [backend], writer).run()
+    assert [p['n'] for p in summary['experiments']['sweep']['per_n']] == [1, 2, 3]

@@ -243,6 +243,7 @@ def _experiment(e: schema.ExperimentKeys, where: str, c: _Context) -> list[Exper
         out['counts'] = tuple(range(e.counts.first, e.counts.last + 1, e.counts.step))
         check_fits(f'{where}.counts.last', out['counts'][-1], volume, tray)
         out['margin'] = e.margin
+        out['extend'] = e.extend
     elif e.type == GRIPPER_SWEEP:
         scene = _bin_or_source(e.bin, e.parts, where, c)
         if not scene:       # no bin: the parts lie on the tray, as in a table_sweep
@@ -348,7 +349,8 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         experiments=tuple(context.earlier.values()),
         sampling=Sampling(mode=s['sampling'].mode, batch=s['sampling'].batch),
         cell=Cell(pick_time=s['cell'].pick_s, image_time=s['cell'].image_s),
-        path=os.path.abspath(path) if path else '', text=text, auto_grasps=auto_grasps)
+        path=os.path.abspath(path) if path else '', text=text, auto_grasps=auto_grasps,
+        part_volume=geometry.volume)
 
 
 def load(path: str) -> ExperimentFile:

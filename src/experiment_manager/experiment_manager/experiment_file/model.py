@@ -153,6 +153,7 @@ class Experiment:
     scenario: Scenario | None = None
     grid: int = 0
     measured: tuple[tuple[str, int], ...] = ()
+    extend: bool = True
 
     @property
     def sources(self) -> tuple[str, ...]:
@@ -180,6 +181,7 @@ class ExperimentFile:
     path: str = ''
     text: str = field(default='', repr=False)
     auto_grasps: bool = False   # the grasps were proposed from the geometry (part.grasps: auto)
+    part_volume: float = 0.0    # m^3, the part's (the packing rule of a sweep's extra counts)
 
     def experiment(self, experiment_id: str) -> Experiment:
         return next(e for e in self.experiments if e.id == experiment_id)

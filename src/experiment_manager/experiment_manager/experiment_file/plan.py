@@ -5,13 +5,14 @@ experiment id and the iteration's key (`iteration_seed`), on a fresh scene of on
 result depends on nothing else, so order, resumption and the worker that ran it do not matter.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+import math
 import zlib
 
 from feeder_controller.policy import FeederConfig
 import numpy as np
-from pick_common.containers import ContainerSpec
-from pick_common.specs import MAX_SEED
+from pick_common.containers import ContainerSpec, PACKING_LIMIT
+from pick_common.specs import MAX_PARTS_PER_INSTANCE, MAX_SEED
 
 from .model import (
     BIN_EMPTYING,
@@ -61,6 +62,29 @@ class Unit:
         if kind == TABLE_SWEEP:
             return f'{self.group} parts, iteration {self.iteration + 1}'
         return f'iteration {self.iteration + 1}/{self.experiment.iterations}'
+
+
+EXTEND_STEPS = 3    # counts a table_sweep adds at a time while its fit still rises at its last
+
+
+def extended(file: ExperimentFile, exp: Experiment, summary: dict) -> Experiment | None:
+    """A table_sweep whose n* (`summary`, its metrics) sits at its last count, with up to
+    EXTEND_STEPS more counts at its step, as many as fit the tray with the sweep's margin
+    (containers' packing rule) and the per-instance limit; None when n* lies inside its counts,
+    no part was valid, no more fit, or the sweep says `extend: false`."""
+    if (exp.type != TABLE_SWEEP or not exp.extend or summary.get('no_valid')
+            or summary.get('n_star') is None):
+        return None
+    last = exp.counts[-1]
+    if summary['n_star'] < last:
+        return None
+    step = exp.counts[1] - exp.counts[0] if len(exp.counts) > 1 else 1
+    most = MAX_PARTS_PER_INSTANCE
+    if file.part_volume > 0:
+        most = min(most, int(PACKING_LIMIT * math.prod(file.tray.inner_size) / file.part_volume))
+    more = tuple(n for n in range(last + step, last + step * EXTEND_STEPS + 1, step)
+                 if n + exp.margin <= most)
+    return replace(exp, counts=exp.counts + more) if more else None
 
 
 def groups(exp: Experiment) -> list[int]:

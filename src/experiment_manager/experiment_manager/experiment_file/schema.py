@@ -302,6 +302,9 @@ class Counts(Section):
 class TableSweepKeys(ExperimentKeys):
     counts: Counts = Counts()
     margin: Int(0, 1000) = 5
+    # while the fit still rises at the last count, sweep on at more counts (plan.extended)
+    extend: Annotated[bool, BeforeValidator(lambda v: v if isinstance(v, bool) else fail(
+        'must be true or false', short(v)))] = True
 
 
 class FeederEmptyingKeys(ExperimentKeys):

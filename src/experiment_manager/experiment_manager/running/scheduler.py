@@ -14,7 +14,7 @@ queue and may come back (Backend.rejoin).
 
 import collections
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import heapq
 import threading
 import time
@@ -23,7 +23,7 @@ from typing import Protocol
 from ..analysis import metrics, sensitivity
 from ..analysis.rows import Record
 from ..experiment_file import BIN_STATIC, Experiment, ExperimentFile, GRIPPER_SWEEP, SENSITIVITY
-from ..experiment_file.plan import count_iterations, experiment_iterations, plan, Unit
+from ..experiment_file.plan import count_iterations, experiment_iterations, extended, plan, Unit
 from . import sampling
 from .backend import Backend, WorkerLost
 from .estimate import Costs
@@ -210,7 +210,7 @@ class Runner:
         checks = ([c for c in self.sink.checks(exp.id) if (c['group'], c['iteration']) in released]
                   if exp.type == GRIPPER_SWEEP else [])
         return [g for g in sampling.unsettled(self.file, exp, rows, checks)
-                if self._unreleased[exp.id][g]]
+                if self._unreleased[exp.id].get(g)]
 
     def _finish(self, exp: Experiment) -> None:
         """An experiment's last iteration is written: order the rows, summarise, release the
@@ -223,6 +223,11 @@ class Runner:
             self._summary[exp.id] = metrics.summarise(
                 self.file.for_experiment(exp), exp, rows, self.sink.picks(exp.id),
                 self._summary, checks)
+            wider = extended(self.file, exp, self._summary[exp.id])
+            if wider is not None:       # a sweep still rising at its last count goes on
+                del self._summary[exp.id]
+                self._extend(exp, wider)
+                return
         if self.file.sampling.adaptive and exp.type != SENSITIVITY:
             left, tie = sampling.ended(self.file, exp, rows, checks)
             self._summary[exp.id]['sampling'] = {
@@ -238,6 +243,29 @@ class Runner:
                     race_confidence=sampling.RACE_CONFIDENCE)
         self.sink.write_summary(metrics.file_summary(self.file, self._ordered_summary()))
         self._release()
+
+    def _extend(self, exp: Experiment, wider: Experiment) -> None:
+        """Run a table_sweep on at more counts (plan.extended): the file holds `wider` from
+        now on, and its new counts' iterations are queued, or released as batches when
+        adaptive; its experiments waiting on it wait on (under the lock)."""
+        self.file = replace(self.file, experiments=tuple(
+            wider if e.id == exp.id else e for e in self.file.experiments))
+        index = self.file.experiments.index(wider)
+        start = sum(1 for key in self._rank if key[0] == exp.id)
+        units = [u for u in plan(self.file, wider, self._summary) if u.group not in exp.counts]
+        for i, u in enumerate(units):
+            self._rank[u.key] = (index, start + i)
+        self._total += len(units)
+        if self.file.sampling.adaptive:
+            unreleased: dict[int, list[Unit]] = {}
+            for u in units:
+                unreleased.setdefault(u.group, []).append(u)
+            self._unreleased[exp.id].update(unreleased)
+            self._next_batch(wider, list(unreleased))
+        else:
+            self._queue(wider, units)
+            if not self._left[exp.id]:
+                self._finish(wider)
 
     def _work(self, k: int) -> None:
         """Worker k's loop: take the first ready iteration, run it, write it. While others are

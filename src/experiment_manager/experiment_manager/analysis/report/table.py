@@ -41,8 +41,10 @@ class Sweep(Section):
         if tested and high > max(tested):
             lines += ['', f'**Warning**: the optimal range runs past the last count tested '
                       f'({max(tested)} parts): beyond it the fit is an extrapolation'
-                      + (', and n* sits at that count, so the fit is still rising there: '
-                         'test higher counts' if s.n_star >= max(tested) else '') + '.']
+                      + (', and n* sits at that count, so the fit is still rising there: the '
+                         'sweep goes on at more counts by itself until its peak lies inside '
+                         'them, so the tray holds no more (its packing limit) or the file says '
+                         '`extend: false`' if s.n_star >= max(tested) else '') + '.']
         return lines
 
 
