@@ -111,3 +111,28 @@ def test_a_part_s_former_material_key_is_refused_naming_the_pairs(key):
     assert err.value.field == f'part.{key}'
     assert f'materials.part_on_surface.{key}' in err.value.rule
     assert f'materials.part_on_part.{key}' in err.value.rule
+
+
+def test_the_part_s_account_says_where_each_contact_pair_comes_from():
+    from experiment_manager.analysis.part_sheet import describe, validator
+    f = experiment_file.parse(FILE.replace('experiments:', """materials:
+  part_on_surface: {restitution: 0.4, source: 'our drop test, 2026-11'}
+  part_on_part: {lateral_friction: 0.45}
+experiments:"""))
+    lines = [line for line in describe(f, validator(f)) if 'contact' in line]
+    assert lines[0].endswith('restitution 0.4; from our drop test, 2026-11')
+    assert 'friction 0.45' in lines[1] and 'source not said' in lines[1]
+    f = experiment_file.parse(FILE)
+    lines = [line for line in describe(f, validator(f)) if 'contact' in line]
+    assert len(lines) == 2
+    assert all('from the defaults: friction: The Engineering ToolBox' in line for line in lines)
+
+
+def test_a_bad_contact_pair_is_named_not_a_traceback():
+    with pytest.raises(InvalidArgument) as err:
+        experiment_file.parse(FILE.replace('experiments:', """materials:
+  part_on_surface: {restitution: 1.4, colour: red}
+experiments:"""))
+    text = str(err.value)
+    assert 'materials.part_on_surface.restitution' in text and '1.4' in text
+    assert 'materials.part_on_surface.colour' in text

@@ -70,6 +70,14 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
         lines.append(f'    made as: {part.collision_note}')
     else:
         lines.append(f'  collision: {len(part.primitives)} piece(s) (boxes and cylinders)')
+    sources = dict(file.material_sources)
+    for pair, where in (('part_on_surface', "on the container's floor and walls"),
+                        ('part_on_part', 'against another part')):
+        c = getattr(spec, pair)
+        lines.append(f'  contact {where} (materials.{pair}, as the physics applies it): '
+                     f'friction {c.lateral_friction:g}, rolling arm {c.rolling_friction * MM:g} '
+                     f'mm, spinning arm {c.spinning_friction * MM:g} mm, restitution '
+                     f'{c.restitution:g}; from {sources.get(pair, "the file")}')
     lines.append("  aspects it can rest on (a drop test's `measured` names them), each with the "
                  "outward normal of its face in the file's frame and its quasi-static share:")
     lines += [f'    {a.name}: ({", ".join(f"{v:.2f}" for v in a.normal)}), '

@@ -299,7 +299,7 @@ def parse(text: str, path: str = '') -> ExperimentFile:
     top = read(schema.FileKeys, data, '')
     s = {key: read(model, data.get(key, {}), key) for key, model in schema.SECTIONS.items()}
     read_part = checked(lambda: part_section.read_part(s['part'], s['materials'], base_dir)
-                        ) if s['part'] else None
+                        ) if s['part'] and s['materials'] else None
     part, grasps, place = read_part or (None, None, None)
     gripper = sections.gripper(s['gripper']) if s['gripper'] else None
     check = sections.check(s['check']) if s['check'] else None
@@ -350,7 +350,8 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         sampling=Sampling(mode=s['sampling'].mode, batch=s['sampling'].batch),
         cell=Cell(pick_time=s['cell'].pick_s, image_time=s['cell'].image_s),
         path=os.path.abspath(path) if path else '', text=text, auto_grasps=auto_grasps,
-        part_volume=geometry.volume)
+        part_volume=geometry.volume,
+        material_sources=part_section.material_sources(s['materials']))
 
 
 def load(path: str) -> ExperimentFile:

@@ -7,7 +7,7 @@ from typing import Any
 
 from pick_common.errors import InvalidArgument
 from pick_common.parts.geometry import build_part, PartGeometry
-from pick_common.parts.materials import body_values, Contact
+from pick_common.parts.materials import body_values, Contact, SOURCE
 from pick_common.parts.spec import PartSpec, states_units, UNITS
 from pick_validity.config import CAPACITOR_GRASPS, GraspPose, PlaceSpec
 from pick_validity.grasp_fit import check_grasps_fit
@@ -50,6 +50,23 @@ def contact(pair: Any) -> Contact:
                    rolling_friction=MM * pair.rolling_friction_mm,
                    spinning_friction=MM * pair.spinning_friction_mm,
                    restitution=pair.restitution)
+
+
+def material_sources(m: schema.MaterialsSection) -> tuple[tuple[str, str], ...]:
+    """Where each pair's values come from, as the report says it: the pair's `source`; the
+    defaults' (materials.SOURCE) when the file sets none of its values; else that they were
+    given without one."""
+    out = []
+    for pair in ('part_on_surface', 'part_on_part'):
+        section = getattr(m, pair)
+        if section.source:
+            said = section.source
+        elif not section.model_fields_set - {'source'}:
+            said = f'the defaults: {SOURCE}'
+        else:
+            said = 'given in the file, its source not said (materials.<pair>.source)'
+        out.append((pair, said))
+    return tuple(out)
 
 
 def read_part(p: schema.Part, m: schema.MaterialsSection, base_dir: str
