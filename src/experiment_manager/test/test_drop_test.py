@@ -136,3 +136,19 @@ experiments:"""))
     text = str(err.value)
     assert 'materials.part_on_surface.restitution' in text and '1.4' in text
     assert 'materials.part_on_surface.colour' in text
+
+
+def test_the_chart_draws_aspects_no_part_landed_on(tmp_path):
+    from experiment_manager.analysis.report.plots import plot_drop_test
+    from experiment_manager.analysis.summary import DropTest
+    s = DropTest.model_validate({
+        'type': 'drop_test', 'drops': 12, 'height_mm': 80.0, 'other': 0,
+        'faults': {'physics_fault': 0, 'tunnelled': 0, 'thrown': 0, 'unsettled': 0,
+                   'flagged': []},
+        'physics': {'spilled': 0, 'tunnelled': 0, 'thrown': 0, 'max_speed': 0.0,
+                    'unsettled': 0, 'max_penetration': 0.0, 'tray_error': 0.0},
+        'aspects': [{'name': '+y', 'normal': [0, 1, 0], 'count': 12, 'share': 1.0,
+                     'ci95': [0.7575, 1.0 - 1e-17], 'quasi_static': 0.5},
+                    {'name': '-z', 'normal': [0, 0, -1], 'count': 0, 'share': 0.0,
+                     'ci95': [1e-17, 0.2425], 'quasi_static': 0.5}]})
+    assert plot_drop_test('drop', s, str(tmp_path / 'drop.png'))

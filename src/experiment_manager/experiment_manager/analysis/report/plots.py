@@ -47,8 +47,9 @@ def plot_drop_test(exp_id: str, s, path: str) -> bool:
     fig, ax = plt.subplots(figsize=FIGSIZE)
     for k, (label, values) in enumerate(series):
         ax.bar(x + (k - (len(series) - 1) / 2) * width, values, width, label=label)
-    low = [a.share - a.ci95[0] if a.share is not None else 0.0 for a in s.aspects]
-    high = [a.ci95[1] - a.share if a.share is not None else 0.0 for a in s.aspects]
+    # the interval holds the share; a share of 0 or 1 may sit a rounding outside it
+    low = [max(0.0, a.share - a.ci95[0]) if a.share is not None else 0.0 for a in s.aspects]
+    high = [max(0.0, a.ci95[1] - a.share) if a.share is not None else 0.0 for a in s.aspects]
     ax.errorbar(x - (len(series) - 1) / 2 * width, [a.share or 0.0 for a in s.aspects],
                 yerr=[low, high], fmt='none', ecolor='black', capsize=3)
     ax.set_xticks(x, names)
