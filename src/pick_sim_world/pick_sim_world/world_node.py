@@ -118,7 +118,7 @@ class WorldNode(Node):
             feeder_zone_size=tuple(get('container.feeder_zone_size',
                                        list(base.feeder_zone_size),
                                        'x, y extent of the tray feeder zone, m')),
-            drop_height=get('container.drop_height', containers.DROP_HEIGHT[kind],
+            drop_height=get('container.drop_height', containers.DROP_HEIGHT.get(kind, 0.0),
                             "how high over the floor parts arrive from, m (a bin's pour, a "
                             "tray's hopper lip)", walls['container.drop_height']))
         model = get('part.model', 'radial_capacitor',
