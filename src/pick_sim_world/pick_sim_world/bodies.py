@@ -58,9 +58,9 @@ def configure(client: int, physics: PhysicsConfig, kind: str) -> None:
 
 
 def hull_inset(vertices: np.ndarray, faces: np.ndarray) -> float:
-    """How far a hull is inset, m: HULL_MARGIN, or INSET_SHARE of the radius of the largest
+    """How far a hull is inset, m: HULL_MARGIN, or INSET_SHARE of the diameter of the largest
     ball inside it when that is less."""
-    return min(HULL_MARGIN, INSET_SHARE * 2.0 * _inner_ball(vertices, faces)[1])
+    return _inset(vertices, faces)[3]
 
 
 def hull_swelling(part: PartGeometry) -> float:
@@ -84,24 +84,25 @@ def _planes(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.nda
     return normals, np.einsum('ij,ij->i', normals, mesh.triangles[keep, 0])
 
 
-def _inner_ball(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, float]:
-    """The centre (3,) and radius, m, of the largest ball inside the hull (its Chebyshev
-    centre: a linear programme over its face planes)."""
+def _inset(vertices: np.ndarray, faces: np.ndarray
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """The hull's face planes (normals, offsets: _planes), the centre of the largest ball
+    inside it (its Chebyshev centre: a linear programme over the planes) and how far the hull
+    is inset (hull_inset), from one pass over its faces."""
     normals, offsets = _planes(vertices, faces)
     # maximise r: n.c + r <= d for every face
     rows = np.column_stack([normals, np.ones(len(normals))])
-    result = linprog(c=[0.0, 0.0, 0.0, -1.0], A_ub=rows, b_ub=offsets,
-                     bounds=[(None, None)] * 3 + [(0.0, None)], method='highs')
-    return result.x[:3], float(result.x[3])
+    ball = linprog(c=[0.0, 0.0, 0.0, -1.0], A_ub=rows, b_ub=offsets,
+                   bounds=[(None, None)] * 3 + [(0.0, None)], method='highs').x
+    return normals, offsets, ball[:3], min(HULL_MARGIN, INSET_SHARE * 2.0 * float(ball[3]))
 
 
-def inset_hull(vertices: np.ndarray, faces: np.ndarray, margin: float) -> np.ndarray:
-    """The vertices of the convex hull whose faces lie `margin` (m, less than the radius of
-    the largest ball inside it) inside those of the hull (vertices (K, 3), triangles faces),
-    so that Bullet's hull grown by `margin` is the hull."""
-    normals, offsets = _planes(vertices, faces)
-    inside = HalfspaceIntersection(np.column_stack([normals, -(offsets - margin)]),
-                                   _inner_ball(vertices, faces)[0])
+def inset_hull(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """The vertices of the convex hull whose faces lie hull_inset inside those of the hull
+    (vertices (K, 3), triangles faces), so that Bullet's hull grown by its margin is the hull
+    (short of hull_swelling)."""
+    normals, offsets, centre, margin = _inset(vertices, faces)
+    inside = HalfspaceIntersection(np.column_stack([normals, -(offsets - margin)]), centre)
     return inside.intersections
 
 
@@ -120,8 +121,7 @@ def create_part_shape(client: int, part: PartGeometry, directory: str) -> int:
             kind, radius, length = pb.GEOM_CYLINDER, p.radius, p.length
         else:
             kind = pb.GEOM_MESH
-            hull = trimesh.convex.convex_hull(
-                inset_hull(p.vertices, p.faces, hull_inset(p.vertices, p.faces)))
+            hull = trimesh.convex.convex_hull(inset_hull(p.vertices, p.faces))
             # named by its content: pybullet keeps a file's mesh by its path for the life of
             # the process, resets included, so a reused name would bring back an old part
             digest = hashlib.sha256(hull.vertices.tobytes() + hull.faces.tobytes())
