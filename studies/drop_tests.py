@@ -29,7 +29,7 @@ from dataclasses import dataclass, field, replace
 import os
 import tempfile
 
-from experiment_manager.experiment_file.model import DROP_PLATE
+from experiment_manager.experiment_file.drop_test import plate
 import numpy as np
 from pick_common.containers import ContainerSpec
 from pick_common.parts import aspects as aspects_of
@@ -121,13 +121,11 @@ def drop(mesh: trimesh.Trimesh, density: float, contact: Contact, height: float,
         spec = PartSpec(model='mesh', mesh_path=path, mass=density * mesh.volume,
                         part_on_surface=contact, part_on_part=contact)
         part = build_part(spec)
-        found = aspects_of.stable_aspects(part.visual, part.mass_frame[0])
-        # the plate a drop_test experiment drops on (experiment_file.loading)
-        width = DROP_PLATE * (part.radius + float(np.linalg.norm(part.center)))
+        found = aspects_of.part_aspects(part)
+        bin_ = plate(part, height, ContainerSpec().wall_thickness)   # a drop_test's plate
         counts: Counter = Counter()
         for start in range(0, drops, PER_WORLD):
             n = min(PER_WORLD, drops - start)
-            bin_ = ContainerSpec(inner_size=(width, width, 0.02), drop_height=height)
             # every part at rest before the snapshot, as when one drop is a world (the
             # default lets 2 % of a world's parts still move: here one part of 64)
             physics = PhysicsConfig(settle_moving_fraction=0.0)

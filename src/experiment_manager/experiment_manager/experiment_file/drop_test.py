@@ -14,15 +14,20 @@ from .errors import checked
 from .model import DROP_PLATE, MM
 
 
+def plate(geometry: PartGeometry, height: float, wall: float) -> ContainerSpec:
+    """The plate a drop test drops `geometry`'s part onto from `height` (m): a bin DROP_PLATE
+    part radii wide, its `wall` (m) walls only there to keep a bouncing part."""
+    width = DROP_PLATE * (geometry.radius + float(np.linalg.norm(geometry.center)))
+    return ContainerSpec(inner_size=(width, width, 0.02), wall_thickness=wall,
+                         drop_height=height)
+
+
 def drop_test(e: schema.DropTestKeys, where: str, geometry: PartGeometry, bin_wall: float
               ) -> dict[str, Any]:
-    """A drop test's plate (a bin DROP_PLATE part radii wide, its walls only there to keep a
-    bouncing part, parts arriving from height_mm) and its measured counts, each aspect name
-    one of the part's; the Experiment's fields."""
-    width = DROP_PLATE * (geometry.radius + float(np.linalg.norm(geometry.center)))
-    plate = ContainerSpec(inner_size=(width, width, 0.02), wall_thickness=bin_wall,
-                          drop_height=MM * e.height_mm)
-    checked(check_container, plate, f'{where}.height_mm')
+    """A drop test's plate (`plate`, parts arriving from height_mm) and its measured counts,
+    each aspect name one of the part's; the Experiment's fields."""
+    plate_ = checked(check_container, plate(geometry, MM * e.height_mm, bin_wall),
+                     f'{where}.height_mm')
     if e.measured:
         names = [a.name for a in part_aspects(geometry)]
         for name in e.measured:
@@ -30,4 +35,4 @@ def drop_test(e: schema.DropTestKeys, where: str, geometry: PartGeometry, bin_wa
                 raise InvalidArgument(f'{where}.measured.{name}', e.measured[name],
                                       f'is not an aspect of the part (its aspects: '
                                       f'{", ".join(names)})')
-    return {'parts': 1, 'bin': plate, 'measured': tuple(e.measured.items())}
+    return {'parts': 1, 'bin': plate_, 'measured': tuple(e.measured.items())}

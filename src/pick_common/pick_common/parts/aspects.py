@@ -88,22 +88,24 @@ def stable_aspects(mesh: trimesh.Trimesh, centre: Sequence[float]) -> list[Aspec
                                           .round(6)))
 
 
-def part_aspects(part: PartGeometry) -> tuple[Aspect, ...]:
-    """A built part's aspects: stable_aspects of its visual mesh about its mass centre (a
-    mesh's own, a built-in model's frame origin)."""
-    centre = part.mass_frame[0] if part.mass_frame is not None else np.zeros(3)
-    return tuple(stable_aspects(part.visual, centre))
-
-
 _BY_GEOMETRY: dict[tuple, tuple[Aspect, ...]] = {}
 
 
-def spec_aspects(spec: PartSpec) -> tuple[Aspect, ...]:
-    """The aspects of the part a spec describes, built once per geometry in a process."""
-    key = geometry_key(spec)
+def part_aspects(part: PartGeometry) -> tuple[Aspect, ...]:
+    """A built part's aspects: stable_aspects of its visual mesh about its mass centre (a
+    mesh's own, a built-in model's frame origin), computed once per geometry in a process
+    (the file's check, the part's account and the summary ask for the same part's)."""
+    key = geometry_key(part.spec)
     if key not in _BY_GEOMETRY:
-        _BY_GEOMETRY[key] = part_aspects(build_part(spec))
+        centre = part.mass_frame[0] if part.mass_frame is not None else np.zeros(3)
+        _BY_GEOMETRY[key] = tuple(stable_aspects(part.visual, centre))
     return _BY_GEOMETRY[key]
+
+
+def spec_aspects(spec: PartSpec) -> tuple[Aspect, ...]:
+    """The aspects of the part a spec describes (part_aspects), its part built only when no
+    aspects of its geometry are known yet."""
+    return _BY_GEOMETRY.get(geometry_key(spec)) or part_aspects(build_part(spec))
 
 
 def classify(aspects: Sequence[Aspect], orientations: np.ndarray) -> list[str]:
