@@ -100,7 +100,13 @@ def test_a_sensitivity_grid_over_a_measured_drop_test_calibrates_it(tmp_path):
     assert fit['keys'][:2] == ['materials:', '  part_on_surface:']
     printed = headlines(summary_model.validate(summary))
     assert '    calibrated on drop (G-test p' in '\n'.join(printed)
-    assert printed[-1].startswith('          restitution: ')
+    assert any(line.startswith('          restitution: ') for line in printed)
+    # the keys pasted into the file give its values and say they were calibrated, and where
+    pasted = experiment_file.parse(FILE.replace('experiments:', '\n'.join(fit['keys'])
+                                                + '\nexperiments:'))
+    (pair, bases, said), _ = pasted.material_account
+    assert pair == 'part_on_surface' and dict(bases)['restitution'] == 'calibrated'
+    assert said == 'calibrated to the drop test drop (30 drops measured)'
 
 
 @pytest.mark.parametrize('key', ['lateral_friction', 'restitution', 'rolling_friction_mm'])
@@ -113,19 +119,38 @@ def test_a_part_s_former_material_key_is_refused_naming_the_pairs(key):
     assert f'materials.part_on_part.{key}' in err.value.rule
 
 
-def test_the_part_s_account_says_where_each_contact_pair_comes_from():
+def test_the_part_s_account_says_how_each_material_value_was_got_and_where_from():
     from experiment_manager.analysis.part_sheet import describe, validator
     f = experiment_file.parse(FILE.replace('experiments:', """materials:
-  part_on_surface: {restitution: 0.4, source: 'our drop test, 2026-11'}
-  part_on_part: {lateral_friction: 0.45}
+  part_on_surface: {restitution: 0.4, source: 'our drop test, 2026-11', basis: calibrated}
+  part_on_part: {lateral_friction: 0.45, restitution: 0.2, basis: {restitution: measured}}
 experiments:"""))
     lines = [line for line in describe(f, validator(f)) if 'contact' in line]
-    assert lines[0].endswith('restitution 0.4; from our drop test, 2026-11')
-    assert 'friction 0.45' in lines[1] and 'source not said' in lines[1]
+    # the value given takes the pair's basis; those left to the defaults keep the defaults'
+    assert 'friction 0.35 (published), rolling arm 0.1 mm (assumed)' in lines[0]
+    assert lines[0].endswith('restitution 0.4 (calibrated); from our drop test, 2026-11')
+    assert 'friction 0.45 (not said)' in lines[1] and 'restitution 0.2 (measured)' in lines[1]
+    assert 'source not said' in lines[1]
     f = experiment_file.parse(FILE)
     lines = [line for line in describe(f, validator(f)) if 'contact' in line]
     assert len(lines) == 2
     assert all('from the defaults: friction: The Engineering ToolBox' in line for line in lines)
+    assert all('restitution 0.3 (assumed)' in line for line in lines)
+
+
+@pytest.mark.parametrize('basis, field, said', [
+    ('guessed', 'materials.part_on_surface.basis', 'guessed'),
+    ('{colour: measured}', 'materials.part_on_surface.basis.colour', 'colour'),
+    ('{lateral_friction: measured}', 'materials.part_on_surface.basis.lateral_friction',
+     'does not give'),
+])
+def test_a_basis_that_is_no_basis_or_of_a_value_not_given_is_refused(basis, field, said):
+    with pytest.raises(InvalidArgument) as err:
+        experiment_file.parse(FILE.replace('experiments:', f"""materials:
+  part_on_surface: {{restitution: 0.4, basis: {basis}}}
+experiments:"""))
+    assert err.value.field == field
+    assert said in str(err.value)
 
 
 def test_a_bad_contact_pair_is_named_not_a_traceback():

@@ -9,6 +9,7 @@ CHI2_HALF of it in log likelihood (the profile likelihood's chi-square(1) rule, 
 resolution: the interval is no finer than the grid). Pure: no rclpy.
 """
 
+import json
 import math
 
 from pick_common.parts.aspects import agreement
@@ -41,18 +42,27 @@ def calibrate(experiment: str, measured: dict[str, int],
     near = [values for ll, values, _ in scored if ll >= best_ll - CHI2_HALF]
     intervals = {name: [min(v[name] for v in near), max(v[name] for v in near)]
                  for name in best}
+    keys: dict[str, tuple[float, float, float] | str] = {
+        name: (best[name], *intervals[name]) for name in best}
+    for name in best:                   # a material's pair says the values are calibrated
+        if name.startswith('materials.'):
+            pair, key = name.rsplit('.', 1)
+            keys[f'{pair}.basis.{key}'] = 'calibrated'
+            keys[f'{pair}.source'] = (f'calibrated to the drop test {experiment} '
+                                      f'({sum(measured.values())} drops measured)')
     return {'experiment': experiment, 'best': best, 'intervals': intervals,
             'p': agreement(best_counts, measured),
             'points': [{'values': v, 'log_likelihood': ll} for ll, v, _ in scored],
-            'keys': file_keys({name: (best[name], *intervals[name]) for name in best})}
+            'keys': file_keys(keys)}
 
 
-def file_keys(values: dict[str, tuple[float, float, float]]) -> list[str]:
+def file_keys(values: dict[str, tuple[float, float, float] | str]) -> list[str]:
     """YAML lines that set each dotted key (an input's name: its file key) to its value,
-    nested as the file nests them, the interval in a comment: {name: (value, low, high)}."""
+    nested as the file nests them: {name: (value, low, high)} with the interval in a comment,
+    or {name: text}."""
     lines: list[str] = []
     open_path: list[str] = []
-    for name, (value, low, high) in sorted(values.items()):
+    for name, given in sorted(values.items()):
         *path, key = name.split('.')
         common = 0
         while common < min(len(path), len(open_path)) and path[common] == open_path[common]:
@@ -60,5 +70,9 @@ def file_keys(values: dict[str, tuple[float, float, float]]) -> list[str]:
         for depth in range(common, len(path)):
             lines.append('  ' * depth + f'{path[depth]}:')
         open_path = path
+        if isinstance(given, str):
+            lines.append('  ' * len(path) + f'{key}: {json.dumps(given)}')
+            continue
+        value, low, high = given
         lines.append('  ' * len(path) + f'{key}: {value:.4g}    # 95 %: {low:.4g} to {high:.4g}')
     return lines

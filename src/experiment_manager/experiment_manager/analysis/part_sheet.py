@@ -70,14 +70,20 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
         lines.append(f'    made as: {part.collision_note}')
     else:
         lines.append(f'  collision: {len(part.primitives)} piece(s) (boxes and cylinders)')
-    sources = dict(file.material_sources)
+    account = {pair: (dict(bases), said) for pair, bases, said in file.material_account}
     for pair, where in (('part_on_surface', "on the container's floor and walls"),
                         ('part_on_part', 'against another part')):
         c = getattr(spec, pair)
+        bases, said = account.get(pair, ({}, 'the file'))
+        figures = ', '.join(
+            f'{label} {getattr(c, field) * scale:g}{unit} ({bases.get(field, "not said")})'
+            for label, field, scale, unit in (
+                ('friction', 'lateral_friction', 1, ''),
+                ('rolling arm', 'rolling_friction', MM, ' mm'),
+                ('spinning arm', 'spinning_friction', MM, ' mm'),
+                ('restitution', 'restitution', 1, '')))
         lines.append(f'  contact {where} (materials.{pair}, as the physics applies it): '
-                     f'friction {c.lateral_friction:g}, rolling arm {c.rolling_friction * MM:g} '
-                     f'mm, spinning arm {c.spinning_friction * MM:g} mm, restitution '
-                     f'{c.restitution:g}; from {sources.get(pair, "the file")}')
+                     f'{figures}; from {said}')
     lines.append("  aspects it can rest on (a drop test's `measured` names them), each with the "
                  "outward normal of its face in the file's frame and its quasi-static share:")
     lines += [f'    {a.name}: ({", ".join(f"{v:.2f}" for v in a.normal)}), '

@@ -9,7 +9,7 @@ from pick_common.errors import InvalidArgument
 from pick_common.parts.aspects import part_aspects
 from pick_common.parts.geometry import PartGeometry
 
-from . import schema
+from . import experiment_keys
 from .errors import checked
 from .model import DROP_PLATE, MM
 
@@ -22,7 +22,7 @@ def plate(geometry: PartGeometry, height: float, wall: float) -> ContainerSpec:
                          drop_height=height)
 
 
-def drop_test(e: schema.DropTestKeys, where: str, geometry: PartGeometry, bin_wall: float
+def drop_test(e: experiment_keys.DropTestKeys, where: str, geometry: PartGeometry, bin_wall: float
               ) -> dict[str, Any]:
     """A drop test's plate (`plate`, parts arriving from height_mm) and its measured counts,
     each aspect name one of the part's; the Experiment's fields."""

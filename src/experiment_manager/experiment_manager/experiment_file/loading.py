@@ -32,9 +32,9 @@ from pick_validity.config import (
 )
 import yaml
 
+from . import experiment_keys, schema, sections
 from . import part as part_section
 from . import scenarios as scenario_inputs
-from . import schema, sections
 from .drop_test import drop_test
 from .errors import checked as checked_as
 from .errors import read as read_keys
@@ -129,7 +129,7 @@ def _bin_or_source(value: Any, parts: int, where: str, c: _Context) -> dict:
     return {'bin': spec}
 
 
-def _variants(e: schema.GripperSweepKeys, where: str, c: _Context
+def _variants(e: experiment_keys.GripperSweepKeys, where: str, c: _Context
               ) -> tuple[GripperVariant, ...]:
     """gripper_sweep's grid: every combination of its grippers (the file's gripper standing in
     for keys not given) and grasp sets (default: every grasp, named 'all'), in the order
@@ -167,7 +167,7 @@ def _variants(e: schema.GripperSweepKeys, where: str, c: _Context
     return tuple(out)
 
 
-def _sensitivity(e: schema.SensitivityKeys, where: str, c: _Context) -> list[Experiment]:
+def _sensitivity(e: experiment_keys.SensitivityKeys, where: str, c: _Context) -> list[Experiment]:
     """A sensitivity experiment and, before it, its repeats of the experiments it names, one
     per scenario (scenarios.py); a repeat takes its bin or range from the same scenario's
     repeat of its source when that is repeated too, else from the source itself."""
@@ -221,7 +221,7 @@ def _sensitivity(e: schema.SensitivityKeys, where: str, c: _Context) -> list[Exp
                                  grid=e.grid)]
 
 
-def _experiment(e: schema.ExperimentKeys, where: str, c: _Context) -> list[Experiment]:
+def _experiment(e: experiment_keys.ExperimentKeys, where: str, c: _Context) -> list[Experiment]:
     """The experiment read at `where` (with, for a sensitivity experiment, its repeats)."""
     if e.id in c.earlier:
         raise InvalidArgument(f'{where}.id', e.id, 'is the id of an earlier experiment')
@@ -331,7 +331,7 @@ def parse(text: str, path: str = '') -> ExperimentFile:
     for i, item in enumerate(raw if isinstance(raw, list) and len(raw) <= MAX_EXPERIMENTS
                              else []):
         where = f'experiments[{i}]'
-        keys = read(schema.experiment_model(item), item, where)
+        keys = read(experiment_keys.experiment_model(item), item, where)
         if keys is not None and context is not None:
             read_here = checked(lambda keys=keys, where=where: _experiment(keys, where,
                                                                             context))
@@ -351,7 +351,7 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         cell=Cell(pick_time=s['cell'].pick_s, image_time=s['cell'].image_s),
         path=os.path.abspath(path) if path else '', text=text, auto_grasps=auto_grasps,
         part_volume=geometry.volume,
-        material_sources=part_section.material_sources(s['materials']))
+        material_account=part_section.material_account(s['materials']))
 
 
 def load(path: str) -> ExperimentFile:

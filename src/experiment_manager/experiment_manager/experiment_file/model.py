@@ -182,8 +182,8 @@ class ExperimentFile:
     text: str = field(default='', repr=False)
     auto_grasps: bool = False   # the grasps were proposed from the geometry (part.grasps: auto)
     part_volume: float = 0.0    # m^3, the part's (the packing rule of a sweep's extra counts)
-    # where each contact pair's values come from (part.material_sources), by pair
-    material_sources: tuple[tuple[str, str], ...] = ()
+    # per contact pair, how each value was got and where they come from (part.material_account)
+    material_account: tuple[tuple[str, tuple[tuple[str, str], ...], str], ...] = ()
 
     def experiment(self, experiment_id: str) -> Experiment:
         return next(e for e in self.experiments if e.id == experiment_id)

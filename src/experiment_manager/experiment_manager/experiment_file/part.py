@@ -7,7 +7,7 @@ from typing import Any
 
 from pick_common.errors import InvalidArgument
 from pick_common.parts.geometry import build_part, PartGeometry
-from pick_common.parts.materials import body_values, Contact, SOURCE
+from pick_common.parts.materials import body_values, Contact, DEFAULT_BASIS, SOURCE
 from pick_common.parts.spec import PartSpec, states_units, UNITS
 from pick_validity.config import CAPACITOR_GRASPS, GraspPose, PlaceSpec
 from pick_validity.grasp_fit import check_grasps_fit
@@ -52,20 +52,28 @@ def contact(pair: Any) -> Contact:
                    restitution=pair.restitution)
 
 
-def material_sources(m: schema.MaterialsSection) -> tuple[tuple[str, str], ...]:
-    """Where each pair's values come from, as the report says it: the pair's `source`; the
-    defaults' (materials.SOURCE) when the file sets none of its values; else that they were
-    given without one."""
+def material_account(m: schema.MaterialsSection
+                     ) -> tuple[tuple[str, tuple[tuple[str, str], ...], str], ...]:
+    """Per pair, how each value was got (materials.BASES, by Contact field) and where the
+    values come from, as the report says them. A value the file leaves to its default has
+    the default's basis (materials.DEFAULT_BASIS); one the file gives, the pair's `basis` for
+    it, else 'not said'. The source: the pair's `source`; the defaults' (materials.SOURCE)
+    when the file gives none of the pair's values; else that they were given without one."""
     out = []
     for pair in ('part_on_surface', 'part_on_part'):
         section = getattr(m, pair)
+        given = section.model_fields_set - {'source', 'basis'}
+        bases = tuple(
+            (field, (section.basis.get(key, section.basis.get('*', 'not said'))
+                     if key in given else DEFAULT_BASIS[field]))
+            for key, field in schema.FIELD_OF.items())
         if section.source:
             said = section.source
-        elif not section.model_fields_set - {'source'}:
+        elif not given:
             said = f'the defaults: {SOURCE}'
         else:
             said = 'given in the file, its source not said (materials.<pair>.source)'
-        out.append((pair, said))
+        out.append((pair, bases, said))
     return tuple(out)
 
 

@@ -35,6 +35,13 @@ SOURCE = ('friction: The Engineering ToolBox, Friction and Friction Coefficients
           'Common Materials (polystyrene on steel 0.3-0.35, polystyrene on polystyrene 0.5); '
           'restitution, rolling and spinning arms: assumed')
 
+# How a value was got, as a file's `basis` and the report say it: measured on the user's own
+# parts, calibrated to a drop test's counts, published (a cited table), or assumed. The
+# defaults' bases, by field: friction from the table above, the rest assumed.
+BASES = ('measured', 'calibrated', 'published', 'assumed')
+DEFAULT_BASIS = {'lateral_friction': 'published', 'rolling_friction': 'assumed',
+                 'spinning_friction': 'assumed', 'restitution': 'assumed'}
+
 
 @dataclass(frozen=True)
 class Contact:
