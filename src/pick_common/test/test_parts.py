@@ -119,6 +119,27 @@ def test_a_step_file_is_read_in_metres_and_takes_no_scale():
         build_part(PartSpec(model='mesh', mesh_path=STEP, scale=0.001, mass=0.002))
 
 
+def test_a_truncated_or_foreign_step_file_is_named_and_nothing_else_is_printed(tmp_path, capfd):
+    with open(STEP, 'rb') as f:
+        whole = f.read()
+    cut = tmp_path / 'cut.step'
+    cut.write_bytes(whole[:len(whole) // 3])
+    with pytest.raises(MeshError) as err:
+        build_part(PartSpec(model='mesh', mesh_path=str(cut), mass=0.002))
+    text = str(err.value)
+    assert text.startswith(f'part.mesh_path: {str(cut)!r} is not a readable STEP file: '
+                           'OpenCASCADE says ')
+    assert 'Line ' in text and 'truncated' in text
+    assert 'converted' not in text and 'Errno' not in text       # nothing of our temporaries
+    printed = capfd.readouterr()
+    assert 'Failed to read STEP' not in printed.out + printed.err    # OpenCASCADE's own lines
+    other = tmp_path / 'notes.step'
+    other.write_text('solid part\nendsolid\n')
+    with pytest.raises(MeshError, match="is not a STEP file: it does not begin with "
+                       "ISO-10303-21; \\(it begins b'solid part"):
+        build_part(PartSpec(model='mesh', mesh_path=str(other), mass=0.002))
+
+
 @pytest.mark.parametrize('size, wrong', [(0.0004, True), (0.0006, False), (0.29, False),
                                          (0.31, True)])
 def test_a_mesh_part_outside_sane_sizes_is_refused(tmp_path, size, wrong):

@@ -3,7 +3,12 @@ triangle mesh in metres: the file's units (stated by STEP and glTF, given by the
 `units` or `mesh_scale` for the others), and the checks that catch a wrong unit or a broken
 file before anything collides it."""
 
+from collections.abc import Callable
 import os
+import re
+import sys
+import tempfile
+from typing import Any
 
 import numpy as np
 import trimesh
@@ -16,12 +21,66 @@ MAX_MESH_FACES = 500_000
 # are wrong far more likely than the part is that small or large (a mm file read as metres is
 # 1000 times too big, a metre file scaled as mm 1000 times too small).
 MESH_EXTENT = (0.0005, 0.3)
+STEP_SUFFIXES = ('.step', '.stp')
 
 
 def fitting_units(extent: float) -> list[str]:
     """The units (of UNITS) in which a mesh `extent` across, in the file's own numbers, is a
     part of sane size (MESH_EXTENT)."""
     return [u for u, s in UNITS.items() if MESH_EXTENT[0] <= extent * s <= MESH_EXTENT[1]]
+
+
+def _read(path: str) -> trimesh.Geometry:
+    """The file as trimesh reads it; MeshError naming what is wrong with it. A STEP file is
+    converted by OpenCASCADE (cascadio), which prints its own errors on the process's standard
+    streams and leaves trimesh to open a converted file that is not there: its output is kept
+    off the terminal, and its first complaint is given in our error."""
+    if not path.lower().endswith(STEP_SUFFIXES):
+        try:
+            return trimesh.load(path, force='mesh', process=False)
+        except Exception as exc:  # trimesh raises many types for a bad file
+            raise MeshError('part.mesh_path', path,
+                            f'could not be read as a mesh: {exc}') from None
+    with open(path, 'rb') as f:
+        head = f.read(64)
+    if not head.lstrip().startswith(b'ISO-10303-21'):
+        raise MeshError('part.mesh_path', path, 'is not a STEP file: it does not begin with '
+                        f'ISO-10303-21; (it begins {head[:20]!r})')
+    loaded, failed, said = _quietly(lambda: trimesh.load(path, force='mesh', process=False))
+    if failed is None:
+        return loaded
+    plain = re.sub(r'\x1b\[[0-9;]*m', '', said)          # the terminal's colours
+    complaint = next((line.strip(' *') for line in plain.splitlines()
+                      if 'ERR' in line or 'Line' in line), '').strip()
+    raise MeshError('part.mesh_path', path, 'is not a readable STEP file'
+                    + (f': OpenCASCADE says {complaint!r}' if complaint else
+                       ' (OpenCASCADE could not convert it)')
+                    + '; is it whole (a truncated or partly written file)?')
+
+
+def _quietly(read: Callable[[], Any]) -> tuple[Any, Exception | None, str]:
+    """read() with the whole process's standard output and error (C libraries' included) kept
+    in a temporary file: (its result or None, the exception it raised or None, what was
+    written)."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    result, failed = None, None
+    with tempfile.TemporaryFile() as sink:
+        saved = [os.dup(1), os.dup(2)]
+        try:
+            os.dup2(sink.fileno(), 1)
+            os.dup2(sink.fileno(), 2)
+            try:
+                result = read()
+            except Exception as exc:
+                failed = exc
+        finally:
+            os.dup2(saved[0], 1)
+            os.dup2(saved[1], 2)
+            for fd in saved:
+                os.close(fd)
+        sink.seek(0)
+        return result, failed, sink.read().decode(errors='replace')
 
 
 def load_mesh(path: str, scale: float) -> trimesh.Trimesh:
@@ -41,10 +100,7 @@ def load_mesh(path: str, scale: float) -> trimesh.Trimesh:
     if states_units(path) and scale != 1.0:
         raise MeshError('part.scale', scale, f'must be 1 for {os.path.basename(path)}: the '
                         'file states its units, and it is read in metres')
-    try:
-        loaded = trimesh.load(path, force='mesh', process=False)
-    except Exception as exc:  # trimesh raises many types for a bad file
-        raise MeshError('part.mesh_path', path, f'could not be read as a mesh: {exc}') from None
+    loaded = _read(path)
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
         raise MeshError('part.mesh_path', path, 'holds no triangles')
     if states_units(path) and loaded.units not in (None, 'm', 'meters'):
