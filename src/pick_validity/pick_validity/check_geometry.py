@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import fcl
 import numpy as np
+from pick_common.errors import InvalidArgument
 from pick_common.parts.geometry import build_part, PartGeometry
 
 from .config import (
@@ -20,7 +21,9 @@ from .config import (
     CheckConfig,
     Grasp,
     Gripper,
+    is_suction,
     Setup,
+    SuctionCup,
     tilts,
 )
 from .geometry import (
@@ -31,8 +34,10 @@ from .geometry import (
     part_shapes,
     rotations_about_x,
     Shape,
+    suction_shapes,
 )
 from .grasp_fit import check_grasps_fit, GraspFit, round_axis
+from .suction import Holding, holding, Seal, seal
 
 
 @dataclass(frozen=True, eq=False)
@@ -58,6 +63,16 @@ class CheckGeometry:
     gripper_shapes: tuple[tuple[Shape, Shape], ...]
     gripper_objects: tuple[tuple[fcl.CollisionObject, ...], ...]
     free_axes: np.ndarray
+    # a suction cup's: per grasp, its seal and holding (suction.seal, suction.holding); and
+    # per grasp whether the check may use it (a suction grasp that seals and holds; every
+    # jaws' grasp)
+    seals: tuple[Seal, ...] = ()
+    holds: tuple[Holding, ...] = ()
+    usable: np.ndarray | None = None
+
+    @property
+    def suction(self) -> bool:
+        return is_suction(self.gripper)
 
 
 def build_geometry(setup: Setup, part: PartGeometry | None = None) -> CheckGeometry:
@@ -66,7 +81,9 @@ def build_geometry(setup: Setup, part: PartGeometry | None = None) -> CheckGeome
     setup or a grasp whose jaws cannot close on the part (grasp_fit)."""
     part = part if part is not None else build_part(setup.part)
     gripper = check_gripper(setup.gripper)
-    grasps = tuple(check_grasps(list(setup.grasps)))
+    grasps = tuple(check_grasps(list(setup.grasps), gripper))
+    if is_suction(gripper):
+        return _suction_geometry(setup, part, gripper, grasps)
     fits = check_grasps_fit(part, setup.grasps)
     place_axis, seat_offset = check_place(setup.place)
     angles = tilts(setup.config)
@@ -104,3 +121,31 @@ def _free_axis(part: PartGeometry, shapes: tuple[Shape, ...], grasp: Grasp) -> n
                 and np.linalg.norm(off - (off @ axis) * axis) < 1e-9):
             return axis.copy()
     return np.zeros(3)
+
+
+def _suction_geometry(setup: Setup, part: PartGeometry, cup: SuctionCup,
+                      grasps: tuple[Grasp, ...]) -> CheckGeometry:
+    """A suction cup's: one approach per grasp, along minus its up axis (the cup is round, so
+    no wrist tilt: `tilts` is [0]); the cup and body as the gripper's shapes; each grasp's
+    seal and holding. Raises InvalidArgument when no grasp both seals and holds, naming
+    each grasp's reason."""
+    tilts(setup.config)                                     # the settings are checked all the same
+    place_axis, seat_offset = check_place(setup.place)
+    seals = tuple(seal(part, cup, g) for g in grasps)
+    holds = tuple(holding(part, cup, g) for g in grasps)
+    usable = np.array([s.ok and h.ok for s, h in zip(seals, holds, strict=True)])
+    if not usable.any():
+        why = '; '.join(f'{g.name!r}: ' + (s.reason or f'holds with a margin of only '
+                                              f'{h.margin:.2f}')
+                        for g, s, h in zip(grasps, seals, holds, strict=True))
+        raise InvalidArgument('grasps', [g.name for g in grasps],
+                              f'hold no grasp the cup can use: {why}')
+    cups = tuple(suction_shapes(cup) for _ in grasps)
+    zero = np.zeros(1)
+    return CheckGeometry(
+        part=part, config=setup.config, gripper=cup, grasps=grasps, grasp_fits=(),
+        tilts=zero, tilt_rotations=rotations_about_x(zero), place_axis=place_axis,
+        seat_offset=seat_offset, part_shapes=part_shapes(part),
+        finger_depths=tuple(0.0 for _ in grasps), gripper_shapes=cups,
+        gripper_objects=tuple(tuple(s.fcl_object() for s in pair) for pair in cups),
+        free_axes=np.zeros((len(grasps), 3)), seals=seals, holds=holds, usable=usable)

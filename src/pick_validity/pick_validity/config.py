@@ -31,6 +31,12 @@ LIMITS = {
     'check.tilt_step': Limit(math.radians(0.1), math.pi),
     'check.approach_cone': Limit(0.0, math.pi / 2, low_open=True),
     'check.rim_tolerance': Limit(0.0, 1.0),
+    'gripper.cup_diameter': Limit(0.0, 0.5, low_open=True),
+    'gripper.cup_height': Limit(0.0, 0.5, low_open=True),
+    'gripper.vacuum': Limit(0.0, 101_325.0, low_open=True),     # Pa below the atmosphere
+    'gripper.safety_factor': Limit(1.0, 10.0),
+    'gripper.acceleration': Limit(0.0, 1000.0),
+    'gripper.cup_friction': Limit(0.0, 2.0, low_open=True),
 }
 
 
@@ -56,6 +62,53 @@ class Gripper:
     jaw_height: float = 0.015
     jaw_depth: float = 0.006
     finger_clearance: float = 0.001
+
+
+@dataclass(frozen=True)
+class SuctionCup:
+    """A single suction cup on a body (the paper's further work: "other kinds of grippers,
+    such as vacuum"). m, Pa, m/s^2.
+
+    cup_diameter and cup_height: the cup's rim and how high its lip (or bellows) stands above
+    the rim to the body; the cup approaches along minus the grasp's up axis and seals when its
+    rim lies on the part all round (`suction.seal`). body_diameter and body_length: the
+    cylinder above the cup. vacuum: the pressure below the atmosphere the cup holds at;
+    safety_factor, acceleration (the robot's, horizontal) and cup_friction (cup on part) set
+    the force the cup must hold (`suction.holding`). Defaults and their sources: VACUUM_SOURCE.
+    """
+
+    cup_diameter: float = 0.004
+    cup_height: float = 0.003
+    body_diameter: float = 0.010
+    body_length: float = 0.060
+    vacuum: float = 60_000.0
+    safety_factor: float = 2.0
+    acceleration: float = 10.0
+    cup_friction: float = 0.5
+
+
+# Where the suction cup's defaults come from.
+VACUUM_SOURCE = (
+    'vacuum 60 kPa: Schmalz, glossary "Holding force" (a cup\'s holding force is usually '
+    'stated at 60 % vacuum); safety factor 2 and cup friction 0.5: Schmalz, "Theoretical '
+    'holding force of a suction cup" (S at least 1.5 for smooth, dense workpieces, 2.0 or more '
+    'for critical ones; mu 0.5 for metal, glass, stone); cup 4 x 3 mm, body 10 x 60 mm and the '
+    "robot's acceleration 10 m/s^2: assumed")
+
+
+@dataclass(frozen=True)
+class SuctionGrasp:
+    """A suction grasp, in the part frame: up_axis must point along world +Z; grasp_point,
+    m, is the point on the part's surface where the cup's centre touches, the cup approaching
+    along minus up_axis."""
+
+    name: str
+    up_axis: tuple[float, float, float]
+    grasp_point: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+def is_suction(gripper: 'Gripper | SuctionCup') -> bool:
+    return isinstance(gripper, SuctionCup)
 
 
 @dataclass(frozen=True)
@@ -124,8 +177,8 @@ class Setup:
     the check's settings. Checked when a Validator is built from it."""
 
     part: PartSpec = PartSpec()
-    gripper: Gripper = Gripper()
-    grasps: tuple[GraspPose, ...] = CAPACITOR_GRASPS
+    gripper: Gripper | SuctionCup = Gripper()
+    grasps: tuple[GraspPose, ...] | tuple[SuctionGrasp, ...] = CAPACITOR_GRASPS
     place: PlaceSpec = PlaceSpec()
     config: CheckConfig = CheckConfig()
 
@@ -154,21 +207,50 @@ def _unit(field_name: str, values) -> np.ndarray:
     return v / norm
 
 
-def check_gripper(gripper: Gripper) -> Gripper:
-    for name in ('body_diameter', 'body_length', 'jaw_height', 'jaw_depth', 'finger_clearance'):
+JAW_FIELDS = ('body_diameter', 'body_length', 'jaw_height', 'jaw_depth', 'finger_clearance')
+SUCTION_FIELDS = ('cup_diameter', 'cup_height', 'body_diameter', 'body_length', 'vacuum',
+                  'safety_factor', 'acceleration', 'cup_friction')
+
+
+def check_gripper(gripper: Gripper | SuctionCup) -> Gripper | SuctionCup:
+    for name in SUCTION_FIELDS if is_suction(gripper) else JAW_FIELDS:
         LIMITS[f'gripper.{name}'].check(f'gripper.{name}', getattr(gripper, name))
     return gripper
 
 
-def check_grasps(grasps: list[GraspPose] | tuple[GraspPose, ...]) -> tuple[Grasp, ...]:
-    """Check every grasp pose; orthogonalise the closing axis against the up axis."""
+def _perpendicular(up: np.ndarray) -> np.ndarray:
+    """A unit vector at right angles to `up`: the part axis least along it, made square."""
+    axis = np.eye(3)[int(np.argmin(np.abs(up)))]
+    axis = axis - (axis @ up) * up
+    return axis / np.linalg.norm(axis)
+
+
+def check_grasps(grasps: list[GraspPose] | tuple[GraspPose, ...] | tuple[SuctionGrasp, ...],
+                 gripper: Gripper | SuctionCup | None = None) -> tuple[Grasp, ...]:
+    """Check every grasp pose; orthogonalise the closing axis against the up axis. A jaws'
+    grasp with a suction cup, or the reverse, is refused. A suction grasp's closing axis is a
+    fixed one at right angles to its up axis (the gripper frame's x; the cup is round) and
+    its jaw opening the cup's diameter."""
     if not 1 <= len(grasps) <= MAX_GRASPS:
         raise InvalidArgument('grasps', len(grasps), f'must hold 1..{MAX_GRASPS} grasp poses')
+    suction = gripper is not None and is_suction(gripper)
     out = []
     for i, g in enumerate(grasps):
         # Named as the node's parameters are (grasps.<name>.up_axis) when the grasp has a name.
         where = f'grasps.{g.name}' if g.name else f'grasps[{i}]'
+        if gripper is not None and isinstance(g, SuctionGrasp) != suction:
+            raise InvalidArgument(
+                where, g.name, f'is a {"suction" if isinstance(g, SuctionGrasp) else "jaws"} '
+                f'grasp, and the gripper is {"a suction cup" if suction else "parallel jaws"}: '
+                + ('give up_axis and grasp_point (no closing_axis, no jaw_opening)' if suction
+                   else 'give closing_axis and jaw_opening, or a suction gripper'))
         up = _unit(f'{where}.up_axis', g.up_axis)
+        if isinstance(g, SuctionGrasp):
+            point = np.array(check_vector(f'{where}.grasp_point', g.grasp_point, 3,
+                                          low=-1.0, high=1.0))
+            opening = gripper.cup_diameter if suction else 0.0
+            out.append(Grasp(g.name or f'grasp_{i}', up, _perpendicular(up), opening, point))
+            continue
         closing = _unit(f'{where}.closing_axis', g.closing_axis)
         angle = math.acos(min(1.0, abs(float(up @ closing))))
         if angle < PARALLEL_LIMIT:

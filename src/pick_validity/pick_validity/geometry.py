@@ -18,7 +18,7 @@ from pick_common.parts.primitives import Box, Cylinder
 from scipy.spatial import Delaunay
 import trimesh
 
-from .config import Gripper
+from .config import Gripper, SuctionCup
 
 
 @dataclass(frozen=True, eq=False)
@@ -120,6 +120,18 @@ def gripper_shapes(gripper: Gripper, opening: float, depth: float
                          fcl.Cylinder(gripper.body_diameter / 2, length),
                          gripper.body_diameter / 2, length / 2)
     return jaws, body
+
+
+def suction_shapes(cup: SuctionCup) -> tuple[CylinderShape, CylinderShape]:
+    """The cup (diameter cup_diameter, from its rim at the grasp point up cup_height) and
+    the body cylinder above it, in the gripper frame: origin at the grasp point, z up the
+    gripper (the grasp's up axis)."""
+    r, h, length = cup.cup_diameter / 2, cup.cup_height, cup.body_length
+    lip = CylinderShape(np.eye(3), np.array([0.0, 0.0, h / 2]), fcl.Cylinder(r, h), r, h / 2)
+    body = CylinderShape(np.eye(3), np.array([0.0, 0.0, h + length / 2]),
+                         fcl.Cylinder(cup.body_diameter / 2, length), cup.body_diameter / 2,
+                         length / 2)
+    return lip, body
 
 
 def contains(shape: Shape, point: np.ndarray) -> bool:

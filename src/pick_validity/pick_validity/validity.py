@@ -134,6 +134,9 @@ class Validator:
         closing = np.stack([g.closing for g in self.grasps])[grasp_index]
         up = np.stack([g.up for g in self.grasps])[grasp_index]
         x = np.einsum('nij,nj->ni', rotations, closing)
+        if self.suction:        # the cup's axis is the grasp's up axis; no tilt
+            z = np.einsum('nij,nj->ni', rotations, up)
+            return np.stack([x, np.cross(z, x), z], axis=-1)[:, None] @ self.tilt_rotations[None]
         z = np.array([0.0, 0.0, 1.0]) - x[:, 2:3] * x
         norm = np.linalg.norm(z, axis=1)
         flat = norm < 1e-9         # a vertical closing axis: no approach within any cone
@@ -188,8 +191,12 @@ class Validator:
                 container, centres[n], self.config.rim_tolerance))
         inner = [row for row, ok in zip(rows, located, strict=True) if ok]
 
-        # 1. candidacy, vectorised over targets and grasps (turned on round bodies).
+        # 1. candidacy, vectorised over targets and grasps (turned on round bodies); a
+        # suction grasp that does not seal or hold is never chosen.
         angles, turns = self.turned(rotations[inner])                   # (n, G)
+        if self.usable is not None:
+            unusable = angles[:, ~self.usable]
+            angles = np.where(self.usable, angles, math.pi)
         best = nearest_grasp(angles, turns)
         frames = self.approach_frames(rotations[inner], best, turns)    # (n, T, 3, 3)
         approach = self._approachable(frames)
@@ -205,6 +212,8 @@ class Validator:
                 result.grasp_index = -1
                 result.reason = (f'no grasp pose within {_deg(self.config.tolerance)} of +Z: '
                                  f'the nearest, {self.grasps[g].name!r}, is at {_deg(angle)}')
+                if self.usable is not None and (unusable[n] <= self.config.tolerance).any():
+                    result.reason += self._unusable_near(unusable[n])
                 continue
             if not approach[n].any():
                 rise = math.asin(min(1.0, abs(float(frames[n, 0, 2, 0]))))
@@ -241,6 +250,15 @@ class Validator:
                                    positions[row])
         return Report([results[row] for row in rows], neighbour_check, queries,
                       time.perf_counter() - start)
+
+    def _unusable_near(self, angles: np.ndarray) -> str:
+        """Why the suction grasps within the tolerance (`angles` over the unusable ones, in
+        their order) were not used."""
+        return ''.join(
+            f'; {self.grasps[k].name!r} at {_deg(a)} does not '
+            + ('seal' if not self.seals[k].ok else 'hold')
+            for k, a in zip(np.flatnonzero(~self.usable), angles, strict=True)
+            if a <= self.config.tolerance)
 
     def _close(self, pairs: Pairs, hit: np.ndarray, kept: dict[int, np.ndarray],
                results: dict[int, PartResult], stage: int, why: str,

@@ -27,6 +27,7 @@ from pick_validity.config import (
     check_gripper,
     check_place,
     Gripper,
+    is_suction,
     Setup,
     tilts,
 )
@@ -298,10 +299,12 @@ def parse(text: str, path: str = '') -> ExperimentFile:
 
     top = read(schema.FileKeys, data, '')
     s = {key: read(model, data.get(key, {}), key) for key, model in schema.SECTIONS.items()}
-    read_part = checked(lambda: part_section.read_part(s['part'], s['materials'], base_dir)
+    gripper = sections.gripper(s['gripper']) if s['gripper'] else None
+    suction = is_suction(gripper)
+    read_part = checked(lambda: part_section.read_part(s['part'], s['materials'], base_dir,
+                                                       suction)
                         ) if s['part'] and s['materials'] else None
     part, grasps, place = read_part or (None, None, None)
-    gripper = sections.gripper(s['gripper']) if s['gripper'] else None
     check = sections.check(s['check']) if s['check'] else None
     requirements = sections.requirements(s['requirements']) if s['requirements'] else None
     tray = checked(lambda: sections.tray(top)) if top else None
@@ -320,7 +323,10 @@ def parse(text: str, path: str = '') -> ExperimentFile:
             else None
     if grasps is not None:
         checked(lambda: checked_as(check_grasps, list(grasps), 'part.grasps'))
-    if geometry is not None and grasps is not None:
+    if None not in (geometry, grasps, gripper, check) and suction:
+        checked(lambda: part_section.check_cup(geometry, Setup(part, gripper, grasps, place,
+                                                                check)))
+    elif geometry is not None and grasps is not None:
         checked(lambda: part_section.check_fits(geometry, grasps))
     context = None
     if None not in (top, geometry, tray, moves, requirements, gripper, grasps, check):

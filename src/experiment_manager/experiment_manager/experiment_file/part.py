@@ -9,9 +9,18 @@ from pick_common.errors import InvalidArgument
 from pick_common.parts.geometry import build_part, PartGeometry
 from pick_common.parts.materials import body_values, Contact, DEFAULT_BASIS, SOURCE
 from pick_common.parts.spec import PartSpec, states_units, UNITS
-from pick_validity.config import CAPACITOR_GRASPS, GraspPose, PlaceSpec
+from pick_validity.check_geometry import build_geometry
+from pick_validity.config import (
+    CAPACITOR_GRASPS,
+    check_grasps,
+    GraspPose,
+    PlaceSpec,
+    Setup,
+    SuctionGrasp,
+)
 from pick_validity.grasp_fit import check_grasps_fit
 from pick_validity.grasp_proposals import propose
+from pick_validity.suction import OFF_SURFACE, seal
 
 from . import schema
 from .model import G, MM
@@ -77,10 +86,12 @@ def material_account(m: schema.MaterialsSection
     return tuple(out)
 
 
-def read_part(p: schema.Part, m: schema.MaterialsSection, base_dir: str
-              ) -> tuple[PartSpec, tuple[GraspPose, ...] | str, PlaceSpec]:
+def read_part(p: schema.Part, m: schema.MaterialsSection, base_dir: str, suction: bool = False
+              ) -> tuple[PartSpec, tuple[GraspPose, ...] | tuple[SuctionGrasp, ...] | str,
+                         PlaceSpec]:
     """The part's spec (its contact materials from `m`), its grasps (AUTO when the file
-    leaves them to `proposed`) and its placing, in SI units."""
+    leaves them to `proposed`; a suction cup's when `suction`) and its placing, in SI
+    units."""
     mesh, scale, mass = '', 1.0, G * p.mass_g
     if p.model == 'mesh':
         if mass == 0.0:
@@ -115,17 +126,56 @@ def read_part(p: schema.Part, m: schema.MaterialsSection, base_dir: str
     body_values(spec.part_on_surface, spec.part_on_part)     # a pair Bullet cannot apply
     place = PlaceSpec(place_axis=p.place.axis, seat_offset=MM * p.place.seat_offset_mm)
     if p.grasps is None:
+        if suction:
+            raise InvalidArgument('part.grasps', None, 'is required with a suction cup (the '
+                                  "default grasps are jaws' for a capacitor): give each "
+                                  "grasp's up_axis and grasp_point_mm, or auto")
         return spec, CAPACITOR_GRASPS, place
     if p.grasps == AUTO:
         return spec, AUTO, place
-    grasps = tuple(GraspPose(
-        name=g.name if g.name is not None else f'grasp_{i}', up_axis=g.up_axis,
-        closing_axis=g.closing_axis, jaw_opening=MM * g.jaw_opening_mm,
-        grasp_point=tuple(MM * v for v in g.grasp_point_mm)) for i, g in enumerate(p.grasps))
+    grasps = tuple(_grasp(g, i, suction) for i, g in enumerate(p.grasps))
     names = [g.name for g in grasps]
     if len(set(names)) != len(names):
         raise InvalidArgument('part.grasps', names, 'has a grasp name twice')
     return spec, grasps, place
+
+
+def _grasp(g: schema.GraspEntry, i: int, suction: bool) -> GraspPose | SuctionGrasp:
+    """One entry of part.grasps as the gripper's type reads it: a suction grasp gives no
+    closing_axis and no jaw_opening_mm, a jaws' grasp both."""
+    name = g.name if g.name is not None else f'grasp_{i}'
+    point = tuple(MM * v for v in g.grasp_point_mm)
+    jaws_keys = [k for k in ('closing_axis', 'jaw_opening_mm') if getattr(g, k) is not None]
+    if suction:
+        if jaws_keys:
+            raise InvalidArgument(f'part.grasps[{i}].{jaws_keys[0]} (grasp {name!r})',
+                                  getattr(g, jaws_keys[0]), "is a jaws' key, and the "
+                                  'gripper is type: suction (a suction grasp is up_axis and '
+                                  "grasp_point_mm: where the cup's centre touches)")
+        return SuctionGrasp(name=name, up_axis=g.up_axis, grasp_point=point)
+    missing = [k for k in ('closing_axis', 'jaw_opening_mm') if getattr(g, k) is None]
+    if missing:
+        raise InvalidArgument(f'part.grasps[{i}].{missing[0]} (grasp {name!r})', None,
+                              'is required with parallel jaws (gripper.type: jaws); a grasp '
+                              "without it is a suction cup's: set gripper.type: suction")
+    return GraspPose(name=name, up_axis=g.up_axis, closing_axis=g.closing_axis,
+                     jaw_opening=MM * g.jaw_opening_mm, grasp_point=point)
+
+
+def check_cup(geometry: PartGeometry, setup: Setup) -> None:
+    """A suction cup's grasps: each one's point lies on the part's surface, named by its
+    place in the file; at least one seals and holds (build_geometry names each one's
+    reason)."""
+    cup, grasps = setup.gripper, setup.grasps
+    for i, (g, c) in enumerate(zip(grasps, check_grasps(grasps, cup), strict=True)):
+        found = seal(geometry, cup, c)
+        if found.reason.startswith(OFF_SURFACE):
+            raise InvalidArgument(f'part.grasps[{i}].grasp_point_mm (grasp {g.name!r})',
+                                  [round(v / MM, 3) for v in g.grasp_point], found.reason)
+    try:
+        build_geometry(setup, geometry)
+    except InvalidArgument as exc:
+        raise InvalidArgument(f'part.{exc.field}', exc.value, exc.rule) from None
 
 
 def proposed(geometry: PartGeometry) -> tuple[GraspPose, ...]:

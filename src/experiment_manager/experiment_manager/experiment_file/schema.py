@@ -22,7 +22,7 @@ from pick_common.specs import (
     MAX_SEED,
     MOVES,
 )
-from pick_validity.config import CheckConfig, Gripper
+from pick_validity.config import CheckConfig, Gripper, SuctionCup
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator, WrapValidator
 
 from .model import (
@@ -64,10 +64,14 @@ class Place(Section):
 
 
 class GraspEntry(Section):
+    """A jaws' grasp (up_axis, closing_axis, jaw_opening_mm, grasp_point_mm) or a suction
+    cup's (up_axis, grasp_point_mm: where the cup's centre touches); which, the gripper's
+    type says (the loader checks)."""
+
     name: Text() | None = None                         # default grasp_<index>
     up_axis: Vector(3)
-    closing_axis: Vector(3)
-    jaw_opening_mm: Number(0.0, low_open=True)
+    closing_axis: Vector(3) | None = None
+    jaw_opening_mm: Number(0.0, low_open=True) | None = None
     grasp_point_mm: Vector(3) = (0.0, 0.0, 0.0)
 
 
@@ -159,14 +163,42 @@ GRIPPER_KEYS = (('body_diameter_mm', 'body_diameter'), ('body_length_mm', 'body_
                 ('finger_clearance_mm', 'finger_clearance'))
 
 
-class GripperSection(Section):
-    """The simplified gripper, mm (its rules are the core's: pick_validity.config)."""
+# A suction cup's keys and the SuctionCup fields they set, with the factor from the file's
+# unit to SI.
+SUCTION_KEYS = (('cup_diameter_mm', 'cup_diameter', MM), ('cup_height_mm', 'cup_height', MM),
+                ('body_diameter_mm', 'body_diameter', MM),
+                ('body_length_mm', 'body_length', MM), ('vacuum_kpa', 'vacuum', 1000.0),
+                ('safety_factor', 'safety_factor', 1.0),
+                ('acceleration_m_s2', 'acceleration', 1.0), ('cup_friction', 'cup_friction', 1.0))
+JAWS_ONLY = ('jaw_height_mm', 'jaw_depth_mm', 'finger_clearance_mm')
+SUCTION_ONLY = tuple(k for k, _, _ in SUCTION_KEYS if not k.startswith('body_'))
 
-    body_diameter_mm: Number() = Gripper.body_diameter / MM
-    body_length_mm: Number() = Gripper.body_length / MM
+
+class GripperSection(Section):
+    """The simplified gripper, mm (its rules are the core's: pick_validity.config): parallel
+    jaws (`type: jaws`, the default) or a suction cup (`type: suction`)."""
+
+    type: Text('jaws', 'suction') = 'jaws'
+    body_diameter_mm: Number() | None = None           # the type's default
+    body_length_mm: Number() | None = None
     jaw_height_mm: Number() = Gripper.jaw_height / MM
     jaw_depth_mm: Number() = Gripper.jaw_depth / MM
     finger_clearance_mm: Number() = Gripper.finger_clearance / MM
+    cup_diameter_mm: Number() = SuctionCup.cup_diameter / MM
+    cup_height_mm: Number() = SuctionCup.cup_height / MM
+    vacuum_kpa: Number() = SuctionCup.vacuum / 1000.0
+    safety_factor: Number() = SuctionCup.safety_factor
+    acceleration_m_s2: Number() = SuctionCup.acceleration
+    cup_friction: Number() = SuctionCup.cup_friction
+
+    @model_validator(mode='after')
+    def _keys_of_its_type(self) -> 'GripperSection':
+        foreign = JAWS_ONLY if self.type == 'suction' else SUCTION_ONLY
+        for key in foreign:
+            if key in self.model_fields_set:
+                fail(f'is a key of {"parallel jaws" if self.type == "suction" else "a suction cup"}'
+                     f', and the gripper is type: {self.type}', getattr(self, key), f'.{key}')
+        return self
 
 
 class CheckSection(Section):

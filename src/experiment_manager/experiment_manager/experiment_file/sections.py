@@ -7,7 +7,7 @@ from dataclasses import replace
 
 from pick_common.containers import check_container, ContainerSpec
 from pick_common.specs import check_vibration, MOVES, Vibration
-from pick_validity.config import CheckConfig, Gripper
+from pick_validity.config import CheckConfig, Gripper, SuctionCup
 
 from . import schema
 from .errors import checked as checked_as
@@ -15,8 +15,15 @@ from .model import DEG, MM, Requirements
 from .schema import GRIPPER_KEYS
 
 
-def gripper(g: schema.GripperSection) -> Gripper:
-    return Gripper(**{attr: MM * getattr(g, key) for key, attr in GRIPPER_KEYS})
+def gripper(g: schema.GripperSection) -> Gripper | SuctionCup:
+    """The section's parallel jaws or suction cup, SI units; a key left out, its type's
+    default."""
+    if g.type == 'suction':
+        return SuctionCup(**{attr: factor * getattr(g, key)
+                             for key, attr, factor in schema.SUCTION_KEYS
+                             if getattr(g, key) is not None})
+    return Gripper(**{attr: MM * getattr(g, key) for key, attr in GRIPPER_KEYS
+                      if getattr(g, key) is not None})
 
 
 def check(c: schema.CheckSection) -> CheckConfig:
