@@ -39,7 +39,7 @@ def _plate_with_a_hole(path, hole_x=(0.6, 1.4), hole_y=(-0.4, 0.4)) -> PartSpec:
              (hole_x[0], hole_y[1])]
     vertices = [(x, y, z) for z in (0.0, -2.0) for x, y in outer + inner]
     faces = []
-    for top, o, i in ((0, 0, 4), (8, 8, 12)):         # the top and bottom annuli
+    for o, i in ((0, 4), (8, 12)):         # the top and bottom annuli
         for k in range(4):
             a, b = o + k, o + (k + 1) % 4
             c, d = i + (k + 1) % 4, i + k
