@@ -59,7 +59,7 @@ BAD = [
     ('colour: red\n' + MINIMAL, r"colour: 'red' is not a known key here \(known: "),
     ('gripper: {body_diameter: 20}\n' + MINIMAL,
      r'gripper\.body_diameter: 20 is not a known key here \(did you mean body_diameter_mm\?\) '
-     r'\(known: body_diameter_mm'),
+     r'\(known: acceleration_m_s2, body_diameter_mm'),
     ('seed: abc\n' + MINIMAL, r"seed: 'abc' is not an integer"),
     ('requirements: {success_rate: 0}\n' + MINIMAL,
      r'requirements\.success_rate: 0 must be > 0'),
@@ -108,7 +108,8 @@ BAD = [
     ('part:\n  grasps:\n    - {up_axis: [0, 0, 1], closing_axis: [0, 0, 2], jaw_opening_mm: 5}\n'
      + MINIMAL, r'part\.grasps \(grasps\.grasp_0\.closing_axis\): .* is parallel to up_axis'),
     ('part:\n  grasps:\n    - {up_axis: [0, 0, 1], closing_axis: [1, 0, 0]}\n' + MINIMAL,
-     r'part\.grasps\[0\]\.jaw_opening_mm: None is required'),
+     r"part\.grasps\[0\]\.jaw_opening_mm \(grasp 'grasp_0'\): None is required with "
+     r'parallel jaws \(gripper\.type: jaws\); a grasp without it is a suction cup'),
     ('moves: [{amplitude_mm: [0, 0, 10], frequency_hz: 50}]\n' + MINIMAL,
      r'moves\[0\] \(vibration\.amplitude\): .* gives a peak acceleration of .* \(limit 200\)'),
     ('moves: [{direction: diagonal}]\n' + MINIMAL,

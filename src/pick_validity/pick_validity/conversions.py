@@ -8,6 +8,7 @@ from geometry_msgs.msg import Point, Vector3
 import numpy as np
 from pick_common import conversions as common
 from pick_common.containers import ContainerSpec
+from pick_common.errors import InvalidArgument
 from pick_msgs.msg import CheckSettings, PartValidity, ValidityReport
 from pick_msgs.msg import GraspPose as GraspPoseMsg
 from pick_msgs.msg import Gripper as GripperMsg
@@ -15,7 +16,17 @@ from pick_msgs.msg import PlaceSpec as PlaceSpecMsg
 from pick_msgs.srv import CheckParts
 from std_msgs.msg import Header
 
-from .config import CheckConfig, GraspPose, Gripper, PlaceSpec, Setup
+from .config import (
+    CheckConfig,
+    GraspPose,
+    Gripper,
+    is_suction,
+    PlaceSpec,
+    Setup,
+    SUCTION_FIELDS,
+    SuctionCup,
+    SuctionGrasp,
+)
 from .results import PartResult, Report
 from .validity import Validator
 
@@ -41,11 +52,20 @@ def setup_from_request(request: CheckParts.Request, defaults: Setup,
     part = common.part_spec_from_msg(request.part_model, mesh_dirs)
     g = request.gripper
     gripper = defaults.gripper
-    if any((g.body_diameter, g.body_length, g.jaw_height, g.jaw_depth)):
+    if g.type == GripperMsg.SUCTION:
+        gripper = SuctionCup(**{name: getattr(g, name) for name in SUCTION_FIELDS})
+    elif g.type != GripperMsg.JAWS:
+        raise InvalidArgument('gripper.type', g.type, f'must be {GripperMsg.JAWS} (jaws) or '
+                              f'{GripperMsg.SUCTION} (suction)')
+    elif any((g.body_diameter, g.body_length, g.jaw_height, g.jaw_depth)):
         gripper = Gripper(g.body_diameter, g.body_length, g.jaw_height, g.jaw_depth,
                           g.finger_clearance)
-    grasps = tuple(GraspPose(m.name, _xyz(m.up_axis), _xyz(m.closing_axis), m.jaw_opening,
-                             _xyz(m.grasp_point)) for m in request.grasps) or defaults.grasps
+    if is_suction(gripper):
+        grasps = tuple(SuctionGrasp(m.name, _xyz(m.up_axis), _xyz(m.grasp_point))
+                       for m in request.grasps) or defaults.grasps
+    else:
+        grasps = tuple(GraspPose(m.name, _xyz(m.up_axis), _xyz(m.closing_axis), m.jaw_opening,
+                                 _xyz(m.grasp_point)) for m in request.grasps) or defaults.grasps
     place = defaults.place
     if any(_xyz(request.place.place_axis)):
         place = PlaceSpec(_xyz(request.place.place_axis), request.place.seat_offset)
@@ -61,11 +81,18 @@ def setup_to_request(setup: Setup, request: CheckParts.Request) -> CheckParts.Re
     """Fill a request's part model, gripper, grasps, placement and settings from a Setup."""
     g, p, c = setup.gripper, setup.place, setup.config
     request.part_model = common.part_spec_to_msg(setup.part)
-    request.gripper = GripperMsg(body_diameter=g.body_diameter, body_length=g.body_length,
-                                 jaw_height=g.jaw_height, jaw_depth=g.jaw_depth,
-                                 finger_clearance=g.finger_clearance)
-    request.grasps = [_grasp_msg(x.name, x.up_axis, x.closing_axis, x.jaw_opening,
-                                 x.grasp_point) for x in setup.grasps]
+    if is_suction(g):
+        request.gripper = GripperMsg(type=GripperMsg.SUCTION,
+                                     **{name: getattr(g, name) for name in SUCTION_FIELDS})
+        request.grasps = [_grasp_msg(x.name, x.up_axis, (0.0, 0.0, 0.0), 0.0, x.grasp_point)
+                          for x in setup.grasps]
+    else:
+        request.gripper = GripperMsg(type=GripperMsg.JAWS, body_diameter=g.body_diameter,
+                                     body_length=g.body_length, jaw_height=g.jaw_height,
+                                     jaw_depth=g.jaw_depth,
+                                     finger_clearance=g.finger_clearance)
+        request.grasps = [_grasp_msg(x.name, x.up_axis, x.closing_axis, x.jaw_opening,
+                                     x.grasp_point) for x in setup.grasps]
     request.place = PlaceSpecMsg(place_axis=Vector3(x=p.place_axis[0], y=p.place_axis[1],
                                                     z=p.place_axis[2]),
                                  seat_offset=p.seat_offset)

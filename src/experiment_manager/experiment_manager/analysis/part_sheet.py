@@ -22,6 +22,7 @@ from pick_common.parts.aspects import part_aspects
 from pick_common.parts.geometry import build_part
 from pick_common.parts.primitives import Hull
 from pick_common.parts.spec import states_units
+from pick_validity.config import VACUUM_SOURCE
 from pick_validity.geometry import BoxShape, CylinderShape, part_shapes, place, Shape, support
 from pick_validity.grasp_proposals import as_yaml, JAW_MARGIN, Proposal
 from pick_validity.validity import Validator
@@ -88,17 +89,15 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
                  "outward normal of its face in the file's frame and its quasi-static share:")
     lines += [f'    {a.name}: ({", ".join(f"{v:.2f}" for v in a.normal)}), '
               f'{100 * a.quasi_static:.1f} %' for a in part_aspects(part)]
-    for g, fit, axis in zip(file.grasps, checks.grasp_fits, checks.free_axes, strict=True):
-        what = fit.problem() or (f'closes on {fit.width * MM:.2f} mm of part '
-                                 f'({-fit.span[0] * MM:.2f} and {fit.span[1] * MM:.2f} mm '
-                                 f'either side of the grasp point)')
-        away = np.linalg.norm(np.asarray(g.grasp_point) - centre) * MM
-        roll = (f'; round there, so it grips at any roll about {np.round(axis, 3).tolist()}'
-                if axis.any() else '; fixed to the part (not across a round body)')
-        lines.append(f'  grasp {g.name!r}: jaws open {g.jaw_opening * MM:.2f} mm at '
-                     f'({", ".join(f"{v * MM:.2f}" for v in g.grasp_point)}) mm, '
-                     f'{away:.2f} mm from the mass centre, up {list(g.up_axis)}, closing '
-                     f'{list(g.closing_axis)}: {what}{roll}')
+    if checks.suction:
+        cup = checks.gripper
+        lines.append(f'  gripper: a suction cup {cup.cup_diameter * MM:g} mm across and '
+                     f'{cup.cup_height * MM:g} mm high on a {cup.body_diameter * MM:g} x '
+                     f'{cup.body_length * MM:g} mm body, {cup.vacuum / 1000:g} kPa, safety '
+                     f'factor {cup.safety_factor:g}, {cup.acceleration:g} m/s^2, cup friction '
+                     f'{cup.cup_friction:g} (defaults: {VACUUM_SOURCE})')
+    for figures in grasp_figures(file, checks):
+        lines.append(_grasp_line(figures))
     if file.auto_grasps:
         lines.append('  the grasps are part.grasps: auto, proposed from the geometry (across '
                      'opposed faces and round bodies at the mass centre, jaws '
@@ -108,6 +107,73 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
                                                               strict=True))
         lines += ['  ' + line for line in as_yaml(used)]
     return lines
+
+
+def grasp_figures(file: ExperimentFile, checks: Validator) -> list[dict]:
+    """Per grasp, what the check computed of it before any scene, mm: for jaws what they
+    close on and whether they turn on a round body; for a suction cup its seal (true or
+    false, the reason), the rim's deviation from a plane against the cup's give, the force
+    margin and the distance of the grasp point from the mass centre's line."""
+    part = checks.part
+    centre = part.mass_frame[0] if part.mass_frame is not None else np.zeros(3)
+    out = []
+    for k, (g, grasp) in enumerate(zip(file.grasps, checks.grasps, strict=True)):
+        item = {'name': g.name, 'up_axis': [float(v) for v in g.up_axis],
+                'grasp_point_mm': [round(float(v) * MM, 3) for v in g.grasp_point],
+                'from_mass_centre_mm': round(float(np.linalg.norm(grasp.point - centre)) * MM,
+                                             3)}
+        if checks.suction:
+            found, held = checks.seals[k], checks.holds[k]
+            item.update({
+                'gripper': 'suction', 'seal': found.ok, 'reason': found.reason,
+                'deviation_mm': None if np.isnan(found.deviation) else
+                round(found.deviation * MM, 4), 'give_mm': round(found.give * MM, 4),
+                'holding_force_n': round(held.force, 4), 'needed_n': round(held.needed, 4),
+                'force_margin': round(held.margin, 3), 'holds': held.ok,
+                'off_axis_mm': round(held.offset * MM, 3),
+                'used': bool(checks.usable[k])})
+        else:
+            fit, axis = checks.grasp_fits[k], checks.free_axes[k]
+            item.update({
+                'gripper': 'jaws', 'closing_axis': [float(v) for v in g.closing_axis],
+                'jaw_opening_mm': round(g.jaw_opening * MM, 3),
+                'problem': fit.problem(), 'closes_on_mm': round(fit.width * MM, 3),
+                'span_mm': None if fit.span is None else [round(-fit.span[0] * MM, 3),
+                                                          round(fit.span[1] * MM, 3)],
+                'round_axis': [round(float(v), 3) for v in axis] if axis.any() else None})
+        out.append(item)
+    return out
+
+
+def _grasp_line(f: dict) -> str:
+    at = (f'at ({", ".join(f"{v:.2f}" for v in f["grasp_point_mm"])}) mm, '
+          f'{f["from_mass_centre_mm"]:.2f} mm from the mass centre, up {f["up_axis"]}')
+    if f['gripper'] == 'suction':
+        seal = ('seals: its rim and the surface inside lie within '
+                f'{f["deviation_mm"]:.2f} mm of a plane (the cup gives {f["give_mm"]:.2f})'
+                if f['seal'] else f'does not seal: {f["reason"]}')
+        force = (f'holds {f["holding_force_n"]:.3f} N against {f["needed_n"]:.3f} N needed, '
+                 f'margin {f["force_margin"]:.2f} with the moment of the mass centre '
+                 f'{f["off_axis_mm"]:.2f} mm off the cup\'s axis'
+                 + ('' if f['holds'] else ': does not hold'))
+        used = '' if f['used'] else '; never used by the check'
+        return f'  grasp {f["name"]!r}: cup {at}: {seal}; {force}{used}'
+    what = f['problem'] or (f'closes on {f["closes_on_mm"]:.2f} mm of part '
+                            f'({f["span_mm"][0]:.2f} and {f["span_mm"][1]:.2f} mm either side '
+                            'of the grasp point)')
+    roll = (f'; round there, so it grips at any roll about {f["round_axis"]}'
+            if f['round_axis'] else '; fixed to the part (not across a round body)')
+    return (f'  grasp {f["name"]!r}: jaws open {f["jaw_opening_mm"]:.2f} mm {at}, closing '
+            f'{f["closing_axis"]}: {what}{roll}')
+
+
+def write_check(file: ExperimentFile, checks: Validator, path: str) -> str:
+    """`run --check --output DIR`'s DIR/check.json: the part's account (describe's lines)
+    and, per grasp, its figures and verdicts (grasp_figures)."""
+    with open(path, 'w', encoding='utf-8') as f:
+        json.dump({'file': file.path, 'part': describe(file, checks),
+                   'grasps': grasp_figures(file, checks)}, f, indent=1)
+    return path
 
 
 def _hull_volume(primitive) -> float:
@@ -231,8 +297,17 @@ def write(checks: Validator, path: str) -> str:
             mesh = _shape_mesh(shape, shape.rotation, shape.center)
             _draw(ax, mesh, np.eye(3), '#4c72b0', 0.25)
             points.append(mesh.vertices.T)
-        _frame(ax, np.hstack(points).T * MM, f'{grasp.name}: pick\njaws {grasp.jaw_opening * MM:g}'
-               f' mm, fingertips {validator.finger_depths[g] * MM:.1f} mm below the point')
+        if validator.suction:       # the rim where it touches the part: green seals
+            found = validator.seals[g]
+            rim = (pick @ (found.rim - grasp.point).T).T * MM
+            ax.plot(*np.vstack([rim, rim[:1]]).T, color='#55a868' if found.ok else '#c44e52',
+                    linewidth=1.5)
+            title = (f'{grasp.name}: pick\ncup {grasp.jaw_opening * MM:g} mm, '
+                     + ('seals' if found.ok else 'no seal'))
+        else:
+            title = (f'{grasp.name}: pick\njaws {grasp.jaw_opening * MM:g} mm, fingertips '
+                     f'{validator.finger_depths[g] * MM:.1f} mm below the point')
+        _frame(ax, np.hstack(points).T * MM, title)
         # place: the part turned so that place.axis points down; gripper as it picked
         ax = fig.add_subplot(rows, 2, 4 + 2 * g, projection='3d')
         relatives = [pick.T @ trimesh.transformations.rotation_matrix(tilts[k], [1, 0, 0])[:3, :3]

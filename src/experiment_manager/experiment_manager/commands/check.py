@@ -2,7 +2,9 @@
 print what the run will use of its part and grasps and what it will run (each experiment's
 iterations, a sensitivity's scenarios and the repeats they add, the feeder's cycle of moves
 when a feeder runs), and draw the part sheet
-(analysis/part_sheet.py) beside it, so that a wrong file is seen before it runs."""
+(analysis/part_sheet.py) beside it, so that a wrong file is seen before it runs. With
+--output DIR, DIR/check.json holds the part's account and each grasp's figures and verdicts
+(part_sheet.write_check; DIR/<id>_check.json per file when there are several)."""
 
 import os
 import sys
@@ -39,6 +41,10 @@ def check(paths: list[str], output: str | None, iterations: int | None = None,
         directory = os.path.abspath(os.path.expanduser(output or file.output_dir))
         sheet = part_sheet.write(checks, os.path.join(directory, f'{file.id}_part.png'))
         print(f'sheet: {sheet}')
+        if output:          # one file: DIR/check.json; several: DIR/<id>_check.json
+            name = 'check.json' if len(paths) == 1 else f'{file.id}_check.json'
+            print('figures: ' + part_sheet.write_check(file, checks,
+                                                       os.path.join(directory, name)))
         print('\n'.join(describe_plan(file)))
     return 0
 

@@ -12,28 +12,25 @@ relate were read without error. The annotated example is `config/default_experim
 
 from collections.abc import Callable, Mapping
 from dataclasses import replace
-import itertools
-import math
 import os
 from typing import Any
 
 from feeder_controller.policy import check_feeder, FeederConfig
 from pick_common.containers import check_container, check_fits, ContainerSpec
-from pick_common.errors import check_int, check_number, InvalidArgument
+from pick_common.errors import check_int, InvalidArgument
 from pick_common.parts.geometry import PartGeometry
 from pick_common.specs import Vibration
 from pick_validity.config import (
     check_grasps,
     check_gripper,
     check_place,
-    Gripper,
     is_suction,
     Setup,
     tilts,
 )
 import yaml
 
-from . import experiment_keys, schema, sections
+from . import experiment_keys, grippers, schema, sections
 from . import part as part_section
 from . import scenarios as scenario_inputs
 from .drop_test import drop_test
@@ -49,18 +46,15 @@ from .model import (
     ExperimentFile,
     FEEDER_EMPTYING,
     GRIPPER_SWEEP,
-    GripperVariant,
     Input,
     MAX_EXPERIMENTS,
     MAX_FILE_BYTES,
     MAX_ITERATIONS,
-    MAX_VARIANTS,
     MM,
     Sampling,
     SENSITIVITY,
     TABLE_SWEEP,
 )
-from .schema import GRIPPER_KEYS
 from .values import short
 
 
@@ -130,44 +124,6 @@ def _bin_or_source(value: Any, parts: int, where: str, c: _Context) -> dict:
     return {'bin': spec}
 
 
-def _variants(e: experiment_keys.GripperSweepKeys, where: str, c: _Context
-              ) -> tuple[GripperVariant, ...]:
-    """gripper_sweep's grid: every combination of its grippers (the file's gripper standing in
-    for keys not given) and grasp sets (default: every grasp, named 'all'), in the order
-    given, body diameter varying slowest."""
-    axes = []
-    for key, attr in GRIPPER_KEYS:
-        given = getattr(e.grippers, key)
-        values = given if given is not None else (check_number(
-            f'{where}.grippers.{key}', getattr(c.gripper, attr) / MM, low=0.0),)
-        axes.append([(attr, v * MM) for v in values])
-    names = [g.name for g in c.grasps]
-    sets = []
-    for name, members in (e.grasp_sets or {'all': names}).items():
-        at = f'{where}.grasp_sets.{name}'
-        if not isinstance(members, list) or not members:
-            raise InvalidArgument(at, short(members), 'must be a non-empty list of grasp '
-                                  f'names (part.grasps: {", ".join(names)})')
-        for i, member in enumerate(members):
-            if member not in names:
-                raise InvalidArgument(f'{at}[{i}]', short(member), 'is not the name of a '
-                                      f'grasp of part.grasps ({", ".join(names)})')
-        if len(set(members)) != len(members):
-            raise InvalidArgument(at, members, 'names a grasp twice')
-        sets.append((str(name), tuple(g for g in c.grasps if g.name in members)))
-    total = math.prod(len(a) for a in axes) * len(sets)
-    if total > MAX_VARIANTS:
-        raise InvalidArgument(f'{where}.grippers', total, f'grippers x grasp sets is over the '
-                              f'limit of {MAX_VARIANTS} combinations per experiment')
-    out = []
-    for combination in itertools.product(*axes):
-        g = Gripper(**dict(combination))
-        checked_as(check_gripper, g, f'{where}.grippers (' + ', '.join(
-            f'{key} {getattr(g, attr) / MM:g}' for key, attr in GRIPPER_KEYS) + ')')
-        out += [GripperVariant(g, name, members) for name, members in sets]
-    return tuple(out)
-
-
 def _sensitivity(e: experiment_keys.SensitivityKeys, where: str, c: _Context) -> list[Experiment]:
     """A sensitivity experiment and, before it, its repeats of the experiments it names, one
     per scenario (scenarios.py); a repeat takes its bin or range from the same scenario's
@@ -196,7 +152,7 @@ def _sensitivity(e: experiment_keys.SensitivityKeys, where: str, c: _Context) ->
                                   'out of `of`')
         low = scenario_inputs.check_input(name, r.low, f'{at}.low')
         high = scenario_inputs.check_input(name, r.high, f'{at}.high')
-        base = scenario_inputs.base_value(name, c.setup, c.geometry.mass)
+        base = scenario_inputs.base_value(name, c.setup, c.geometry.mass, at)
         inputs.append(Input(name, round(base, 9), low, high, r.source.strip()))
     inputs = tuple(inputs)
     repeats = (2 * len(inputs) + e.joint + (e.grid ** len(inputs) if e.grid else 0)) * len(e.of)
@@ -250,7 +206,7 @@ def _experiment(e: experiment_keys.ExperimentKeys, where: str, c: _Context) -> l
         if not scene:       # no bin: the parts lie on the tray, as in a table_sweep
             check_fits(f'{where}.parts (tray_mm)', e.parts, volume, tray)
         out.update(scene)
-        out['variants'] = _variants(e, where, c)
+        out['variants'] = grippers.variants(e, where, c.gripper, c.grasps)
         out['min_valid'] = e.min_valid
     elif e.type == FEEDER_EMPTYING:
         if isinstance(e.optimal_range, str):

@@ -28,10 +28,10 @@ import itertools
 import zlib
 
 import numpy as np
-from pick_common.errors import check_number
+from pick_common.errors import check_number, InvalidArgument
 from pick_common.parts.materials import body_values
 from pick_common.specs import check_vibration, Vibration
-from pick_validity.config import check_gripper, Setup
+from pick_validity.config import check_gripper, is_suction, Setup
 
 from .errors import checked
 from .model import G, Input, MM, Scenario
@@ -50,6 +50,9 @@ INPUTS = {
     'gripper.jaw_height_mm': ('gripper', 'jaw_height', MM, 0.0, None, True),
     'gripper.jaw_depth_mm': ('gripper', 'jaw_depth', MM, 0.0, None, True),
     'gripper.finger_clearance_mm': ('gripper', 'finger_clearance', MM, 0.0, None, False),
+    'gripper.cup_diameter_mm': ('gripper', 'cup_diameter', MM, 0.0, None, True),
+    'gripper.cup_height_mm': ('gripper', 'cup_height', MM, 0.0, None, True),
+    'gripper.vacuum_kpa': ('gripper', 'vacuum', 1000.0, 0.0, 101.325, True),
     'moves.amplitude_scale': ('moves', 'amplitude', 1.0, 0.0, None, True),
     'moves.frequency_scale': ('moves', 'frequency', 1.0, 0.0, None, True),
     'moves.duration_scale': ('moves', 'duration', 1.0, 0.0, None, True),
@@ -57,10 +60,15 @@ INPUTS = {
 MAX_REPEATS = 200    # scenarios x experiments repeated, per sensitivity experiment
 
 
-def base_value(name: str, setup: Setup, mass: float) -> float:
+def base_value(name: str, setup: Setup, mass: float, where: str = '') -> float:
     """The file's value of input `name`, in the file's units (`mass`: the part's mass, kg,
-    which the file may leave to the model)."""
+    which the file may leave to the model); InvalidArgument named `where` for a key of the
+    other kind of gripper."""
     section, attr, unit = INPUTS[name][:3]
+    if section == 'gripper' and not hasattr(setup.gripper, attr):
+        kind = 'a suction cup' if is_suction(setup.gripper) else 'parallel jaws'
+        raise InvalidArgument(where or name, name, f"is not a key of the file's gripper, "
+                              f'{kind} (gripper.type)')
     if section == 'moves':
         return 1.0
     if attr == 'mass':
