@@ -76,7 +76,7 @@ def test_every_interface_file_is_covered():
     assert len(listed) == files and len(list(_types())) >= files
 
 
-UNIT = re.compile(r"#.*\b(m|s|rad|kg|Hz|Pa|1|m\^3|m/s\^2)\b")
+UNIT = re.compile(r'#.*\b(m|s|rad|kg|Hz|Pa|1|m\^3|m/s\^2)\b')
 
 
 def test_every_float_field_states_its_unit():
