@@ -109,15 +109,16 @@ def _finger_depth(shapes: tuple[Shape, ...], gripper: Gripper, grasp: Grasp) -> 
 
 def _free_axis(part: PartGeometry, shapes: tuple[Shape, ...], grasp: Grasp) -> np.ndarray:
     """The axis of a cylinder of the part that holds the grasp point on its axis and that the
-    closing axis crosses at a right angle, or zeros. A built-in model's cylinders are its
+    closing axis crosses at a right angle or runs along (the jaws on its ends), or zeros. A built-in model's cylinders are its
     primitives; a mesh's are found from its surface (`grasp_fit.round_axis`)."""
     if part.spec.model == 'mesh':
         return round_axis(part, grasp.point, grasp.closing, grasp.up)
     for shape in shapes:
         axis = shape.rotation[:, 2]
         off = grasp.point - shape.center
+        along = abs(float(axis @ grasp.closing))      # across the body, or on its two ends
         if (isinstance(shape, CylinderShape) and contains(shape, grasp.point)
-                and abs(float(axis @ grasp.closing)) < 1e-6
+                and (along < 1e-6 or along > 1 - 1e-9)
                 and np.linalg.norm(off - (off @ axis) * axis) < 1e-9):
             return axis.copy()
     return np.zeros(3)

@@ -106,17 +106,21 @@ def round_axis(part: PartGeometry, point: np.ndarray, closing: np.ndarray,
                up: np.ndarray) -> np.ndarray:
     """For a mesh part: the axis (unit, part frame) about which the part is round where the
     jaws close on it, or zeros. The axis runs through the grasp point at right angles to the
-    closing axis, across the up axis or along it; the part is round about it when every line
-    through the point at right angles to it meets the part's surface at one radius on both
-    sides. Jaws closing across such a body grip it at any roll about the axis, as those of a
-    built-in capacitor do (`Validator.free_axes`)."""
+    closing axis, across the up axis or along it, or along the closing axis itself (jaws on
+    a round body's two ends); the part is round about it when every line through the point
+    at right angles to it meets the part's surface at one radius on both sides. Jaws closing
+    on such a body grip it at any roll about the axis, as those of a built-in capacitor do
+    (`Validator.free_axes`)."""
     triangles = surface(part)
-    for axis in (np.cross(closing, up), up):
+    for axis in (np.cross(closing, up), up, closing):
         axis = axis / np.linalg.norm(axis)
-        side = np.cross(axis, closing)
+        first = up if abs(float(axis @ closing)) > 0.5 else closing     # at right angles to it
+        first = first - (first @ axis) * axis
+        first /= np.linalg.norm(first)
+        side = np.cross(axis, first)
         radii = []
         for angle in np.linspace(0.0, np.pi, ROUND_DIRECTIONS, endpoint=False):
-            t = crossings(triangles, point, np.cos(angle) * closing + np.sin(angle) * side)
+            t = crossings(triangles, point, np.cos(angle) * first + np.sin(angle) * side)
             if len(t) == 0 or t.min() > TOLERANCE or t.max() < -TOLERANCE:
                 break
             radii += [-float(t.min()), float(t.max())]

@@ -31,6 +31,8 @@ JAW_MARGIN = 0.003
 # A face a part can lie on or be closed across: at least this share of its surface area.
 FACE_SHARE = 0.05
 AXIS_NAMES = ('x', 'y', 'z')
+SNAP = np.radians(3.0)      # a direction this near a frame axis is taken as that axis
+ROUNDING = 1e-5             # jaw openings and grasp points to 0.01 mm, as a person reads them
 
 
 @dataclass(frozen=True)
@@ -68,9 +70,14 @@ def _faces(part: PartGeometry) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _snap(v: np.ndarray) -> np.ndarray:
-    """A direction within 1e-6 of a frame axis becomes that axis (for names and the YAML)."""
-    v = np.where(np.abs(v) < 1e-6, 0.0, v)
-    return v / np.linalg.norm(v) + 0.0        # + 0.0: no -0 in the YAML
+    """A direction within SNAP of a frame axis becomes that axis: a part drawn in CAD has
+    its symmetry along its frame's axes, and a mesh's principal axes stray from them by a
+    few degrees where a lead, a flat or the tessellation breaks the symmetry slightly."""
+    v = v / np.linalg.norm(v)
+    k = int(np.argmax(np.abs(v)))
+    if abs(float(v[k])) >= np.cos(SNAP):
+        v = np.sign(v[k]) * np.eye(3)[k]
+    return v + 0.0        # + 0.0: no -0 in the YAML
 
 
 def _name(v: np.ndarray) -> str:
@@ -82,35 +89,54 @@ def _name(v: np.ndarray) -> str:
 
 
 def propose(part: PartGeometry, margin: float = JAW_MARGIN) -> tuple[Proposal, ...]:
-    """Grasps at the mass centre across opposed faces, and across a round body's axis, one per
-    way the part can lie with the closing direction horizontal."""
+    """Grasps at the mass centre across opposed faces, one per way the part can lie with the
+    closing direction horizontal; and across each round body, one grasp that the check turns
+    with the body's roll (`Validator.free_axes`), lying on its side, plus one per flat end it
+    can stand on; on a round body's two ends, lying, one grasp, which turns the same way."""
     centre = part.mass_frame[0] if part.mass_frame is not None else np.zeros(3)
+    centre = np.round(centre / ROUNDING) * ROUNDING
     faces, principal = _directions(part)
-    # across a round body: directions at right angles to an axis it is round about (the
-    # frame's axes where they are, else the principal axes: a round body's two equal moments
-    # leave its principal axes across it at any angle)
-    across = []
+    # round bodies: an axis it is round about (the frame's axes where they are, else the
+    # principal axes: a round body's two equal moments leave its principal axes across it
+    # at any angle), and a direction across it
+    rounds: list[tuple[np.ndarray, np.ndarray]] = []
     for a in principal[::2]:
+        a = _snap(a)
+        if any(abs(a @ b) > 0.999 for b, _ in rounds):
+            continue
         square = [s * e for e in np.eye(3) for s in (1.0, -1.0) if abs(e @ a) < 1e-6]
         sides = square or [p for p in principal if abs(p @ a) < 1e-6]
-        if sides and round_axis(part, centre, sides[0], a).any():
-            across += sides
-    closings = _distinct([f for f in faces if any(f @ g < -0.999 for g in faces)] + across,
-                         signed=False)
+        if sides and abs(float(round_axis(part, centre, sides[0], a) @ a)) > 0.999:
+            rounds.append((a, _distinct([sides[0]], signed=False)[0]))
     triangles = surface(part)
     found: list[Proposal] = []
-    for c in closings:
+
+    def add(u: np.ndarray, c: np.ndarray) -> None:
         t = crossings(triangles, centre, c)
         if len(t) == 0 or t.min() > 0 or t.max() < 0:
-            continue                # the mass centre lies in a hollow along this direction
+            return                  # the mass centre lies in a hollow along this direction
         width = float(t.max() - t.min())
-        for u in _distinct([-f for f in faces] + across, signed=True):
-            if abs(u @ c) > 1e-3:
-                continue
-            grasp = GraspPose(f'up{_name(u)}_close{_name(c)}', tuple(float(v) for v in u),
-                              tuple(float(v) for v in c), width + 2 * margin,
-                              tuple(float(v) for v in centre))
-            found.append(Proposal(grasp, width))
+        opening = float(np.round((width + 2 * margin) / ROUNDING) * ROUNDING)
+        found.append(Proposal(GraspPose(
+            f'up{_name(u)}_close{_name(c)}', tuple(float(v) for v in u),
+            tuple(float(v) for v in c), opening, tuple(float(v) for v in centre)), width))
+
+    for a, c in rounds:
+        add(_snap(np.cross(a, c)), c)           # lying on its side, at any roll
+        for u in _distinct([-f for f in faces], signed=True):
+            if abs(u @ a) > 0.999:              # standing on a flat end
+                add(u, c)
+    closings = _distinct([f for f in faces if any(f @ g < -0.999 for g in faces)],
+                         signed=False)
+    for c in closings:
+        if any(abs(c @ a) < 1e-3 for a, _ in rounds):
+            continue                            # across a round body: its grasps are above
+        ups = [u for u in _distinct([-f for f in faces], signed=True) if abs(u @ c) <= 1e-3]
+        if any(abs(c @ a) > 0.999 for a, _ in rounds):
+            ups = ups[:1] or [_snap(np.cross(c, _distinct([np.eye(3)[int(np.argmin(
+                np.abs(c)))]], signed=False)[0]))]   # on its ends, lying: it turns with the roll
+        for u in ups:
+            add(u, c)
     return tuple(found)
 
 

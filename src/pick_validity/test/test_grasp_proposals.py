@@ -30,8 +30,9 @@ def test_kicads_to220_gets_grasps_across_its_width_and_thickness_at_its_mass_cen
                                                                 abs=1e-5)
     for name in ('up+x_close+y', 'up-x_close+y'):
         assert by_name[name].width == pytest.approx(0.00446, abs=1e-5)
-    for p in proposals:
-        assert np.allclose(p.grasp.grasp_point, part.mass_frame[0])
+    for p in proposals:      # at the mass centre, to the 0.01 mm a person reads
+        assert np.allclose(p.grasp.grasp_point, part.mass_frame[0], atol=5e-6)
+        assert p.grasp.jaw_opening * 1e5 == pytest.approx(round(p.grasp.jaw_opening * 1e5))
 
 
 def test_a_round_body_is_closed_across_its_axis(tmp_path):
@@ -49,6 +50,42 @@ def test_a_round_body_is_closed_across_its_axis(tmp_path):
     ups = sorted(tuple(np.round(p.grasp.up_axis, 6)) for p in across)
     lying = [u for u in ups if abs(u[0]) < 1e-6]
     assert lying and sorted({u for u in ups if abs(u[0]) > 0.999}) == [(-1, 0, 0), (1, 0, 0)]
+
+
+def _led(path) -> PartSpec:
+    """A 5 mm LED as KiCad draws it, roughly: a round body along z on a flange with a flat on
+    one side, two leads below; the flat and the leads tilt its principal axes off the frame's
+    by a degree or two."""
+    body = trimesh.creation.cylinder(radius=0.0025, height=0.0086, sections=48)
+    body.apply_translation([0, 0, 0.0053])
+    ring = [(0.0029 * np.cos(a), 0.0029 * np.sin(a)) for a in np.linspace(0, 2 * np.pi, 48,
+                                                                            endpoint=False)]
+    ring = [(min(x, 0.0025), y) for x, y in ring]            # the flat
+    flange = trimesh.convex.convex_hull([(x, y, z) for x, y in ring for z in (0.0, 0.001)])
+    leads = [trimesh.creation.box(extents=[0.0005, 0.0005, 0.02],
+                                  transform=trimesh.transformations.translation_matrix(
+                                      [x, 0.0, -0.01])) for x in (-0.00127, 0.00127)]
+    trimesh.util.concatenate([body, flange, *leads]).export(path)
+    return PartSpec(model='mesh', mesh_path=str(path), mass=0.0003)
+
+
+def test_a_round_body_gets_one_grasp_that_turns_with_its_roll_named_as_a_person_reads(tmp_path):
+    from pick_validity.config import Setup
+    from pick_validity.validity import Validator
+    part = build_part(_led(tmp_path / 'led.stl'))
+    proposals = propose(part)
+    lying = [p for p in proposals if abs(p.grasp.up_axis[2]) < 1e-9]
+    across = [p for p in lying if abs(p.grasp.closing_axis[2]) < 1e-9]
+    assert len(across) == 1         # not four rolls 1.6 deg off the axes
+    (one,) = across
+    assert 'deg' not in one.grasp.name
+    assert sorted(map(abs, one.grasp.up_axis)) == [0, 0, 1]
+    assert sorted(map(abs, one.grasp.closing_axis)) == [0, 0, 1]
+    assert one.width == pytest.approx(0.005, rel=0.01)
+    assert one.grasp.jaw_opening * 1e5 == pytest.approx(round(one.grasp.jaw_opening * 1e5))
+    v = Validator(Setup(part.spec, grasps=tuple(p.grasp for p in proposals)), part)
+    for p in lying:         # across the body, and on its two ends: each turns about its axis
+        assert np.allclose(np.abs(v.free_axes[proposals.index(p)]), [0, 0, 1])
 
 
 def test_the_printed_yaml_reads_back_as_the_same_grasps():
