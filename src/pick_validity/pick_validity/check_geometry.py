@@ -109,8 +109,9 @@ def _finger_depth(shapes: tuple[Shape, ...], gripper: Gripper, grasp: Grasp) -> 
 
 def _free_axis(part: PartGeometry, shapes: tuple[Shape, ...], grasp: Grasp) -> np.ndarray:
     """The axis of a cylinder of the part that holds the grasp point on its axis and that the
-    closing axis crosses at a right angle or runs along (the jaws on its ends), or zeros. A built-in model's cylinders are its
-    primitives; a mesh's are found from its surface (`grasp_fit.round_axis`)."""
+    closing axis crosses at a right angle or runs along (the jaws on its ends), or zeros. A
+    built-in model's cylinders are its primitives; a mesh's are found from its surface
+    (`grasp_fit.round_axis`)."""
     if part.spec.model == 'mesh':
         return round_axis(part, grasp.point, grasp.closing, grasp.up)
     for shape in shapes:

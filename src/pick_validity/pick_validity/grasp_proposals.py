@@ -8,6 +8,11 @@ direction gets one grasp per way the part can lie with it horizontal: on a face 
 FACE_SHARE (the up axis that face's opposite), or on a round body's side. The jaws open to the
 width measured across the mass centre plus JAW_MARGIN on each side.
 
+For a suction cup (`propose_suction`): per way the part can lie (its stable aspects, from
+the hull's faces), the cup comes down along the aspect's up axis onto the top of the part, at
+the point nearest the mass centre's vertical where it seals and holds (`suction.seal`,
+`suction.holding`), searched on a grid of half the cup's radius outward from that vertical.
+
 A proposal is a start, not a gripper design: `run --check` prints them as YAML to paste under
 `part.grasps` and edit, and `part.grasps: auto` takes them as they are.
 
@@ -17,11 +22,14 @@ Units: metres; the part frame.
 from dataclasses import dataclass
 
 import numpy as np
+from pick_common.errors import InvalidArgument
+from pick_common.parts.aspects import part_aspects
 from pick_common.parts.geometry import PartGeometry
 import trimesh
 
-from .config import GraspPose
+from .config import check_grasps, GraspPose, SuctionCup, SuctionGrasp
 from .grasp_fit import crossings, round_axis, surface
+from .suction import holding, seal
 
 # 3 mm on each side of the part: the margin of every grasp of the project's test case
 # (config/test_case/grippers_pth*.yaml: 11 mm over the capacitor's 5 mm body, 16 and 10.5 mm
@@ -37,9 +45,10 @@ ROUNDING = 1e-5             # jaw openings and grasp points to 0.01 mm, as a per
 
 @dataclass(frozen=True)
 class Proposal:
-    """A proposed grasp and the width it closes on, m."""
+    """A proposed grasp and the width it closes on, m (a suction grasp's: the rim's
+    deviation from a plane)."""
 
-    grasp: GraspPose
+    grasp: GraspPose | SuctionGrasp
     width: float
 
 
@@ -153,6 +162,57 @@ def _distinct(directions: list[np.ndarray], signed: bool) -> list[np.ndarray]:
     return kept
 
 
+def propose_suction(part: PartGeometry, cup: SuctionCup) -> tuple[Proposal, ...]:
+    """One suction grasp per way the part can lie (module docstring); InvalidArgument naming
+    gripper.cup_diameter when the cup seals nowhere, with the largest of the cup's halves and
+    quarters that would."""
+    found = _cup_grasps(part, cup)
+    if found:
+        return found
+    for share in (0.75, 0.5, 0.25):
+        smaller = SuctionCup(**{**cup.__dict__, 'cup_diameter': share * cup.cup_diameter})
+        if _cup_grasps(part, smaller):
+            fits = f'a {smaller.cup_diameter * 1000:g} mm cup would seal on it'
+            break
+    else:
+        fits = f'not even a {0.25 * cup.cup_diameter * 1000:g} mm cup would'
+    raise InvalidArgument('gripper.cup_diameter', round(cup.cup_diameter * 1000, 3),
+                          '(mm) is larger than every flat patch on the top of the part as it '
+                          f'can lie: {fits}; write its grasps, or choose a smaller cup')
+
+
+def _cup_grasps(part: PartGeometry, cup: SuctionCup) -> tuple[Proposal, ...]:
+    centre = part.mass_frame[0] if part.mass_frame is not None else np.zeros(3)
+    triangles = surface(part)
+    step = cup.cup_diameter / 4
+    reach = int(np.ceil(part.radius / step))
+    offsets = sorted(((i, j) for i in range(-reach, reach + 1) for j in range(-reach, reach + 1)
+                      if np.hypot(i, j) * step <= part.radius), key=lambda ij: np.hypot(*ij))
+    out = []
+    for aspect in part_aspects(part):
+        up = _snap(-np.asarray(aspect.normal, dtype=np.float64))
+        if any(np.allclose(up, p.grasp.up_axis) for p in out):
+            continue
+        e1 = _snap(np.cross(up, np.eye(3)[int(np.argmin(np.abs(up)))]))
+        e2 = np.cross(up, e1)
+        top = 2 * part.radius + float(np.linalg.norm(centre))
+        for i, j in offsets:
+            base = centre + step * (i * e1 + j * e2)
+            t = crossings(triangles, base + top * up, -up)
+            t = t[t >= 0]
+            if not len(t):
+                continue
+            point = np.round((base + (top - float(t.min())) * up) / ROUNDING) * ROUNDING
+            grasp = SuctionGrasp(f'cup_up{_name(up)}', tuple(float(v) for v in up),
+                                 tuple(float(v) for v in point))
+            (checked,) = check_grasps([grasp], cup)
+            found = seal(part, cup, checked)
+            if found.ok and holding(part, cup, checked).ok:
+                out.append(Proposal(grasp, found.deviation))
+                break
+    return tuple(out)
+
+
 def as_yaml(proposals: tuple[Proposal, ...]) -> list[str]:
     """The proposals as the lines of `part.grasps` in an experiment file (mm)."""
     def vector(v, digits):
@@ -160,6 +220,11 @@ def as_yaml(proposals: tuple[Proposal, ...]) -> list[str]:
     lines = ['  grasps:']
     for p in proposals:
         g = p.grasp
+        if isinstance(g, SuctionGrasp):
+            lines.append(f'    - {{name: {g.name}, up_axis: {vector(g.up_axis, 4)}, '
+                         f'grasp_point_mm: [{", ".join(f"{v * 1000:.2f}" for v in g.grasp_point)}]}}'
+                         f'   # seals within {p.width * 1000:.2f} mm of a plane')
+            continue
         lines.append(f'    - {{name: {g.name}, up_axis: {vector(g.up_axis, 4)}, closing_axis: '
                      f'{vector(g.closing_axis, 4)}, jaw_opening_mm: {g.jaw_opening * 1000:.2f}, '
                      f'grasp_point_mm: [{", ".join(f"{v * 1000:.2f}" for v in g.grasp_point)}]}}'
