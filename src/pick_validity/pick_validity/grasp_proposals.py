@@ -221,9 +221,10 @@ def as_yaml(proposals: tuple[Proposal, ...]) -> list[str]:
     for p in proposals:
         g = p.grasp
         if isinstance(g, SuctionGrasp):
+            point = ', '.join(f'{v * 1000:.2f}' for v in g.grasp_point)
             lines.append(f'    - {{name: {g.name}, up_axis: {vector(g.up_axis, 4)}, '
-                         f'grasp_point_mm: [{", ".join(f"{v * 1000:.2f}" for v in g.grasp_point)}]}}'
-                         f'   # seals within {p.width * 1000:.2f} mm of a plane')
+                         f'grasp_point_mm: [{point}]}}   # seals within '
+                         f'{p.width * 1000:.2f} mm of a plane')
             continue
         lines.append(f'    - {{name: {g.name}, up_axis: {vector(g.up_axis, 4)}, closing_axis: '
                      f'{vector(g.closing_axis, 4)}, jaw_opening_mm: {g.jaw_opening * 1000:.2f}, '

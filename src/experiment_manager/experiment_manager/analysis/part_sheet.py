@@ -98,7 +98,15 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
                      f'{cup.cup_friction:g} (defaults: {VACUUM_SOURCE})')
     for figures in grasp_figures(file, checks):
         lines.append(_grasp_line(figures))
-    if file.auto_grasps:
+    if file.auto_grasps and checks.suction:
+        lines.append('  the grasps are part.grasps: auto, proposed from the geometry (per way '
+                     'the part can lie, the cup on its top where it seals and holds nearest '
+                     'the mass centre); to edit them, paste these under part: in place of '
+                     'grasps: auto')
+        used = tuple(Proposal(g, s.deviation) for g, s in zip(file.grasps, checks.seals,
+                                                              strict=True))
+        lines += ['  ' + line for line in as_yaml(used)]
+    elif file.auto_grasps:
         lines.append('  the grasps are part.grasps: auto, proposed from the geometry (across '
                      'opposed faces and round bodies at the mass centre, jaws '
                      f'{JAW_MARGIN * MM:g} mm wider than the part each side); to edit them, '

@@ -275,8 +275,8 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         checked(lambda: checked_as(tilts, check, 'check'))
     geometry = checked(lambda: part_section.geometry(part)) if part is not None else None
     if auto_grasps:
-        grasps = checked(lambda: part_section.proposed(geometry)) if geometry is not None \
-            else None
+        grasps = checked(lambda: part_section.proposed(geometry, gripper)) \
+            if geometry is not None else None
     if grasps is not None:
         checked(lambda: checked_as(check_grasps, list(grasps), 'part.grasps'))
     if None not in (geometry, grasps, gripper, check) and suction:

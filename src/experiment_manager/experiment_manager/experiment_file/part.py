@@ -14,12 +14,15 @@ from pick_validity.config import (
     CAPACITOR_GRASPS,
     check_grasps,
     GraspPose,
+    Gripper,
+    is_suction,
     PlaceSpec,
     Setup,
+    SuctionCup,
     SuctionGrasp,
 )
 from pick_validity.grasp_fit import check_grasps_fit
-from pick_validity.grasp_proposals import propose
+from pick_validity.grasp_proposals import propose, propose_suction
 from pick_validity.suction import OFF_SURFACE, seal
 
 from . import schema
@@ -178,8 +181,16 @@ def check_cup(geometry: PartGeometry, setup: Setup) -> None:
         raise InvalidArgument(f'part.{exc.field}', exc.value, exc.rule) from None
 
 
-def proposed(geometry: PartGeometry) -> tuple[GraspPose, ...]:
-    """`part.grasps: auto`: the grasps proposed from the part's geometry."""
+def proposed(geometry: PartGeometry, gripper: Gripper | SuctionCup | None = None
+             ) -> tuple[GraspPose, ...] | tuple[SuctionGrasp, ...]:
+    """`part.grasps: auto`: the grasps proposed from the part's geometry for the gripper's
+    type (a suction cup's: grasp_proposals.propose_suction)."""
+    if gripper is not None and is_suction(gripper):
+        try:
+            return tuple(p.grasp for p in propose_suction(geometry, gripper))
+        except InvalidArgument as exc:      # the core's field, in the file's mm
+            raise InvalidArgument(f'{exc.field}_mm', exc.value,
+                                  exc.rule.removeprefix('(mm) ')) from None
     grasps = tuple(p.grasp for p in propose(geometry))
     if not grasps:
         raise InvalidArgument('part.grasps', AUTO, 'found no grasp: the part has no opposed '

@@ -57,12 +57,19 @@ class PartGeometry:
     collision_note: str = ''
 
 
+MM = 1e-3       # m
+
+
 def primitive_mesh(p: Primitive) -> trimesh.Trimesh:
     """The triangle mesh of a primitive, in the part frame."""
     if isinstance(p, Box):
         mesh = trimesh.creation.box(extents=2.0 * np.asarray(p.half))
     elif isinstance(p, Cylinder):
-        mesh = trimesh.creation.cylinder(radius=p.radius, height=p.length, sections=24)
+        # made in mm and scaled: in metres trimesh drops the caps of a lead's cylinder (0.25
+        # mm across) as degenerate triangles, and the lead is an open tube
+        mesh = trimesh.creation.cylinder(radius=p.radius / MM, height=p.length / MM,
+                                         sections=24)
+        mesh.apply_scale(MM)
     else:
         mesh = trimesh.Trimesh(p.vertices, p.faces, process=False)
     transform = trimesh.transformations.quaternion_matrix(
