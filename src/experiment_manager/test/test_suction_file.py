@@ -90,3 +90,64 @@ def test_auto_proposes_a_cup_grasp_per_way_the_part_lies_or_names_a_cup_too_larg
     assert err.value.field == 'gripper.cup_diameter_mm' and err.value.value == 12
     assert 'is larger than every flat patch' in str(err.value)
     assert 'a 6 mm cup would seal on it' in str(err.value)
+
+
+OPTIONS = """id: dip_options
+seed: 4
+part:
+  model: dip
+  place: {axis: [0, 0, -1], seat_offset_mm: 1.65}
+  grasps:
+    - {name: top, up_axis: [0, 0, 1], closing_axis: [0, 1, 0], jaw_opening_mm: 13.5}
+    - {name: bottom, up_axis: [0, 0, -1], closing_axis: [0, 1, 0], jaw_opening_mm: 13.5}
+gripper: {body_diameter_mm: 20, jaw_depth_mm: 3}
+grippers:
+  cup: {type: suction, cup_diameter_mm: 4, grasps: auto}
+requirements: {parts_per_hour: 60, refill_interval_h: 0.25}
+experiments:
+  - {id: emptying, type: bin_emptying, iterations: 1, parts: 15, bin: [60, 60, 20]}
+  - {id: emptying_cup, type: bin_emptying, iterations: 1, parts: 15, bin: [60, 60, 20],
+     gripper: cup}
+"""
+
+
+def test_one_file_compares_options_per_gripper_with_the_stage_that_stops_most(tmp_path):
+    from experiment_manager.analysis import summary as summary_model
+    from experiment_manager.analysis.results import ResultsWriter
+    from experiment_manager.analysis.verdicts import verdicts
+    from experiment_manager.running.local_backend import LocalBackend
+    from experiment_manager.running.scheduler import Runner
+    file = experiment_file.parse(OPTIONS)
+    cup = file.experiment('emptying_cup')
+    assert cup.gripper == 'cup' and type(cup.setup.gripper).__name__ == 'SuctionCup'
+    assert type(file.for_experiment(cup).setup.gripper).__name__ == 'SuctionCup'
+    assert file.for_experiment(file.experiment('emptying')).setup == file.setup
+    with LocalBackend() as backend, ResultsWriter(str(tmp_path), file.text) as writer:
+        summary = Runner(file, [backend], writer).run()
+    assert summary['experiments']['emptying_cup']['gripper'] == 'cup'
+    assert 'gripper' not in summary['experiments']['emptying']
+    found = verdicts(summary_model.validate(summary))
+    bins = [v for v in found if v.kind.startswith('static bin')]
+    assert [v.kind for v in bins] == ['static bin', 'static bin, gripper cup']
+    assert bins[1].option == 'static bin 60 x 60 x 20 mm, gripper cup'
+    for v in bins:       # the stage that stops most parts, with its share
+        assert v.stops.split(' (')[0] in ('candidacy', 'placeability', 'container',
+                                          'neighbours')
+        assert '% of the parts checked)' in v.stops
+    # the cup's checks are the cup's: its emptying removed parts on its own grasps
+    assert summary['experiments']['emptying_cup']['removed']['mean'] is not None
+
+
+@pytest.mark.parametrize('change, field, words', [
+    (('gripper: cup}', 'gripper: pump}'), 'experiments[1].gripper',
+     "names no gripper of the file's grippers (cup)"),
+    (('grasps: auto}', 'grasps: auto, jaw_depth_mm: 3}'), 'grippers.cup.jaw_depth_mm',
+     'is a key of parallel jaws'),
+    (('cup_diameter_mm: 4', 'cup_diameter_mm: 12'), 'grippers.cup.gripper.cup_diameter_mm',
+     'larger than every flat patch'),
+])
+def test_a_bad_named_gripper_is_named(change, field, words):
+    with pytest.raises(InvalidArgument) as err:
+        experiment_file.parse(OPTIONS.replace(*change))
+    assert err.value.field == field, str(err.value)
+    assert words in str(err.value)

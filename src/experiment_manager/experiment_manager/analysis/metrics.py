@@ -100,7 +100,7 @@ def rate_interval(successes, n, confidence: float = 0.95):
 def _fractions(rows: list[dict]) -> dict:
     out = {}
     for stage in ('candidates', 'placeable', 'container_free', 'valid'):
-        values = [r[stage] / r['checked'] for r in rows if r['checked']]
+        values = [r[stage] / r['checked'] for r in rows if r.get('checked')]
         out[stage] = stats(values)
     return out
 
@@ -249,7 +249,8 @@ def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
             'minutes_per_vibration_allowed': per_vibration,
             'parts_per_hour': stats(hourly), 'parts_per_hour_ci95': list(interval(hourly)),
             'cell': {'pick_s': file.cell.pick_time, 'image_s': file.cell.image_time},
-            'decision': {name: d.as_dict() for name, d in table_grounds(file, rows).items()}}
+            'decision': {name: d.as_dict() for name, d in table_grounds(file, rows).items()},
+            'first_check': _fractions(rows)}
 
 
 def table_grounds(file: ExperimentFile, rows: list[dict],
@@ -358,6 +359,8 @@ def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: li
     else:
         low_high = exp.optimal_range or (earlier or {})[exp.range_from]['optimal_range']
         out = feeder_emptying(file, exp, rows, low_high)
+    if exp.gripper:
+        out['gripper'] = exp.gripper
     return {'type': exp.type, **out, 'faults': faults, 'physics': health}
 
 

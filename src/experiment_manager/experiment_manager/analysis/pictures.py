@@ -172,7 +172,7 @@ def bin_picture(file: ExperimentFile, summary: dict, run_dir: str,
     if not parts:
         return None
     with _settle(file, unit) as world:
-        validator = Validator(file.setup, world.part)
+        validator = Validator(file.for_experiment(exp).setup, world.part)
         grasps = validator.grasps
         same = _same_as_recorded(world, parts, 0)
         overlays, notes = [], []
@@ -217,8 +217,8 @@ def tray_picture(file: ExperimentFile, summary: dict, run_dir: str,
     with _settle(file, unit) as world:
         same = _same_as_recorded(world, rows, n)
         image = world.render(*SIZE, **_camera(unit))
-        stopped_in_world(world, Validator(file.setup, world.part), unit, rows, exp.id, run_dir,
-                         captions)
+        stopped_in_world(world, Validator(file.for_experiment(exp).setup, world.part), unit,
+                         rows, exp.id, run_dir, captions)
     _save(os.path.join(run_dir, 'tray.png'), image)
     return (f'{n} parts settled on the tray (`{exp.id}`, the tested count nearest n* = '
             f'{n_star}, iteration 1, seed {unit.seed}; re-simulated: poses '
@@ -237,9 +237,9 @@ def write(file: ExperimentFile, run_dir: str) -> dict[str, str]:
         caption = draw(file, summary, run_dir, captions)
         if caption:
             captions[name] = caption
-    validator = Validator(file.setup)
     for exp in file.experiments:
         if exp.id in summary['experiments']:
+            validator = Validator(file.for_experiment(exp).setup)
             caption = placeability_picture(validator, _rows(run_dir, 'parts', exp.id), exp.id,
                                            run_dir)
             if caption:

@@ -65,6 +65,8 @@ class _Experiment(_Record):
     faults: Faults
     physics: Physics
     sampling: Sampling | None = None
+    gripper: str | None = Field(None, description="the gripper of the file's `grippers` it "
+                                "ran with; none: the file's own")
 
 
 class Bin(_Record):
@@ -144,6 +146,8 @@ class FeederEmptying(_Experiment):
     parts_per_hour_ci95: list[float | None]
     cell: Cell
     decision: TableGrounds
+    first_check: Fractions | None = Field(None, description="each run's first check, the "
+                                          'tray loaded')
 
 
 class Variant(_Record):

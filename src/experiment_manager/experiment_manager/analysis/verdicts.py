@@ -71,64 +71,23 @@ class Verdict:
     verdict: str
     reasons: list[str]
     grounds: dict[str, Decision] = field(default_factory=dict)
+    stops: str = ''         # the stage that stops most checked parts, and its share
 
 
 def verdicts(summary: Summary) -> list[Verdict]:
-    """The decision per option, in the order static bin, vibrating table, gripper sweeps."""
+    """The decision per option, in the order static bin, vibrating table, gripper sweeps;
+    the bin and the table once per gripper their experiments ran with (the file's first, then
+    its `grippers` in the order the experiments name them)."""
     capacity = summary.requirements.capacity
     required = summary.requirements.success_rate
-    out = []
-    s = summary.last('bin_emptying')
-    if s:
-        decision = s.decision
-        reasons = [decision.reason + _more(decision, required),
-                   f'parts removed per bin: mean {fmt(s.removed.mean)}, max '
-                   f'{fmt(s.removed.max)} of {s.parts}']
-        verdict, reasons = _decided(decision.verdict, reasons, s,
-                                    None if s.parts >= capacity else
-                                    f'the bin was filled with {s.parts} parts, fewer than '
-                                    f'the {capacity} a refill interval needs')
-        out.append(Verdict(f'static bin {dims(s.bin_mm)} mm', 'static bin', verdict, reasons,
-                           {'emptied': decision}))
-    else:
-        out.append(Verdict('static bin', 'static bin', NOT_ANALYSED,
-                           ['no bin_emptying experiment in the file']))
-    s = summary.last('feeder_emptying')
-    if s:
-        grounds = {'time': s.decision.time, 'spills': s.decision.spills}
-        time, spills = grounds['time'], grounds['spills']
-        verdict = decisions.combined([g.verdict for g in grounds.values()])
-        settled = [f'{name} {g.verdict}' for name, g in grounds.items()
-                   if g.verdict != UNDECIDED]
-        open_ = [name for name, g in grounds.items() if g.verdict == UNDECIDED]
-        v = s.vibrations_to_empty
-        # the ground that decides first (run prints only the first reason): NOT FEASIBLE,
-        # then UNDECIDED, then FEASIBLE; the time first among equals
-        said = sorted([(time, time.reason + _more(time, required)), (spills, spills.reason)],
-                      key=lambda g: [NOT_FEASIBLE, UNDECIDED, FEASIBLE].index(g[0].verdict))
-        reasons = [said[0][1], said[1][1],
-                   'grounds settled: ' + (', '.join(settled) or 'none')
-                   + ('; not settled: ' + ', '.join(open_) if open_ else ''),
-                   f'{s.emptied} of {s.iterations} feeder runs emptied '
-                   f'(optimal range {s.optimal_range[0]}-{s.optimal_range[1]} parts on '
-                   f'the table; runs ended by: '
-                   f'{", ".join(f"{_STOPS.get(k, k)} {n}" for k, n in s.stops.items())})']
-        if v.mean is not None:
-            reasons.append(f'vibrations to empty the feeder: mean {fmt(v.mean, 4)}; the '
-                           f'refill interval allows one vibration every '
-                           f'{fmt(s.minutes_per_vibration_allowed)} min')
-        if s.parts_per_hour.mean is not None:
-            reasons.append(f'the cell would pick {fmt(s.parts_per_hour.mean, 4)} parts per hour '
-                           f'on average, at {fmt(s.cell.pick_s)} s per pick and '
-                           f'{fmt(s.cell.image_s)} s per image (cell.pick_s, '
-                           'cell.image_s) and the simulated time of the feeds and vibrations')
-        verdict, reasons = _decided(verdict, reasons, s, None if s.parts >= capacity else
-                                    f'the feeder held {s.parts} parts, fewer than the '
-                                    f'{capacity} a refill interval needs')
-        out.append(Verdict('vibrating table', 'vibrating table', verdict, reasons, grounds))
-    else:
-        out.append(Verdict('vibrating table', 'vibrating table', NOT_ANALYSED,
-                           ['no feeder_emptying experiment in the file']))
+    out = [_bin_verdict(s, gripper, capacity, required)
+           for gripper, s in _per_gripper(summary, 'bin_emptying')] or [
+        Verdict('static bin', 'static bin', NOT_ANALYSED,
+                ['no bin_emptying experiment in the file'])]
+    out += [_table_verdict(s, gripper, capacity, required)
+            for gripper, s in _per_gripper(summary, 'feeder_emptying')] or [
+        Verdict('vibrating table', 'vibrating table', NOT_ANALYSED,
+                ['no feeder_emptying experiment in the file'])]
     out += [_gripper_verdict(exp_id, s) for exp_id, s in summary.of_type('gripper_sweep')]
     for exp_id, s in summary.of_type('sensitivity'):     # how far each verdict moves
         lines = {r.option: r.said for r in s.robustness}
@@ -136,6 +95,85 @@ def verdicts(summary: Summary) -> list[Verdict]:
             if v.kind in lines:
                 v.reasons.append(f'over the ranges of `{exp_id}`: {lines[v.kind]}')
     return out
+
+
+def _per_gripper(summary: Summary, kind: str) -> list[tuple[str, object]]:
+    """(gripper name, '' for the file's own, and the last experiment of `kind` run with it),
+    the file's own first."""
+    found: dict[str, object] = {}
+    for _, s in summary.of_type(kind):
+        found[s.gripper or ''] = s
+    return sorted(found.items(), key=lambda item: item[0] != '')
+
+
+def _named(text: str, gripper: str) -> str:
+    return f'{text}, gripper {gripper}' if gripper else text
+
+
+def stops_most(fractions) -> tuple[str, float] | None:
+    """The stage that stops the largest share of the checked parts (from a check's stage
+    fractions) and that share, or None without figures."""
+    f = [fractions.candidates.mean, fractions.placeable.mean, fractions.container_free.mean,
+         fractions.valid.mean]
+    if any(v is None for v in f):
+        return None
+    lost = {'candidacy': 1.0 - f[0], 'placeability': f[0] - f[1], 'container': f[1] - f[2],
+            'neighbours': f[2] - f[3]}
+    stage = max(lost, key=lost.get)
+    return stage, lost[stage]
+
+
+def _stops(fractions) -> str:
+    found = stops_most(fractions) if fractions is not None else None
+    return '' if found is None else f'{found[0]} ({pct(found[1])} of the parts checked)'
+
+
+def _bin_verdict(s, gripper: str, capacity: int, required: float) -> Verdict:
+    decision = s.decision
+    reasons = [decision.reason + _more(decision, required),
+               f'parts removed per bin: mean {fmt(s.removed.mean)}, max '
+               f'{fmt(s.removed.max)} of {s.parts}']
+    verdict, reasons = _decided(decision.verdict, reasons, s,
+                                None if s.parts >= capacity else
+                                f'the bin was filled with {s.parts} parts, fewer than '
+                                f'the {capacity} a refill interval needs')
+    return Verdict(_named(f'static bin {dims(s.bin_mm)} mm', gripper),
+                   _named('static bin', gripper), verdict, reasons, {'emptied': decision},
+                   _stops(s.first_check))
+
+
+def _table_verdict(s, gripper: str, capacity: int, required: float) -> Verdict:
+    grounds = {'time': s.decision.time, 'spills': s.decision.spills}
+    time, spills = grounds['time'], grounds['spills']
+    verdict = decisions.combined([g.verdict for g in grounds.values()])
+    settled = [f'{name} {g.verdict}' for name, g in grounds.items() if g.verdict != UNDECIDED]
+    open_ = [name for name, g in grounds.items() if g.verdict == UNDECIDED]
+    v = s.vibrations_to_empty
+    # the ground that decides first (run prints only the first reason): NOT FEASIBLE,
+    # then UNDECIDED, then FEASIBLE; the time first among equals
+    said = sorted([(time, time.reason + _more(time, required)), (spills, spills.reason)],
+                  key=lambda g: [NOT_FEASIBLE, UNDECIDED, FEASIBLE].index(g[0].verdict))
+    reasons = [said[0][1], said[1][1],
+               'grounds settled: ' + (', '.join(settled) or 'none')
+               + ('; not settled: ' + ', '.join(open_) if open_ else ''),
+               f'{s.emptied} of {s.iterations} feeder runs emptied '
+               f'(optimal range {s.optimal_range[0]}-{s.optimal_range[1]} parts on '
+               f'the table; runs ended by: '
+               f'{", ".join(f"{_STOPS.get(k, k)} {n}" for k, n in s.stops.items())})']
+    if v.mean is not None:
+        reasons.append(f'vibrations to empty the feeder: mean {fmt(v.mean, 4)}; the '
+                       f'refill interval allows one vibration every '
+                       f'{fmt(s.minutes_per_vibration_allowed)} min')
+    if s.parts_per_hour.mean is not None:
+        reasons.append(f'the cell would pick {fmt(s.parts_per_hour.mean, 4)} parts per hour '
+                       f'on average, at {fmt(s.cell.pick_s)} s per pick and '
+                       f'{fmt(s.cell.image_s)} s per image (cell.pick_s, '
+                       'cell.image_s) and the simulated time of the feeds and vibrations')
+    verdict, reasons = _decided(verdict, reasons, s, None if s.parts >= capacity else
+                                f'the feeder held {s.parts} parts, fewer than the '
+                                f'{capacity} a refill interval needs')
+    return Verdict(_named('vibrating table', gripper), _named('vibrating table', gripper),
+                   verdict, reasons, grounds, _stops(s.first_check))
 
 
 def _decided(verdict: str, reasons: list[str], s, shortfall: str | None

@@ -294,8 +294,21 @@ def _run(node: Node, client: LockedActionClient, goal, given: str, graph: Graph,
         print(f'report:    {result.report_path}')
     summary = summary_model.validate(summary_model.migrate(json.loads(result.summary_json)))
     print('\n'.join(headlines(summary)))
-    # the manager's decisions, each with its first reason (the report gives them all)
-    print('verdicts:\n' + '\n'.join(
-        f'  {v.option.replace("`", "")}: {v.verdict} ({v.reasons[0]})'
-        for v in result.verdicts))
+    # the manager's decisions in one table, each with the stage that stops most parts and
+    # its first reason (the report gives them all)
+    print('verdicts:\n' + '\n'.join(verdict_table(result.verdicts)))
     return 0
+
+
+def verdict_table(found) -> list[str]:
+    """The options' verdicts as aligned columns: option, verdict, the stage that stops most
+    parts; each row's first reason on the line below it."""
+    rows = [(v.option.replace('`', ''), v.verdict, v.stops_most or '-') for v in found]
+    head = ('option', 'verdict', 'stops most parts')
+    widths = [max(len(r[k]) for r in [head, *rows]) for k in range(3)]
+    lines = ['  ' + '  '.join(c.ljust(w) for c, w in zip(head, widths, strict=True)).rstrip()]
+    for v, row in zip(found, rows, strict=True):
+        lines.append('  ' + '  '.join(c.ljust(w) for c, w in zip(row, widths,
+                                                                 strict=True)).rstrip())
+        lines.append(f'      ({v.reasons[0]})')
+    return lines

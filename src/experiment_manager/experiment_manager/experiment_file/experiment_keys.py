@@ -86,13 +86,20 @@ class ExperimentKeys(Section):
     iterations: Int(1, MAX_ITERATIONS)
 
 
-class BinStaticKeys(ExperimentKeys):
+class OnGripper(ExperimentKeys):
+    """An experiment of the cell's picking: run with the file's gripper, or with one of the
+    file's `grippers` named here."""
+
+    gripper: Identifier | None = None
+
+
+class BinStaticKeys(OnGripper):
     parts: Parts
     bins_mm: Annotated[list[PositiveSize], BeforeValidator(partial(
         list_of, low=1, high=MAX_BINS, what=f'1..{MAX_BINS} bins [x, y, z] in mm'))]
 
 
-class BinEmptyingKeys(ExperimentKeys):
+class BinEmptyingKeys(OnGripper):
     parts: Parts
     bin: BinOrId
 
@@ -110,7 +117,7 @@ class Counts(Section):
         return self
 
 
-class TableSweepKeys(ExperimentKeys):
+class TableSweepKeys(OnGripper):
     counts: Counts = Counts()
     margin: Int(0, 1000) = 5
     # while the fit still rises at the last count, sweep on at more counts (plan.extended)
@@ -118,7 +125,7 @@ class TableSweepKeys(ExperimentKeys):
         'must be true or false', short(v)))] = True
 
 
-class FeederEmptyingKeys(ExperimentKeys):
+class FeederEmptyingKeys(OnGripper):
     parts: Parts
     optimal_range: Annotated[str | tuple[int, int], BeforeValidator(_range_or_id)]
     max_vibrations: Int(1, 1_000_000) = 500

@@ -84,6 +84,7 @@ class _Context:
         self.max_dimension, self.setup, self.moves, self.seed = max_dimension, setup, moves, seed
         self.gripper, self.grasps = setup.gripper, setup.grasps
         self.earlier: dict[str, Experiment] = {}
+        self.named: dict[str, Setup] = {}           # the file's `grippers`
 
 
 def _bin(size_mm: tuple[float, ...], where: str, c: _Context) -> ContainerSpec:
@@ -134,6 +135,10 @@ def _sensitivity(e: experiment_keys.SensitivityKeys, where: str, c: _Context) ->
                                   '(of a type other than sensitivity)')
     if len(set(e.of)) != len(e.of):
         raise InvalidArgument(f'{where}.of', list(e.of), 'names an experiment twice')
+    for i, exp_id in enumerate(e.of):
+        if c.earlier[exp_id].gripper:
+            raise InvalidArgument(f'{where}.of[{i}]', exp_id, 'runs with a gripper of the '
+                                  "file's grippers; a sensitivity varies the file's own")
     inputs = []
     for name, r in e.inputs.items():
         at = f'{where}.inputs.{name}'
@@ -190,6 +195,11 @@ def _experiment(e: experiment_keys.ExperimentKeys, where: str, c: _Context) -> l
         return [Experiment(**out, **drop_test(e, where, c.geometry, c.bin_wall))]
     if e.type != TABLE_SWEEP:
         out['parts'] = e.parts
+    if getattr(e, 'gripper', None) is not None:
+        if e.gripper not in c.named:
+            raise InvalidArgument(f'{where}.gripper', e.gripper, 'names no gripper of the '
+                                  f"file's grippers ({', '.join(c.named) or 'none'})")
+        out['gripper'], out['setup'] = e.gripper, c.named[e.gripper]
     if e.type == BIN_STATIC:
         out['bins'] = tuple(_bin(v, f'{where}.bins_mm[{i}]', c) for i, v in enumerate(e.bins_mm))
         for i, b in enumerate(out['bins']):
@@ -289,6 +299,8 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         context = _Context(geometry, tray, MM * top.bin_wall_mm, MM * top.bin_drop_mm,
                            requirements.max_dimension,
                            Setup(part, gripper, grasps, place, check), moves, top.seed)
+        context.named = checked(lambda: grippers.named(top.grippers, context.setup,
+                                                       geometry)) or {}
     raw = data.get('experiments')
     for i, item in enumerate(raw if isinstance(raw, list) and len(raw) <= MAX_EXPERIMENTS
                              else []):

@@ -154,6 +154,9 @@ class Experiment:
     grid: int = 0
     measured: tuple[tuple[str, int], ...] = ()
     extend: bool = True
+    # the gripper of the file's `grippers` it runs with ('' and None: the file's own)
+    gripper: str = ''
+    setup: Setup | None = None
 
     @property
     def sources(self) -> tuple[str, ...]:
@@ -209,10 +212,11 @@ class ExperimentFile:
         return self.setup.config
 
     def for_experiment(self, exp: Experiment) -> 'ExperimentFile':
-        """The file an experiment's iterations run with: this one, or for a sensitivity
-        scenario's repeat this one with the scenario's setup and moves."""
+        """The file an experiment's iterations run with: this one, this one with the gripper
+        and grasps the experiment names (`grippers`), or for a sensitivity scenario's repeat
+        this one with the scenario's setup and moves."""
         if exp.scenario is None:
-            return self
+            return self if exp.setup is None else replace(self, setup=exp.setup)
         return replace(self, setup=exp.scenario.setup, moves=exp.scenario.moves)
 
     def variant_setup(self, variant: GripperVariant | None) -> Setup:

@@ -136,14 +136,14 @@ def read_part(p: schema.Part, m: schema.MaterialsSection, base_dir: str, suction
         return spec, CAPACITOR_GRASPS, place
     if p.grasps == AUTO:
         return spec, AUTO, place
-    grasps = tuple(_grasp(g, i, suction) for i, g in enumerate(p.grasps))
+    grasps = tuple(grasp_entry(g, i, suction) for i, g in enumerate(p.grasps))
     names = [g.name for g in grasps]
     if len(set(names)) != len(names):
         raise InvalidArgument('part.grasps', names, 'has a grasp name twice')
     return spec, grasps, place
 
 
-def _grasp(g: schema.GraspEntry, i: int, suction: bool) -> GraspPose | SuctionGrasp:
+def grasp_entry(g: schema.GraspEntry, i: int, suction: bool) -> GraspPose | SuctionGrasp:
     """One entry of part.grasps as the gripper's type reads it: a suction grasp gives no
     closing_axis and no jaw_opening_mm, a jaws' grasp both."""
     name = g.name if g.name is not None else f'grasp_{i}'

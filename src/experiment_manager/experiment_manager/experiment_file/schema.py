@@ -255,6 +255,7 @@ class FileKeys(Section):
     part: Any = None
     materials: Any = None
     gripper: Any = None
+    grippers: Any = None            # other grippers by name: {name: {gripper keys, grasps}}
     check: Any = None
     requirements: Any = None
     sampling: Any = None
@@ -274,3 +275,11 @@ class FileKeys(Section):
 SECTIONS: dict[str, type[Section]] = {
     'part': Part, 'materials': MaterialsSection, 'gripper': GripperSection, 'check': CheckSection,
     'requirements': RequirementsSection, 'sampling': SamplingSection, 'cell': CellSection}
+
+
+class NamedGripper(GripperSection):
+    """One of the file's `grippers`: a gripper's keys and its grasps (as part.grasps: a
+    list, or auto), for experiments that name it."""
+
+    grasps: Annotated[list[GraspEntry] | None, WrapValidator(grasp_list)] = \
+        Field(default=None, validate_default=False)

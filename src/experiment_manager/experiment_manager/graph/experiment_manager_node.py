@@ -171,7 +171,7 @@ class ExperimentManagerNode(Node):
         msg = RunVerdicts(header=Header(stamp=self.get_clock().now().to_msg()),
                           experiment_id=session.file.id, run_directory=session.run_dir,
                           verdicts=[Verdict(option=v.option, verdict=v.verdict,
-                                            reasons=v.reasons)
+                                            reasons=v.reasons, stops_most=v.stops)
                                     for v in verdicts(summary_model.validate(summary))])
         self._verdicts.publish(msg)
         self._topics.write(self._verdicts, msg)

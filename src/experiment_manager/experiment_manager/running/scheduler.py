@@ -272,7 +272,8 @@ class Runner:
         in flight it waits rather than leave: their end may release an experiment, and a lost
         worker's iteration comes back to the queue."""
         backend = self.backends[k]
-        scenario = None     # the scenario `backend` was last given (None: the file's own)
+        # what `backend` was last given: the scenario and the gripper (None, '': the file's)
+        scenario, gripper = None, ''
         while True:
             with self._cond:
                 while not self._ready and self._in_flight and not self._errors:
@@ -284,9 +285,9 @@ class Runner:
                 self._report(u.experiment, f'{u.experiment.id}: {u.label}')
             try:
                 file = self.file.for_experiment(u.experiment)
-                if u.experiment.scenario is not scenario:
+                if u.experiment.scenario is not scenario or u.experiment.gripper != gripper:
                     backend.start(file)
-                    scenario = u.experiment.scenario
+                    scenario, gripper = u.experiment.scenario, u.experiment.gripper
                 record = run_unit(file, u, backend)
             except WorkerLost as exc:
                 with self._cond:

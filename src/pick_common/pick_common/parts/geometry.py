@@ -65,11 +65,7 @@ def primitive_mesh(p: Primitive) -> trimesh.Trimesh:
     if isinstance(p, Box):
         mesh = trimesh.creation.box(extents=2.0 * np.asarray(p.half))
     elif isinstance(p, Cylinder):
-        # made in mm and scaled: in metres trimesh drops the caps of a lead's cylinder (0.25
-        # mm across) as degenerate triangles, and the lead is an open tube
-        mesh = trimesh.creation.cylinder(radius=p.radius / MM, height=p.length / MM,
-                                         sections=24)
-        mesh.apply_scale(MM)
+        mesh = trimesh.creation.cylinder(radius=p.radius, height=p.length, sections=24)
     else:
         mesh = trimesh.Trimesh(p.vertices, p.faces, process=False)
     transform = trimesh.transformations.quaternion_matrix(
@@ -77,6 +73,21 @@ def primitive_mesh(p: Primitive) -> trimesh.Trimesh:
     transform[:3, 3] = p.position
     mesh.apply_transform(transform)
     return mesh
+
+
+def visual_mesh(p: Primitive) -> trimesh.Trimesh:
+    """A built-in's visual piece: primitive_mesh's, but a cylinder made in mm and scaled,
+    closed: in metres trimesh drops the end faces of a lead's cylinder (0.25 mm across) as
+    degenerate triangles, and the lead is an open tube that a line along it never meets
+    (the suction cup's seal casts such lines). The collision bounds keep primitive_mesh's."""
+    if not isinstance(p, Cylinder):
+        return primitive_mesh(p)
+    mesh = trimesh.creation.cylinder(radius=p.radius / MM, height=p.length / MM, sections=24)
+    mesh.apply_scale(MM)
+    transform = trimesh.transformations.quaternion_matrix(
+        [p.orientation[3], *p.orientation[:3]])
+    transform[:3, 3] = p.position
+    return mesh.apply_transform(transform)
 
 
 def _finish(spec: PartSpec, dims: Mapping[str, float], mass: float,
@@ -97,7 +108,7 @@ def _finish(spec: PartSpec, dims: Mapping[str, float], mass: float,
 
 def _builtin(spec: PartSpec) -> PartGeometry:
     dims, mass, collision, visual_parts = builtin(spec)
-    visual = trimesh.util.concatenate([primitive_mesh(p) for p in visual_parts])
+    visual = trimesh.util.concatenate([visual_mesh(p) for p in visual_parts])
     volume = float(sum(primitive_mesh(p).volume for p in visual_parts))
     return _finish(spec, dims, mass, collision, visual, volume)
 

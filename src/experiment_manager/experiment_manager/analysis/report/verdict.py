@@ -39,8 +39,8 @@ class Head(Section):
                  f'{fmt(r.refill_interval_h)} h (capacity {r.capacity} parts), no bin longer '
                  f'than {fmt(r.max_dimension_mm)} mm in any dimension (every bin analysed '
                  'meets it: the experiment file refuses others).', '', '## Verdict', '']
-        lines += table(['option', 'verdict', 'why'],
-                       [[v.option, f'**{v.verdict}**', '; '.join(v.reasons)]
+        lines += table(['option', 'verdict', 'stops most parts', 'why'],
+                       [[v.option, f'**{v.verdict}**', v.stops or '-', '; '.join(v.reasons)]
                         for v in run.verdicts])
         grounds = [[v.option, name, g.quantity, g.verdict,
                     '' if g.bound is None else _bound(g), g.interval, g.runs]
