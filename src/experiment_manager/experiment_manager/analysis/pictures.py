@@ -237,9 +237,13 @@ def write(file: ExperimentFile, run_dir: str) -> dict[str, str]:
         caption = draw(file, summary, run_dir, captions)
         if caption:
             captions[name] = caption
+    validators: dict[tuple, Validator] = {}     # per setup: the file's and its grippers'
     for exp in file.experiments:
         if exp.id in summary['experiments']:
-            validator = Validator(file.for_experiment(exp).setup)
+            setup = file.for_experiment(exp).setup
+            if setup.key() not in validators:
+                validators[setup.key()] = Validator(setup)
+            validator = validators[setup.key()]
             caption = placeability_picture(validator, _rows(run_dir, 'parts', exp.id), exp.id,
                                            run_dir)
             if caption:
