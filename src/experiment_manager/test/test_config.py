@@ -239,7 +239,8 @@ def test_the_installed_share_holds_the_paper_test_case():
     share = os.path.join(get_package_share_directory('experiment_manager'), 'config')
     for name in ('pth0.yaml', 'pth1.yaml', 'pth2.yaml', 'grippers_pth0.yaml',
                  'pth0_robustness.yaml', 'pth1_robustness.yaml', 'pth2_robustness.yaml',
-                 'pth0_gripper_map.yaml'):
+                 'pth0_gripper_map.yaml', 'pth0_options.yaml', 'pth1_options.yaml',
+                 'pth2_options.yaml'):
         assert experiment_file.load(os.path.join(share, 'test_case', name)).experiments
 
 
@@ -258,6 +259,24 @@ def test_the_robustness_files_are_their_part_with_a_sensitivity_experiment(name)
         part.requirements, part.cell, part.tray)
     sensitivity = robust.experiments[-1]
     assert sensitivity.type == 'sensitivity' and all(x.source for x in sensitivity.inputs)
+
+
+@pytest.mark.parametrize('name', ['pth0_options.yaml', 'pth1_options.yaml',
+                                  'pth2_options.yaml'])
+def test_the_options_files_are_their_part_and_the_same_experiments_with_a_cup(name):
+    case = os.path.join(HERE, '..', 'config', 'test_case')
+    part = experiment_file.load(os.path.join(case, name.split('_')[0] + '.yaml'))
+    options = experiment_file.load(os.path.join(case, name))
+    assert [e for e in options.experiments if not e.gripper] == list(part.experiments)
+    assert (options.id, options.seed, options.setup, options.moves, options.requirements,
+            options.cell, options.tray) == (part.id, part.seed, part.setup, part.moves,
+                                             part.requirements, part.cell, part.tray)
+    cup = [e for e in options.experiments if e.gripper]
+    assert [e.id for e in cup] == [f'{e.id}_cup' for e in part.experiments]
+    for mine, theirs in zip(cup, part.experiments, strict=True):
+        assert (mine.type, mine.iterations, mine.parts, mine.bins, mine.counts) == (
+            theirs.type, theirs.iterations, theirs.parts, theirs.bins, theirs.counts)
+        assert mine.gripper == 'cup' and type(mine.setup.gripper).__name__ == 'SuctionCup'
 
 
 def test_every_error_of_a_file_comes_at_once():

@@ -9,9 +9,10 @@ FACE_SHARE (the up axis that face's opposite), or on a round body's side. The ja
 width measured across the mass centre plus JAW_MARGIN on each side.
 
 For a suction cup (`propose_suction`): per way the part can lie (its stable aspects, from
-the hull's faces), the cup comes down along the aspect's up axis onto the top of the part, at
-the point nearest the mass centre's vertical where it seals and holds (`suction.seal`,
-`suction.holding`), searched on a grid of half the cup's radius outward from that vertical.
+the hull's faces; a round body's side at four rolls), the cup comes down along the aspect's
+up axis onto the top of the part, at the point nearest the mass centre's vertical where it
+seals and holds (`suction.seal`, `suction.holding`), searched on a grid of half the cup's
+radius outward from that vertical.
 
 A proposal is a start, not a gripper design: `run --check` prints them as YAML to paste under
 `part.grasps` and edit, and `part.grasps: auto` takes them as they are.
@@ -189,8 +190,7 @@ def _cup_grasps(part: PartGeometry, cup: SuctionCup) -> tuple[Proposal, ...]:
     offsets = sorted(((i, j) for i in range(-reach, reach + 1) for j in range(-reach, reach + 1)
                       if np.hypot(i, j) * step <= part.radius), key=lambda ij: np.hypot(*ij))
     out = []
-    for aspect in part_aspects(part):
-        up = _snap(-np.asarray(aspect.normal, dtype=np.float64))
+    for up in _cup_ups(part):
         if any(np.allclose(up, p.grasp.up_axis) for p in out):
             continue
         e1 = _snap(np.cross(up, np.eye(3)[int(np.argmin(np.abs(up)))]))
@@ -211,6 +211,22 @@ def _cup_grasps(part: PartGeometry, cup: SuctionCup) -> tuple[Proposal, ...]:
                 out.append(Proposal(grasp, found.deviation))
                 break
     return tuple(out)
+
+
+def _cup_ups(part: PartGeometry) -> list[np.ndarray]:
+    """The up axes the cup comes down along: each aspect's (minus the normal of the face it
+    rests on), and for a round body lying on its side (aspect `side_<axis>`) the four frame
+    axes across it: a cup, unlike the jaws, is not turned with the roll by the check, and
+    four rolls a quarter turn apart leave none more than 45 deg (check.tolerance's default)
+    from one."""
+    ups = []
+    for aspect in part_aspects(part):
+        if aspect.name.startswith('side_'):
+            k = AXIS_NAMES.index(aspect.name[-1])
+            ups += [s * e for e in np.eye(3) if e[k] == 0 for s in (1.0, -1.0)]
+        else:
+            ups.append(_snap(-np.asarray(aspect.normal, dtype=np.float64)))
+    return ups
 
 
 def as_yaml(proposals: tuple[Proposal, ...]) -> list[str]:
