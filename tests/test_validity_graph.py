@@ -90,6 +90,37 @@ def test_service_agrees_with_the_core_on_a_settled_bin(client, check, settled, n
                for r in valid)
 
 
+def test_a_suction_request_is_checked_with_the_cup_as_the_core_checks_it(check, settled):
+    # the world's capacitors, checked with a 3 mm cup on their flat ends and, lying, at four
+    # rolls: the request carries the cup and its grasps; the node answers as the core does
+    from pick_validity import conversions as validity_conv
+    from pick_validity.config import SuctionCup, SuctionGrasp
+    scene, parts = settled
+    cup = SuctionCup(cup_diameter=0.003)
+    grasps = (SuctionGrasp('end', (0, 0, 1), (0, 0, 0.0055)),
+              *(SuctionGrasp(f'side{k}', (math.cos(k * math.pi / 2), math.sin(k * math.pi / 2),
+                                          0.0), (0.0025 * math.cos(k * math.pi / 2),
+                                                 0.0025 * math.sin(k * math.pi / 2), 0.0))
+                for k in range(4)))
+    setup = Setup(part_spec_from_msg(scene.part_model), gripper=cup, grasps=grasps)
+    request = validity_conv.setup_to_request(setup, _request(scene, parts, check_neighbours=True))
+    assert request.gripper.type == request.gripper.SUCTION
+    response = check(request)
+    assert response.error_code == OK, response.error_msg
+    ids, _, poses = parts_to_arrays(parts)
+    core = Validator(setup).check(container_from_msg(scene.instances[0].container), ids, poses)
+    assert [(r.part_id, r.stage_reached, r.grasp_index, tuple(r.valid_tilts))
+            for r in response.report.results] == [r.key() for r in core.results]
+    assert response.report.valid == core.counts['valid'] > 0
+    # an unknown gripper type is refused by name, and the node keeps serving
+    bad = validity_conv.setup_to_request(setup, _request(scene, parts))
+    bad.gripper.type = 7
+    answer = check(bad)
+    assert answer.error_code == CheckParts.Response.INVALID_ARGUMENT
+    assert 'gripper.type: 7 must be 0 (jaws) or 1 (suction)' in answer.error_msg
+    assert check(_request(scene, parts)).error_code == OK
+
+
 def test_targets_only_are_checked(check, settled):
     scene, parts = settled
     response = check(_request(scene, parts, target_ids=[parts[3].id, parts[7].id]))
