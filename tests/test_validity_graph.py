@@ -76,7 +76,7 @@ def test_service_agrees_with_the_core_on_a_settled_bin(client, check, settled, n
     core = Validator(Setup(part_spec_from_msg(scene.part_model))).check(
         container_from_msg(scene.instances[0].container), ids, poses,
         neighbour_check=neighbours)
-    got = [(r.part_id, r.stage_reached, r.grasp_index, tuple(r.valid_tilts))
+    got = [(r.part_id, r.stage_reached, r.grasp_index, tuple(r.valid_tilts), r.regrasp)
            for r in response.report.results]
     assert got == [r.key() for r in core.results]
     report = response.report
@@ -109,7 +109,7 @@ def test_a_suction_request_is_checked_with_the_cup_as_the_core_checks_it(check, 
     assert response.error_code == OK, response.error_msg
     ids, _, poses = parts_to_arrays(parts)
     core = Validator(setup).check(container_from_msg(scene.instances[0].container), ids, poses)
-    assert [(r.part_id, r.stage_reached, r.grasp_index, tuple(r.valid_tilts))
+    assert [(r.part_id, r.stage_reached, r.grasp_index, tuple(r.valid_tilts), r.regrasp)
             for r in response.report.results] == [r.key() for r in core.results]
     assert response.report.valid == core.counts['valid'] > 0
     # an unknown gripper type is refused by name, and the node keeps serving

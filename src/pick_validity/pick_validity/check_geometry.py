@@ -37,6 +37,7 @@ from .geometry import (
     suction_shapes,
 )
 from .grasp_fit import check_grasps_fit, GraspFit, round_axis
+from .regrasp import Placement, placements
 from .suction import Holding, holding, Seal, seal
 
 
@@ -69,6 +70,11 @@ class CheckGeometry:
     seals: tuple[Seal, ...] = ()
     holds: tuple[Holding, ...] = ()
     usable: np.ndarray | None = None
+    # with a regrasp station (config.regrasp_station): the placements the part rests on
+    # there, and from which of them a grasp picks it and places it as required (set by the
+    # Validator, which owns the stages); None without a station
+    placements: tuple[Placement, ...] = ()
+    station_ok: np.ndarray | None = None
 
     @property
     def suction(self) -> bool:
@@ -92,12 +98,17 @@ def build_geometry(setup: Setup, part: PartGeometry | None = None) -> CheckGeome
     jaws = tuple(gripper_shapes(gripper, g.jaw_opening, depth)
                  for g, depth in zip(grasps, depths, strict=True))
     return CheckGeometry(
+        placements=_placements(part, setup.config),
         part=part, config=setup.config, gripper=gripper, grasps=grasps, grasp_fits=fits,
         tilts=angles, tilt_rotations=rotations_about_x(angles), place_axis=place_axis,
         seat_offset=seat_offset, part_shapes=shapes, finger_depths=depths,
         gripper_shapes=jaws,
         gripper_objects=tuple(tuple(s.fcl_object() for s in pair) for pair in jaws),
         free_axes=np.stack([_free_axis(part, shapes, g) for g in grasps]))
+
+
+def _placements(part: PartGeometry, config: CheckConfig) -> tuple[Placement, ...]:
+    return placements(part, config.station_margin) if config.regrasp_station else ()
 
 
 def _finger_depth(shapes: tuple[Shape, ...], gripper: Gripper, grasp: Grasp) -> float:
@@ -145,6 +156,7 @@ def _suction_geometry(setup: Setup, part: PartGeometry, cup: SuctionCup,
     cups = tuple(suction_shapes(cup) for _ in grasps)
     zero = np.zeros(1)
     return CheckGeometry(
+        placements=_placements(part, setup.config),
         part=part, config=setup.config, gripper=cup, grasps=grasps, grasp_fits=(),
         tilts=zero, tilt_rotations=rotations_about_x(zero), place_axis=place_axis,
         seat_offset=seat_offset, part_shapes=part_shapes(part),

@@ -31,6 +31,7 @@ LIMITS = {
     'check.tilt_step': Limit(math.radians(0.1), math.pi),
     'check.approach_cone': Limit(0.0, math.pi / 2, low_open=True),
     'check.rim_tolerance': Limit(0.0, 1.0),
+    'check.station_margin': Limit(0.0, 10.0),
     'gripper.cup_diameter': Limit(0.0, 0.5, low_open=True),
     'gripper.cup_height': Limit(0.0, 0.5, low_open=True),
     'gripper.vacuum': Limit(0.0, 101_325.0, low_open=True),     # Pa below the atmosphere
@@ -147,6 +148,9 @@ class CheckConfig:
     A tilt whose gripper axis is more than approach_cone from world +Z is not tried.
     rim_tolerance: a part whose centre lies more than this above the container's rim is not
     in the container (nor is one beside its walls or below its floor), m.
+    regrasp_station: a part no tilt can place as it was picked may be put down on a flat
+    station and picked again (regrasp.py); station_margin: the d / h its placement there
+    must keep.
     """
 
     tolerance: float = math.radians(45.0)
@@ -155,6 +159,8 @@ class CheckConfig:
     tilt_step: float = math.radians(5.0)
     approach_cone: float = math.radians(45.0)
     rim_tolerance: float = 0.02
+    regrasp_station: bool = False
+    station_margin: float = 0.1
 
 
 # The default grasp poses, for a radial capacitor (body along part +Z, leads along -Z) lying on
@@ -276,6 +282,7 @@ def tilts(cfg: CheckConfig) -> np.ndarray:
     LIMITS['check.tolerance'].check('check.tolerance', cfg.tolerance)
     LIMITS['check.approach_cone'].check('check.approach_cone', cfg.approach_cone)
     LIMITS['check.rim_tolerance'].check('check.rim_tolerance', cfg.rim_tolerance)
+    LIMITS['check.station_margin'].check('check.station_margin', cfg.station_margin)
     low = LIMITS['check.tilt_min'].check('check.tilt_min', cfg.tilt_min)
     high = LIMITS['check.tilt_max'].check('check.tilt_max', cfg.tilt_max, low=low)
     step = LIMITS['check.tilt_step'].check('check.tilt_step', cfg.tilt_step)

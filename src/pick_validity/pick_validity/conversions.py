@@ -73,7 +73,8 @@ def setup_from_request(request: CheckParts.Request, defaults: Setup,
     config = defaults.config
     if s.tilt_step != 0.0:
         config = CheckConfig(s.tolerance, s.tilt_min, s.tilt_max, s.tilt_step,
-                             s.approach_cone, s.rim_tolerance)
+                             s.approach_cone, s.rim_tolerance, s.regrasp_station,
+                             s.station_margin or CheckConfig.station_margin)
     return Setup(part, gripper, grasps, place, config)
 
 
@@ -99,7 +100,9 @@ def setup_to_request(setup: Setup, request: CheckParts.Request) -> CheckParts.Re
     request.settings = CheckSettings(tolerance=c.tolerance, tilt_min=c.tilt_min,
                                      tilt_max=c.tilt_max, tilt_step=c.tilt_step,
                                      approach_cone=c.approach_cone,
-                                     rim_tolerance=c.rim_tolerance)
+                                     rim_tolerance=c.rim_tolerance,
+                                     regrasp_station=c.regrasp_station,
+                                     station_margin=c.station_margin)
     return request
 
 
@@ -126,7 +129,8 @@ def report_to_msg(report: Report, validator: Validator, stamp: Time, frame_id: s
         item = PartValidity(part_id=r.part_id, stage_reached=r.stage, valid=r.valid,
                             reason=r.reason, grasp_index=r.grasp_index,
                             candidacy_angle=float(r.candidacy_angle),
-                            jaw_opening=float(r.jaw_opening), valid_tilts=list(r.valid_tilts))
+                            jaw_opening=float(r.jaw_opening), valid_tilts=list(r.valid_tilts),
+                            regrasp=r.regrasp)
         if r.grasp_index >= 0:
             g = validator.grasps[r.grasp_index]
             item.grasp = _grasp_msg(g.name, g.up, g.closing, g.jaw_opening, g.point)
@@ -146,5 +150,5 @@ def report_from_msg(msg: ValidityReport) -> Report:
             pose = np.array([p.x, p.y, p.z, q.x, q.y, q.z, q.w])
         results.append(PartResult(r.part_id, r.stage_reached, r.reason, r.grasp_index,
                                   r.candidacy_angle, pose, r.jaw_opening,
-                                  tuple(r.valid_tilts)))
+                                  tuple(r.valid_tilts), r.regrasp))
     return Report(results, msg.neighbour_check, wall_time=msg.wall_time)

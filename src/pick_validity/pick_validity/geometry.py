@@ -82,6 +82,20 @@ def rotations_about_x(angles: np.ndarray) -> np.ndarray:
     return m
 
 
+def turn_onto(vector: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """The shortest rotation (3, 3) taking unit `vector` to unit `target`."""
+    v, t = vector / np.linalg.norm(vector), target / np.linalg.norm(target)
+    axis, c = np.cross(v, t), float(v @ t)
+    if np.linalg.norm(axis) < 1e-9:
+        if c > 0:
+            return np.eye(3)
+        other = np.array([1.0, 0, 0]) if abs(v[0]) < 0.9 else np.array([0, 1.0, 0])
+        axis = np.cross(v, other)
+    axis /= np.linalg.norm(axis)
+    angle = np.arctan2(np.linalg.norm(np.cross(v, t)), c)
+    return trimesh.transformations.rotation_matrix(angle, axis)[:3, :3]
+
+
 def _convex(vertices: np.ndarray, faces: np.ndarray) -> fcl.Convex:
     """FCL's convex shape from a hull's vertices (M, 3) and triangles (F, 3)."""
     polygons = np.hstack([np.full((len(faces), 1), 3), faces]).ravel()

@@ -113,6 +113,22 @@ def naive_check(geometry: CheckGeometry, container: ContainerSpec, ids: Sequence
                 clear &= not collide(obj, surface)
             if clear:
                 kept.append(k)
+        if not kept and v.station_ok is not None:   # put down on the station, picked again
+            for k in approach:
+                relative = rotation.T @ frames[k]
+                for p, ok in zip(v.placements, v.station_ok, strict=True):
+                    station = fcl.CollisionObject(fcl.Halfspace(-p.normal, -p.offset),
+                                                  fcl.Transform())
+                    clear = ok
+                    for s, obj in zip(shapes, objects, strict=True):
+                        obj.setTransform(fcl.Transform(relative @ s.rotation,
+                                                       grasp.point + relative @ s.center))
+                        queries += 1
+                        clear = clear and not collide(obj, station)
+                    if clear:
+                        kept.append(k)
+                        result.regrasp = True
+                        break
         if not kept:
             result.stage = STAGE_PLACEABILITY
             continue

@@ -40,6 +40,7 @@ class PartResult:
     gripper_pose: np.ndarray | None = None
     jaw_opening: float = 0.0
     valid_tilts: tuple[float, ...] = ()
+    regrasp: bool = False       # placed only after a regrasp on the station
 
     @property
     def valid(self) -> bool:
@@ -47,7 +48,7 @@ class PartResult:
 
     def key(self) -> tuple:
         """What two checks must agree on."""
-        return self.part_id, self.stage, self.grasp_index, self.valid_tilts
+        return self.part_id, self.stage, self.grasp_index, self.valid_tilts, self.regrasp
 
 
 @dataclass

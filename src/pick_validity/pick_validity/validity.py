@@ -30,6 +30,7 @@ centre of the inner floor, +Z up).
 
 
 from collections.abc import Iterable, Sequence
+from dataclasses import replace
 import math
 import time
 
@@ -40,7 +41,7 @@ from pick_common.parts.geometry import PartGeometry
 
 from .check_geometry import build_geometry
 from .config import Setup
-from .geometry import matrix_to_quaternion, place, quaternions_to_matrices, support
+from .geometry import matrix_to_quaternion, place, quaternions_to_matrices, support, turn_onto
 from .pairs import Pairs
 from .results import (
     CENTRE_TOLERANCE,
@@ -78,6 +79,8 @@ class Validator:
         jaws cannot close on the part among them (grasp_fit)."""
         self.setup = setup
         self.geometry = build_geometry(setup, part)
+        if setup.config.regrasp_station:
+            self.geometry = replace(self.geometry, station_ok=self._station_ok())
 
     def __getattr__(self, name: str):
         """The shared geometry's fields, read-only (only called for names the Validator itself
@@ -150,10 +153,14 @@ class Validator:
         return frames[..., 2, 2] >= math.cos(self.config.approach_cone) - 1e-12
 
     def _placeable(self, rotations: np.ndarray, frames: np.ndarray,
-                   grasp_index: np.ndarray) -> np.ndarray:
+                   grasp_index: np.ndarray, axis: np.ndarray | None = None,
+                   offset: float | None = None) -> np.ndarray:
         """(n, T) bool: with the part turned to its place orientation, the gripper holding it
         as it picked it stays on the gripper's side of the seating plane. Decided in the part
-        frame, where the place orientation only fixes the seating plane."""
+        frame, where the place orientation only fixes the seating plane: `axis` . x =
+        `offset` (the place's; a station placement's when given)."""
+        axis = self.place_axis if axis is None else axis
+        offset = self.seat_offset if offset is None else offset
         n, count = frames.shape[:2]
         relative = (np.swapaxes(rotations, 1, 2)[:, None] @ frames).reshape(-1, 3, 3)
         points = np.stack([g.point for g in self.grasps])[grasp_index]
@@ -163,8 +170,40 @@ class Validator:
             sel = np.repeat(grasp_index == g, count)
             for shape in self.gripper_shapes[g]:
                 r, c = place(shape, relative[sel], origin[sel])
-                clear[sel] &= support(shape, r, c, self.place_axis) < self.seat_offset
+                clear[sel] &= support(shape, r, c, axis) < offset
         return clear.reshape(n, count)
+
+    def _station_ok(self) -> np.ndarray:
+        """(P,) bool, per station placement (regrasp.py): the part resting on it, its
+        nearest usable grasp within the tolerance picks it at a tilt within the approach cone
+        that keeps the gripper clear of the station and places it as required."""
+        found = self.placements
+        if not found:
+            return np.zeros(0, dtype=bool)
+        down = np.array([0.0, 0.0, -1.0])
+        rotations = np.stack([turn_onto(p.normal, down) for p in found])
+        angles, turns = self.turned(rotations)
+        if self.usable is not None:
+            angles = np.where(self.usable, angles, math.pi)
+        best = nearest_grasp(angles, turns)
+        frames = self.approach_frames(rotations, best, turns)
+        ok = (angles[np.arange(len(found)), best] <= self.config.tolerance)[:, None] \
+            & self._approachable(frames) & self._placeable(rotations, frames, best)
+        for k, p in enumerate(found):
+            ok[k] &= self._placeable(rotations[k:k + 1], frames[k:k + 1], best[k:k + 1],
+                                     p.normal, p.offset)[0]
+        return ok.any(axis=1)
+
+    def _put_down(self, rotations: np.ndarray, frames: np.ndarray,
+                  grasp_index: np.ndarray) -> np.ndarray:
+        """(n, T) bool: the gripper, holding the part as it picked it, can put it down on a
+        station placement it can be picked from again (station_ok) without reaching past the
+        station's surface."""
+        out = np.zeros(frames.shape[:2], dtype=bool)
+        for p, ok in zip(self.placements, self.station_ok, strict=True):
+            if ok:
+                out |= self._placeable(rotations, frames, grasp_index, p.normal, p.offset)
+        return out
 
     # ----------------------------------------------------------------------------- check
     def check(self, container: ContainerSpec, ids: Sequence[int], poses: np.ndarray,
@@ -201,6 +240,8 @@ class Validator:
         frames = self.approach_frames(rotations[inner], best, turns)    # (n, T, 3, 3)
         approach = self._approachable(frames)
         placeable = self._placeable(rotations[inner], frames, best) & approach
+        station = (self._put_down(rotations[inner], frames, best) & approach
+                   if self.station_ok is not None else np.zeros_like(approach))
         kept: dict[int, np.ndarray] = {}
         world_frames: dict[int, np.ndarray] = {}
         for n, row in enumerate(inner):
@@ -221,7 +262,13 @@ class Validator:
                                  f'within {_deg(self.config.approach_cone)} of +Z (the '
                                  f'closing axis rises {_deg(rise)})')
                 continue
-            # 2. placeability of the tilts within the approach cone.
+            # 2. placeability of the tilts within the approach cone; with a station, the
+            # tilts that put the part down there to be picked again
+            if not placeable[n].any() and station[n].any():
+                result.regrasp = True
+                kept[row] = station[n].copy()
+                world_frames[row] = frames[n]
+                continue
             if not placeable[n].any():
                 result.stage = STAGE_PLACEABILITY
                 result.reason = (f'grasp {self.grasps[g].name!r}: held as it lies, the part '
@@ -288,7 +335,8 @@ class Validator:
         origin = position + rotation @ self.grasps[g].point
         result.gripper_pose = np.concatenate([origin, matrix_to_quaternion(frames[k])])
         result.reason = (f'valid with grasp {self.grasps[g].name!r} at {len(valid)} of '
-                         f'{len(self.tilts)} tilts')
+                         f'{len(self.tilts)} tilts'
+                         + (', placed after a regrasp on the station' if result.regrasp else ''))
 
 
 def nearest_grasp(angles: np.ndarray, turns: np.ndarray) -> np.ndarray:

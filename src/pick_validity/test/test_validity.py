@@ -113,6 +113,28 @@ def test_placeability_depends_on_how_the_part_lies():
     assert _tilts(wide, _tilted(20))[0] == STAGE_PLACEABILITY
 
 
+def test_a_regrasp_station_places_what_the_pitch_kept_from_placing(tmp_path):
+    # Pitched 30 deg the wrong way the part cannot be placed as picked; put down on the
+    # station (lying on its side, flat) it is picked again and placed: valid after a regrasp.
+    from pick_validity.regrasp import placements
+    station = Validator(Setup(grasps=(SIDE,), config=CheckConfig(regrasp_station=True)))
+    assert station.placements and station.station_ok.any()
+    result = station.check(DEEP, [1], [_tilted(-30)], neighbour_check=False).results[0]
+    assert result.stage == STAGE_VALID and result.regrasp, result.reason
+    assert result.reason.endswith('placed after a regrasp on the station')
+    naive = naive_check(station.geometry, DEEP, [1], [_tilted(-30)], neighbour_check=False)
+    assert naive.results[0].key() == result.key()
+    # what places without it keeps its answer, and no regrasp
+    flat = station.check(DEEP, [1], [_tilted(0)], neighbour_check=False).results[0]
+    assert flat.stage == STAGE_VALID and not flat.regrasp
+    # the station's placements keep the margin: a cube rests on each face with d / h = 1;
+    # a margin over it leaves none
+    trimesh.creation.box(extents=(0.01, 0.01, 0.01)).export(tmp_path / 'cube.stl')
+    cube = build_part(PartSpec(model='mesh', mesh_path=str(tmp_path / 'cube.stl'), mass=0.001))
+    assert [round(p.ratio, 6) for p in placements(cube, 0.1)] == [1.0] * 6
+    assert placements(cube, 1.5) == ()
+
+
 def test_the_gripper_stays_within_the_approach_cone():
     # A grasp off the body's axis is fixed to the part. Rolled 40 deg about its body axis,
     # the lying part's closing axis rises 40 deg: the gripper's axis leans at least 40 deg
@@ -288,6 +310,13 @@ def test_fast_check_equals_the_naive_loop_on_settled_scenes(container, model, co
             assert fast.queries < naive.queries
     stages = {r.stage for r in fast.results}
     assert len(stages) >= 3, f'a scene that exercises several stages, got {stages}'
+    # with a regrasp station: its put-downs and picks again, part for part
+    v = Validator(Setup(PartSpec(model=model), grasps=tuple(grasps),
+                        place=PlaceSpec(seat_offset=0.003),
+                        config=CheckConfig(regrasp_station=True)), part)
+    fast = v.check(container, state.ids, state.poses)
+    naive = naive_check(v.geometry, container, state.ids, state.poses)
+    assert [r.key() for r in fast.results] == [r.key() for r in naive.results]
 
 
 def test_mesh_parts_are_checked_with_their_hulls(tmp_path):

@@ -23,7 +23,15 @@ from pick_common.parts.geometry import build_part
 from pick_common.parts.primitives import Hull
 from pick_common.parts.spec import states_units
 from pick_validity.config import VACUUM_SOURCE
-from pick_validity.geometry import BoxShape, CylinderShape, part_shapes, place, Shape, support
+from pick_validity.geometry import (
+    BoxShape,
+    CylinderShape,
+    part_shapes,
+    place,
+    Shape,
+    support,
+    turn_onto,
+)
 from pick_validity.grasp_proposals import as_yaml, JAW_MARGIN, Proposal
 from pick_validity.validity import Validator
 import trimesh
@@ -219,20 +227,6 @@ def _frame(ax, points: np.ndarray, title: str) -> None:
     ax.set_title(title, fontsize=8)
 
 
-def _turn(vector: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """The shortest rotation (3, 3) taking unit `vector` to unit `target`."""
-    v, t = vector / np.linalg.norm(vector), target / np.linalg.norm(target)
-    axis, c = np.cross(v, t), float(v @ t)
-    if np.linalg.norm(axis) < 1e-9:
-        if c > 0:
-            return np.eye(3)
-        other = np.array([1.0, 0, 0]) if abs(v[0]) < 0.9 else np.array([0, 1.0, 0])
-        axis = np.cross(v, other)
-    axis /= np.linalg.norm(axis)
-    angle = np.arctan2(np.linalg.norm(np.cross(v, t)), c)
-    return trimesh.transformations.rotation_matrix(angle, axis)[:3, :3]
-
-
 def clearance(validator: Validator, g: int, relative: np.ndarray) -> float:
     """How far (m) the gripper of grasp `g`, holding the part at `relative` (its rotation in
     the part frame), stays on its side of the seating plane once the part is placed: negative
@@ -251,7 +245,7 @@ def draw_place(ax, validator: Validator, g: int, relatives: list[np.ndarray],
     it reaches past it. Returns the words per tilt ('+0 deg hits')."""
     part = validator.part
     visual, grasp = part.visual, validator.grasps[g]
-    view = _turn(validator.place_axis, np.array([0.0, 0.0, -1.0]))
+    view = turn_onto(validator.place_axis, np.array([0.0, 0.0, -1.0]))
     _draw(ax, visual, view, '#999999', 0.7)
     points = [view @ visual.vertices.T]
     words = []
