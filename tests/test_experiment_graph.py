@@ -22,6 +22,7 @@ from experiment_manager.analysis.results import FILES, read_text_rows, ResultsWr
 from experiment_manager.analysis.verdicts import verdicts
 from experiment_manager.commands import interrupt, supervisor
 from experiment_manager.commands.launcher import executable, WORKER_NODES
+from experiment_manager.commands.run import verdict_table
 from experiment_manager.running.local_backend import LocalBackend
 from experiment_manager.running.scheduler import Runner
 from graph import SMALL, unique_namespace
@@ -78,16 +79,18 @@ def core_run(tmp_path_factory) -> str:
 def test_the_graph_gives_the_results_of_the_cores(graph_run, core_run):
     run_dir, _, done = graph_run
     assert 'best bin' in done.stdout and 'optimum' in done.stdout
-    # the decisions end the output: one line per option, as the report's verdict table
+    # the decisions end the output: one table, a row per option (option, verdict, the stage
+    # that stops most parts) with its deciding reason below it, as the report's verdict table
     verdict_lines = done.stdout.split('verdicts:\n')[1].splitlines()
-    assert [line.split()[0] for line in verdict_lines] == ['static', 'vibrating', 'gripper']
-    assert all(re.search(r': (NOT FEASIBLE|FEASIBLE|UNDECIDED) \(.+\)$', line)
-               for line in verdict_lines)
+    assert verdict_lines[0].split() == ['option', 'verdict', 'stops', 'most', 'parts']
+    rows, reasons = verdict_lines[1::2], verdict_lines[2::2]
+    assert [line.split()[0] for line in rows] == ['static', 'vibrating', 'gripper']
+    assert all(re.search(r'  (NOT FEASIBLE|FEASIBLE|UNDECIDED)  ', line) for line in rows)
+    assert all(re.fullmatch(r'      \(.+\)', line) for line in reasons)
     # the cores decide the same
-    expected = [f'  {v.option.replace("`", "")}: {v.verdict} ('
-                for v in verdicts(summary_model.read(os.path.join(core_run, 'summary.json')))]
-    assert all(line.startswith(e) for line, e in zip(verdict_lines, expected, strict=True)), \
-        (verdict_lines, expected)
+    expected = verdict_table([(v.option, v.verdict, v.stops, v.reasons[0]) for v in verdicts(
+        summary_model.read(os.path.join(core_run, 'summary.json')))])
+    assert rows == expected[1::2], (rows, expected)
     report = re.search(r'^report:\s+(\S+)', done.stdout, re.M).group(1)
     assert report == os.path.join(run_dir, 'report.html')
     for name in ('report.md', 'fig14_bins.png', 'fig15_table.png', 'bin.png', 'tray.png'):
@@ -227,13 +230,13 @@ def test_the_run_s_verdicts_are_published_recorded_and_printed(graph_run):
             if channel.topic == f'{NS}/verdicts']
     expected = verdicts(summary_model.read(os.path.join(run_dir, 'summary.json')))
     assert len(got) == 1 and got[0].run_directory == run_dir
-    assert [(v.option, v.verdict, list(v.reasons)) for v in got[0].verdicts] == [
-        (v.option, v.verdict, v.reasons) for v in expected]
+    assert [(v.option, v.verdict, list(v.reasons), v.stops_most) for v in got[0].verdicts] == [
+        (v.option, v.verdict, v.reasons, v.stops) for v in expected]
     assert {v.verdict for v in got[0].verdicts} <= {
         Verdict.FEASIBLE, Verdict.NOT_FEASIBLE, Verdict.UNDECIDED, Verdict.NOT_ANALYSED}
     printed = done.stdout[done.stdout.index('verdicts:\n'):].splitlines()[1:]
-    for line, v in zip(printed, expected, strict=True):
-        assert line.startswith(f'  {v.option.replace("`", "")}: {v.verdict} ('), line
+    assert printed == verdict_table([(v.option, v.verdict, v.stops, v.reasons[0])
+                                     for v in expected])
 
 
 SENSITIVITY = os.path.join(os.path.dirname(SMALL), 'sensitivity_experiment.yaml')

@@ -267,16 +267,22 @@ def test_the_options_files_are_their_part_and_the_same_experiments_with_a_cup(na
     case = os.path.join(HERE, '..', 'config', 'test_case')
     part = experiment_file.load(os.path.join(case, name.split('_')[0] + '.yaml'))
     options = experiment_file.load(os.path.join(case, name))
-    assert [e for e in options.experiments if not e.gripper] == list(part.experiments)
+    assert [e for e in options.experiments if not e.gripper and not e.station] == list(
+        part.experiments)
     assert (options.id, options.seed, options.setup, options.moves, options.requirements,
             options.cell, options.tray) == (part.id, part.seed, part.setup, part.moves,
                                              part.requirements, part.cell, part.tray)
     cup = [e for e in options.experiments if e.gripper]
     assert [e.id for e in cup] == [f'{e.id}_cup' for e in part.experiments]
-    for mine, theirs in zip(cup, part.experiments, strict=True):
+    for mine, theirs in zip(cup, part.experiments, strict=True):     # on the same scenes
         assert (mine.type, mine.iterations, mine.parts, mine.bins, mine.counts) == (
             theirs.type, theirs.iterations, theirs.parts, theirs.bins, theirs.counts)
         assert mine.gripper == 'cup' and type(mine.setup.gripper).__name__ == 'SuctionCup'
+        assert mine.seeded_by == theirs.id
+    station = options.experiment('emptying_station')
+    assert station.station and station.setup.config.regrasp_station
+    assert (station.bin_from, station.parts, station.seeded_by) == ('bins', part.experiment(
+        'emptying').parts, 'emptying')
 
 
 def test_every_error_of_a_file_comes_at_once():

@@ -108,6 +108,8 @@ experiments:
   - {id: emptying, type: bin_emptying, iterations: 1, parts: 15, bin: [60, 60, 20]}
   - {id: emptying_cup, type: bin_emptying, iterations: 1, parts: 15, bin: [60, 60, 20],
      gripper: cup}
+  - {id: emptying_station, type: bin_emptying, iterations: 1, parts: 15, bin: [60, 60, 20],
+     regrasp_station: true, scenes_of: emptying}
 """
 
 
@@ -128,14 +130,45 @@ def test_one_file_compares_options_per_gripper_with_the_stage_that_stops_most(tm
     assert 'gripper' not in summary['experiments']['emptying']
     found = verdicts(summary_model.validate(summary))
     bins = [v for v in found if v.kind.startswith('static bin')]
-    assert [v.kind for v in bins] == ['static bin', 'static bin, gripper cup']
-    assert bins[1].option == 'static bin 60 x 60 x 20 mm, gripper cup'
+    assert [v.kind for v in bins] == ['static bin', 'static bin with a regrasp station',
+                                      'static bin, gripper cup']
+    assert bins[2].option == 'static bin 60 x 60 x 20 mm, gripper cup'
+    assert summary['experiments']['emptying_station']['station'] is True
+    assert any('after a regrasp on the station' in r for r in bins[1].reasons)
     for v in bins:       # the stage that stops most parts, with its share
         assert v.stops.split(' (')[0] in ('candidacy', 'placeability', 'container',
                                           'neighbours')
         assert '% of the parts checked)' in v.stops
     # the cup's checks are the cup's: its emptying removed parts on its own grasps
     assert summary['experiments']['emptying_cup']['removed']['mean'] is not None
+
+
+STATION = """id: station
+seed: 5
+experiments:
+  - {id: emptying, type: bin_emptying, iterations: 1, parts: 20, bin: [150, 150, 20]}
+  - {id: station, type: bin_emptying, iterations: 1, parts: 20, bin: [150, 150, 20],
+     regrasp_station: true, scenes_of: emptying}
+"""
+
+
+def test_a_regrasp_station_picks_what_could_not_be_placed_on_the_same_scenes(tmp_path):
+    from experiment_manager.analysis.results import read_csv, ResultsWriter
+    from experiment_manager.running.local_backend import LocalBackend
+    from experiment_manager.running.scheduler import Runner
+    file = experiment_file.parse(STATION)
+    assert file.experiment('station').seeded_by == 'emptying'
+    with LocalBackend() as backend, ResultsWriter(str(tmp_path), file.text) as writer:
+        summary = Runner(file, [backend], writer).run()
+    rows = {r['experiment']: r for r in read_csv(str(tmp_path / 'iterations.csv'))}
+    assert rows['station']['seed'] == rows['emptying']['seed']         # the same scene
+    picks = [p for p in read_csv(str(tmp_path / 'picks.csv')) if p['experiment'] == 'station']
+    station = summary['experiments']['station']
+    # the regrasps counted are the picks placed only after one: here the station picked
+    # one part the plain bin left
+    assert station['regrasps']['mean'] == sum(p['regrasp'] for p in picks) == 1
+    plain = summary['experiments']['emptying']['removed']['mean']
+    assert station['removed']['mean'] == plain + 1
 
 
 @pytest.mark.parametrize('change, field, words', [

@@ -81,7 +81,8 @@ def feeder_runs(rows: list[dict], cell) -> list[dict]:
     time to empty the feeder, s (inf for a run that did not empty), and `spilled`."""
     out = []
     for r in rows:
-        busy = r['picks'] * cell.pick_time + r['checks'] * cell.image_time + r['table_time']
+        busy = (r['picks'] * cell.pick_time + r['checks'] * cell.image_time + r['table_time']
+                + r.get('regrasps', 0) * cell.regrasp_time)
         out.append({'time': busy if r['emptied'] else math.inf, 'spilled': r['spilled'],
                     'emptied': bool(r['emptied'])})
     return out

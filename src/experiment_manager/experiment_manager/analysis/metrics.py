@@ -135,7 +135,9 @@ def bin_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
             'emptied': emptied, 'emptied_ci95': list(rate_interval(emptied, len(rows))),
             'removed': stats([r['picks'] for r in rows]),
             'searches_per_pick': stats([p['searches'] for p in picks]),
-            'first_check': _fractions(rows)}
+            'first_check': _fractions(rows),
+            **({'regrasps': stats([r.get('regrasps', 0) for r in rows])}
+               if exp.station else {})}
 
 
 def fit(counts: np.ndarray, means: np.ndarray, order: int, first: int, last: int
@@ -248,9 +250,12 @@ def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
                                                                             for r in rows})},
             'minutes_per_vibration_allowed': per_vibration,
             'parts_per_hour': stats(hourly), 'parts_per_hour_ci95': list(interval(hourly)),
-            'cell': {'pick_s': file.cell.pick_time, 'image_s': file.cell.image_time},
+            'cell': {'pick_s': file.cell.pick_time, 'image_s': file.cell.image_time,
+                     'regrasp_s': file.cell.regrasp_time},
             'decision': {name: d.as_dict() for name, d in table_grounds(file, rows).items()},
-            'first_check': _fractions(rows)}
+            'first_check': _fractions(rows),
+            **({'regrasps': stats([r.get('regrasps', 0) for r in rows])}
+               if exp.station else {})}
 
 
 def table_grounds(file: ExperimentFile, rows: list[dict],
@@ -273,7 +278,7 @@ def cell_throughput(cell, row: dict) -> float:
     (each pick `cell.pick_time`, each check an image of `cell.image_time`) plus the time the
     table's feeds and vibrations took until the parts rested (simulated, `table_time`)."""
     busy = (row['picks'] * cell.pick_time + row['checks'] * cell.image_time
-            + row['table_time'])
+            + row['table_time'] + row.get('regrasps', 0) * cell.regrasp_time)
     return 3600.0 * row['picks'] / busy
 
 
@@ -361,6 +366,8 @@ def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: li
         out = feeder_emptying(file, exp, rows, low_high)
     if exp.gripper:
         out['gripper'] = exp.gripper
+    if exp.station:
+        out['station'] = True
     return {'type': exp.type, **out, 'faults': faults, 'physics': health}
 
 

@@ -16,13 +16,13 @@ ITERATION_COLUMNS = (
     'container_z', 'parts', 'checked', 'outside', 'candidates', 'placeable', 'container_free',
     'valid', 'checks', 'picks', 'settled', 'unsettled', 'spilled', 'tunnelled', 'thrown',
     'max_penetration', 'max_speed', 'tray_error', 'emptied', 'vibrations', 'feeds', 'stop',
-    'fault', 'table_time', 'wall_time', 'aspect')
+    'fault', 'table_time', 'wall_time', 'aspect', 'regrasps')
 CHECK_COLUMNS = (*KEY, 'check', 'parts_on_table', 'checked', 'outside', 'candidates',
                  'placeable', 'container_free', 'valid', 'picked_id', 'searches', 'vibrations',
                  'wall_time')
 PART_COLUMNS = (*KEY, 'check', 'part_id', *POSE, 'inside', 'stage', 'grasp', 'tilts')
 PICK_COLUMNS = (*KEY, 'pick', 'check', 'part_id', 'searches', 'vibrations', 'grasp',
-                *GRIPPER_POSE)
+                *GRIPPER_POSE, 'regrasp')
 FILES = {'iterations': ITERATION_COLUMNS, 'checks': CHECK_COLUMNS, 'parts': PART_COLUMNS,
          'picks': PICK_COLUMNS}
 TEXT = {'experiment', 'type', 'stop', 'fault', 'aspect'}

@@ -67,6 +67,7 @@ class _Experiment(_Record):
     sampling: Sampling | None = None
     gripper: str | None = Field(None, description="the gripper of the file's `grippers` it "
                                 "ran with; none: the file's own")
+    station: bool | None = Field(None, description='with a regrasp station')
 
 
 class Bin(_Record):
@@ -96,6 +97,8 @@ class BinEmptying(_Experiment):
     removed: Stats
     searches_per_pick: Stats
     first_check: Fractions
+    regrasps: Stats | None = Field(None, description='with a station: picks placed only '
+                                   'after a regrasp, per iteration')
 
 
 class Count(_Record):
@@ -120,6 +123,7 @@ class TableSweep(_Experiment):
 class Cell(_Record):
     pick_s: float
     image_s: float
+    regrasp_s: float | None = None
 
 
 class TableGrounds(_Record):
@@ -148,6 +152,8 @@ class FeederEmptying(_Experiment):
     decision: TableGrounds
     first_check: Fractions | None = Field(None, description="each run's first check, the "
                                           'tray loaded')
+    regrasps: Stats | None = Field(None, description='with a station: picks placed only '
+                                   'after a regrasp, per run')
 
 
 class Variant(_Record):

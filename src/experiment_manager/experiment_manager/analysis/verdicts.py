@@ -80,12 +80,12 @@ def verdicts(summary: Summary) -> list[Verdict]:
     its `grippers` in the order the experiments name them)."""
     capacity = summary.requirements.capacity
     required = summary.requirements.success_rate
-    out = [_bin_verdict(s, gripper, capacity, required)
-           for gripper, s in _per_gripper(summary, 'bin_emptying')] or [
+    out = [_bin_verdict(s, option, capacity, required)
+           for option, s in _per_gripper(summary, 'bin_emptying')] or [
         Verdict('static bin', 'static bin', NOT_ANALYSED,
                 ['no bin_emptying experiment in the file'])]
-    out += [_table_verdict(s, gripper, capacity, required)
-            for gripper, s in _per_gripper(summary, 'feeder_emptying')] or [
+    out += [_table_verdict(s, option, capacity, required)
+            for option, s in _per_gripper(summary, 'feeder_emptying')] or [
         Verdict('vibrating table', 'vibrating table', NOT_ANALYSED,
                 ['no feeder_emptying experiment in the file'])]
     out += [_gripper_verdict(exp_id, s) for exp_id, s in summary.of_type('gripper_sweep')]
@@ -97,17 +97,19 @@ def verdicts(summary: Summary) -> list[Verdict]:
     return out
 
 
-def _per_gripper(summary: Summary, kind: str) -> list[tuple[str, object]]:
-    """(gripper name, '' for the file's own, and the last experiment of `kind` run with it),
-    the file's own first."""
-    found: dict[str, object] = {}
+def _per_gripper(summary: Summary, kind: str) -> list[tuple[tuple[str, bool], object]]:
+    """((gripper name, '' for the file's own; with a station), the last experiment of `kind`
+    run so), the file's own gripper first, without a station before with one."""
+    found: dict[tuple[str, bool], object] = {}
     for _, s in summary.of_type(kind):
-        found[s.gripper or ''] = s
-    return sorted(found.items(), key=lambda item: item[0] != '')
+        found[s.gripper or '', bool(s.station)] = s
+    return sorted(found.items(), key=lambda item: (item[0][0] != '', item[0][1]))
 
 
-def _named(text: str, gripper: str) -> str:
-    return f'{text}, gripper {gripper}' if gripper else text
+def _named(text: str, option: tuple[str, bool]) -> str:
+    gripper, station = option
+    return (text + (' with a regrasp station' if station else '')
+            + (f', gripper {gripper}' if gripper else ''))
 
 
 def stops_most(fractions) -> tuple[str, float] | None:
@@ -128,21 +130,24 @@ def _stops(fractions) -> str:
     return '' if found is None else f'{found[0]} ({pct(found[1])} of the parts checked)'
 
 
-def _bin_verdict(s, gripper: str, capacity: int, required: float) -> Verdict:
+def _bin_verdict(s, option: tuple[str, bool], capacity: int, required: float) -> Verdict:
     decision = s.decision
     reasons = [decision.reason + _more(decision, required),
                f'parts removed per bin: mean {fmt(s.removed.mean)}, max '
                f'{fmt(s.removed.max)} of {s.parts}']
+    if s.regrasps is not None and s.regrasps.mean is not None:
+        reasons.append(f'of them placed after a regrasp on the station: mean '
+                       f'{fmt(s.regrasps.mean)} per bin')
     verdict, reasons = _decided(decision.verdict, reasons, s,
                                 None if s.parts >= capacity else
                                 f'the bin was filled with {s.parts} parts, fewer than '
                                 f'the {capacity} a refill interval needs')
-    return Verdict(_named(f'static bin {dims(s.bin_mm)} mm', gripper),
-                   _named('static bin', gripper), verdict, reasons, {'emptied': decision},
+    return Verdict(_named(f'static bin {dims(s.bin_mm)} mm', option),
+                   _named('static bin', option), verdict, reasons, {'emptied': decision},
                    _stops(s.first_check))
 
 
-def _table_verdict(s, gripper: str, capacity: int, required: float) -> Verdict:
+def _table_verdict(s, option: tuple[str, bool], capacity: int, required: float) -> Verdict:
     grounds = {'time': s.decision.time, 'spills': s.decision.spills}
     time, spills = grounds['time'], grounds['spills']
     verdict = decisions.combined([g.verdict for g in grounds.values()])
@@ -168,11 +173,14 @@ def _table_verdict(s, gripper: str, capacity: int, required: float) -> Verdict:
         reasons.append(f'the cell would pick {fmt(s.parts_per_hour.mean, 4)} parts per hour '
                        f'on average, at {fmt(s.cell.pick_s)} s per pick and '
                        f'{fmt(s.cell.image_s)} s per image (cell.pick_s, '
-                       'cell.image_s) and the simulated time of the feeds and vibrations')
+                       'cell.image_s) and the simulated time of the feeds and vibrations'
+                       + (f', and {fmt(s.cell.regrasp_s)} s per regrasp (cell.regrasp_s; '
+                          f'{fmt(s.regrasps.mean)} per run)' if s.regrasps is not None
+                          and s.regrasps.mean is not None else ''))
     verdict, reasons = _decided(verdict, reasons, s, None if s.parts >= capacity else
                                 f'the feeder held {s.parts} parts, fewer than the '
                                 f'{capacity} a refill interval needs')
-    return Verdict(_named('vibrating table', gripper), _named('vibrating table', gripper),
+    return Verdict(_named('vibrating table', option), _named('vibrating table', option),
                    verdict, reasons, grounds, _stops(s.first_check))
 
 

@@ -296,19 +296,23 @@ def _run(node: Node, client: LockedActionClient, goal, given: str, graph: Graph,
     print('\n'.join(headlines(summary)))
     # the manager's decisions in one table, each with the stage that stops most parts and
     # its first reason (the report gives them all)
-    print('verdicts:\n' + '\n'.join(verdict_table(result.verdicts)))
+    print('verdicts:\n' + '\n'.join(verdict_table(
+        [(v.option, v.verdict, v.stops_most, v.reasons[0]) for v in result.verdicts])))
     return 0
 
 
-def verdict_table(found) -> list[str]:
-    """The options' verdicts as aligned columns: option, verdict, the stage that stops most
-    parts; each row's first reason on the line below it."""
-    rows = [(v.option.replace('`', ''), v.verdict, v.stops_most or '-') for v in found]
+def verdict_table(rows: list[tuple[str, str, str, str]]) -> list[str]:
+    """The options' verdicts as aligned columns, option, verdict and the stage that stops
+    most parts ('-' when none is known), from (option, verdict, stops, first reason) each;
+    the first reason, in brackets, on the line below its row."""
+    cells = [(option.replace('`', ''), verdict, stops or '-') for option, verdict, stops, _
+             in rows]
     head = ('option', 'verdict', 'stops most parts')
-    widths = [max(len(r[k]) for r in [head, *rows]) for k in range(3)]
-    lines = ['  ' + '  '.join(c.ljust(w) for c, w in zip(head, widths, strict=True)).rstrip()]
-    for v, row in zip(found, rows, strict=True):
-        lines.append('  ' + '  '.join(c.ljust(w) for c, w in zip(row, widths,
-                                                                 strict=True)).rstrip())
-        lines.append(f'      ({v.reasons[0]})')
-    return lines
+    widths = [max(len(c[k]) for c in [head, *cells]) for k in range(3)]
+
+    def line(c: tuple[str, ...]) -> str:
+        return '  ' + '  '.join(x.ljust(w) for x, w in zip(c, widths, strict=True)).rstrip()
+    out = [line(head)]
+    for c, row in zip(cells, rows, strict=True):
+        out += [line(c), f'      ({row[3]})']
+    return out

@@ -91,6 +91,11 @@ class OnGripper(ExperimentKeys):
     file's `grippers` named here."""
 
     gripper: Identifier | None = None
+    # a part no tilt can place as picked is put down on a flat station and picked again
+    regrasp_station: bool = False
+    # an earlier experiment of the same type whose seeds this one runs on: the same scenes,
+    # another gripper or a station
+    scenes_of: Identifier | None = None
 
 
 class BinStaticKeys(OnGripper):

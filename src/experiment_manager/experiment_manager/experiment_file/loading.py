@@ -136,9 +136,10 @@ def _sensitivity(e: experiment_keys.SensitivityKeys, where: str, c: _Context) ->
     if len(set(e.of)) != len(e.of):
         raise InvalidArgument(f'{where}.of', list(e.of), 'names an experiment twice')
     for i, exp_id in enumerate(e.of):
-        if c.earlier[exp_id].gripper:
+        if c.earlier[exp_id].gripper or c.earlier[exp_id].station:
             raise InvalidArgument(f'{where}.of[{i}]', exp_id, 'runs with a gripper of the '
-                                  "file's grippers; a sensitivity varies the file's own")
+                                  "file's grippers or a regrasp station; a sensitivity varies "
+                                  "the file's own cell")
     inputs = []
     for name, r in e.inputs.items():
         at = f'{where}.inputs.{name}'
@@ -200,6 +201,13 @@ def _experiment(e: experiment_keys.ExperimentKeys, where: str, c: _Context) -> l
             raise InvalidArgument(f'{where}.gripper', e.gripper, 'names no gripper of the '
                                   f"file's grippers ({', '.join(c.named) or 'none'})")
         out['gripper'], out['setup'] = e.gripper, c.named[e.gripper]
+    if getattr(e, 'scenes_of', None) is not None:
+        _earlier(f'{where}.scenes_of', e.scenes_of, c, e.type, 'leave scenes_of out')
+        out['seeded_by'] = c.earlier[e.scenes_of].seeded_by or e.scenes_of
+    if getattr(e, 'regrasp_station', False):
+        mine = out.get('setup', c.setup)
+        out['station'] = True
+        out['setup'] = replace(mine, config=replace(mine.config, regrasp_station=True))
     if e.type == BIN_STATIC:
         out['bins'] = tuple(_bin(v, f'{where}.bins_mm[{i}]', c) for i, v in enumerate(e.bins_mm))
         for i, b in enumerate(out['bins']):
@@ -322,7 +330,8 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         tray=tray, moves=moves, bin_wall=MM * top.bin_wall_mm, requirements=requirements,
         experiments=tuple(context.earlier.values()),
         sampling=Sampling(mode=s['sampling'].mode, batch=s['sampling'].batch),
-        cell=Cell(pick_time=s['cell'].pick_s, image_time=s['cell'].image_s),
+        cell=Cell(pick_time=s['cell'].pick_s, image_time=s['cell'].image_s,
+                  regrasp_time=s['cell'].regrasp_s),
         path=os.path.abspath(path) if path else '', text=text, auto_grasps=auto_grasps,
         part_volume=geometry.volume,
         material_account=part_section.material_account(s['materials']))

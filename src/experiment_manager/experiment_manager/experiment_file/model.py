@@ -57,10 +57,12 @@ class Cell:
     pick and every vibration), s. The table's time comes from the simulation: each feed's and
     vibration's simulated duration until the parts rest. 4 s per pick: the fast end of the 4
     to 10 s a hand insertion of a wired part takes (docs/decisions.md); 0 s per image: not
-    counted unless set. Set both to the cell's measured figures."""
+    counted unless set. Set both to the cell's measured figures. A regrasp on a station
+    costs one more place and pick, regrasp_time s: assumed as long as a pick."""
 
     pick_time: float = 4.0      # s
     image_time: float = 0.0     # s
+    regrasp_time: float = 4.0   # s
 
 
 @dataclass(frozen=True)
@@ -157,6 +159,8 @@ class Experiment:
     # the gripper of the file's `grippers` it runs with ('' and None: the file's own)
     gripper: str = ''
     setup: Setup | None = None
+    station: bool = False       # with a regrasp station (its setup's check says so)
+    seeded_by: str = ''         # the experiment whose seeds it runs on (scenes_of); '': its own
 
     @property
     def sources(self) -> tuple[str, ...]:

@@ -112,7 +112,7 @@ def plan(file: ExperimentFile, exp: Experiment, summary: dict) -> list[Unit]:
     """The iterations of `exp`, given the metrics of the experiments before it. A sensitivity
     scenario's repeat runs on the seeds of the experiment it repeats (scenarios.py)."""
     units = []
-    seeded_by = exp.id.partition('@')[0]
+    seeded_by = exp.seeded_by or exp.id.partition('@')[0]
 
     def unit(group: int, i: int, container: ContainerSpec, parts: int, **kw) -> Unit:
         return Unit(exp, group, i, iteration_seed(file.seed, seeded_by, (group, i)),

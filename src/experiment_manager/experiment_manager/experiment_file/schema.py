@@ -222,6 +222,7 @@ class RequirementsSection(Section):
 class CellSection(Section):
     pick_s: Number(0.0, 3600.0, low_open=True) = Cell.pick_time
     image_s: Number(0.0, 3600.0) = Cell.image_time
+    regrasp_s: Number(0.0, 3600.0) = Cell.regrasp_time
 
 
 class SamplingSection(Section):

@@ -85,7 +85,8 @@ def run_unit(file: ExperimentFile, u: Unit, backend: Backend) -> Record:
                                          'container_free', 'valid')},
         'checks': len(record.checks), 'picks': len(record.picks),
         **row, 'fault': faults(row), 'table_time': iteration.table_time,
-        'wall_time': time.monotonic() - start, 'aspect': row.get('aspect', '')}
+        'wall_time': time.monotonic() - start, 'aspect': row.get('aspect', ''),
+        'regrasps': sum(p['regrasp'] for p in record.picks)}
     return record
 
 
@@ -163,7 +164,7 @@ class Iteration:
                     'part_id': pid, 'searches': searches, 'vibrations': vibrations,
                     'grasp': result.grasp_index,
                     **dict(zip(GRIPPER_POSE, np.asarray(result.gripper_pose).tolist(),
-                               strict=True))})
+                               strict=True)), 'regrasp': int(result.regrasp)})
                 return pid
         raise AssertionError('a report with valid parts has none in the search order')
 

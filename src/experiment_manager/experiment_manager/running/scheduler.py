@@ -272,8 +272,9 @@ class Runner:
         in flight it waits rather than leave: their end may release an experiment, and a lost
         worker's iteration comes back to the queue."""
         backend = self.backends[k]
-        # what `backend` was last given: the scenario and the gripper (None, '': the file's)
-        scenario, gripper = None, ''
+        # what `backend` was last given: the scenario, the gripper and the station (None,
+        # '', False: the file's)
+        given = (None, '', False)
         while True:
             with self._cond:
                 while not self._ready and self._in_flight and not self._errors:
@@ -285,9 +286,10 @@ class Runner:
                 self._report(u.experiment, f'{u.experiment.id}: {u.label}')
             try:
                 file = self.file.for_experiment(u.experiment)
-                if u.experiment.scenario is not scenario or u.experiment.gripper != gripper:
+                wanted = (u.experiment.scenario, u.experiment.gripper, u.experiment.station)
+                if wanted[0] is not given[0] or wanted[1:] != given[1:]:
                     backend.start(file)
-                    scenario, gripper = u.experiment.scenario, u.experiment.gripper
+                    given = wanted
                 record = run_unit(file, u, backend)
             except WorkerLost as exc:
                 with self._cond:
