@@ -83,14 +83,14 @@ def test_the_graph_gives_the_results_of_the_cores(graph_run, core_run):
     # that stops most parts) with its deciding reason below it, as the report's verdict table
     verdict_lines = done.stdout.split('verdicts:\n')[1].splitlines()
     assert verdict_lines[0].split() == ['option', 'verdict', 'stops', 'most', 'parts']
-    rows, reasons = verdict_lines[1::2], verdict_lines[2::2]
-    assert [line.split()[0] for line in rows] == ['static', 'vibrating', 'gripper']
-    assert all(re.search(r'  (NOT FEASIBLE|FEASIBLE|UNDECIDED)  ', line) for line in rows)
+    table_rows, reasons = verdict_lines[1::2], verdict_lines[2::2]
+    assert [line.split()[0] for line in table_rows] == ['static', 'vibrating', 'gripper']
+    assert all(re.search(r'  (NOT FEASIBLE|FEASIBLE|UNDECIDED)  ', line) for line in table_rows)
     assert all(re.fullmatch(r'      \(.+\)', line) for line in reasons)
     # the cores decide the same
     expected = verdict_table([(v.option, v.verdict, v.stops, v.reasons[0]) for v in verdicts(
         summary_model.read(os.path.join(core_run, 'summary.json')))])
-    assert rows == expected[1::2], (rows, expected)
+    assert table_rows == expected[1::2], (table_rows, expected)
     report = re.search(r'^report:\s+(\S+)', done.stdout, re.M).group(1)
     assert report == os.path.join(run_dir, 'report.html')
     for name in ('report.md', 'fig14_bins.png', 'fig15_table.png', 'bin.png', 'tray.png'):

@@ -97,15 +97,7 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
                  "outward normal of its face in the file's frame and its quasi-static share:")
     lines += [f'    {a.name}: ({", ".join(f"{v:.2f}" for v in a.normal)}), '
               f'{100 * a.quasi_static:.1f} %' for a in part_aspects(part)]
-    if checks.suction:
-        cup = checks.gripper
-        lines.append(f'  gripper: a suction cup {cup.cup_diameter * MM:g} mm across and '
-                     f'{cup.cup_height * MM:g} mm high on a {cup.body_diameter * MM:g} x '
-                     f'{cup.body_length * MM:g} mm body, {cup.vacuum / 1000:g} kPa, safety '
-                     f'factor {cup.safety_factor:g}, {cup.acceleration:g} m/s^2, cup friction '
-                     f'{cup.cup_friction:g} (defaults: {VACUUM_SOURCE})')
-    for figures in grasp_figures(file, checks):
-        lines.append(_grasp_line(figures))
+    lines += grasp_lines(file, checks)
     if file.auto_grasps and checks.suction:
         lines.append('  the grasps are part.grasps: auto, proposed from the geometry (per way '
                      'the part can lie, the cup on its top where it seals and holds nearest '
@@ -123,6 +115,33 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
                                                               strict=True))
         lines += ['  ' + line for line in as_yaml(used)]
     return lines
+
+
+def grasp_lines(file: ExperimentFile, checks: Validator) -> list[str]:
+    """A suction cup's line (the jaws are said in the file's keys), then a line per grasp
+    (grasp_figures)."""
+    lines = []
+    if checks.suction:
+        cup = checks.gripper
+        lines.append(f'  gripper: a suction cup {cup.cup_diameter * MM:g} mm across and '
+                     f'{cup.cup_height * MM:g} mm high on a {cup.body_diameter * MM:g} x '
+                     f'{cup.body_length * MM:g} mm body, {cup.vacuum / 1000:g} kPa, safety '
+                     f'factor {cup.safety_factor:g}, {cup.acceleration:g} m/s^2, cup friction '
+                     f'{cup.cup_friction:g} (defaults: {VACUUM_SOURCE})')
+    return lines + [_grasp_line(figures) for figures in grasp_figures(file, checks)]
+
+
+def named_grippers(file: ExperimentFile, checks: Validator
+                   ) -> list[tuple[str, ExperimentFile, Validator]]:
+    """The file's `grippers` its experiments name, in the order they first do: (name, the
+    file as such an experiment runs it, its checks on the same part)."""
+    out, seen = [], set()
+    for exp in file.experiments:
+        if exp.gripper and exp.gripper not in seen:
+            seen.add(exp.gripper)
+            mine = file.for_experiment(exp)
+            out.append((exp.gripper, mine, Validator(mine.setup, checks.part)))
+    return out
 
 
 def grasp_figures(file: ExperimentFile, checks: Validator) -> list[dict]:
@@ -188,7 +207,10 @@ def write_check(file: ExperimentFile, checks: Validator, path: str) -> str:
     and, per grasp, its figures and verdicts (grasp_figures)."""
     with open(path, 'w', encoding='utf-8') as f:
         json.dump({'file': file.path, 'part': describe(file, checks),
-                   'grasps': grasp_figures(file, checks)}, f, indent=1)
+                   'grasps': grasp_figures(file, checks),
+                   'grippers': {name: grasp_figures(mine, theirs)
+                                for name, mine, theirs in named_grippers(file, checks)}},
+                  f, indent=1)
     return path
 
 

@@ -38,6 +38,9 @@ def check(paths: list[str], output: str | None, iterations: int | None = None,
         checks = part_sheet.validator(file)
         print(f'{path}: reads as a run would')
         print('\n'.join(part_sheet.describe(file, checks)))
+        for name, mine, theirs in part_sheet.named_grippers(file, checks):
+            print(f'  gripper {name!r} (grippers.{name}), for the experiments that name it:')
+            print('\n'.join('  ' + line for line in part_sheet.grasp_lines(mine, theirs)))
         directory = os.path.abspath(os.path.expanduser(output or file.output_dir))
         sheet = part_sheet.write(checks, os.path.join(directory, f'{file.id}_part.png'))
         print(f'sheet: {sheet}')
