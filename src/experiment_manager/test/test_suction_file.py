@@ -184,3 +184,13 @@ def test_a_bad_named_gripper_is_named(change, field, words):
         experiment_file.parse(OPTIONS.replace(*change))
     assert err.value.field == field, str(err.value)
     assert words in str(err.value)
+
+
+def test_the_station_s_margin_is_the_file_s_and_checked():
+    text = STATION.replace('experiments:', 'check: {station_margin: 0.3}\nexperiments:')
+    file = experiment_file.parse(text)
+    assert file.experiment('station').setup.config.station_margin == 0.3
+    assert not file.for_experiment(file.experiment('emptying')).setup.config.regrasp_station
+    with pytest.raises(InvalidArgument) as err:
+        experiment_file.parse(text.replace('0.3}', '-1}'))
+    assert 'check.station_margin' in str(err.value) and '-1' in str(err.value)

@@ -208,6 +208,7 @@ class CheckSection(Section):
     tilt_step_deg: Number() = CheckConfig.tilt_step / DEG
     approach_cone_deg: Number() = CheckConfig.approach_cone / DEG
     rim_tolerance_mm: Number() = CheckConfig.rim_tolerance / MM
+    station_margin: Number() = CheckConfig.station_margin      # d / h, for regrasp_station
     search_order: Text(*SEARCH_ORDERS) = 'top_first'
 
 

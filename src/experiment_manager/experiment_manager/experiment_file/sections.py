@@ -30,7 +30,7 @@ def check(c: schema.CheckSection) -> CheckConfig:
     return CheckConfig(tolerance=DEG * c.tolerance_deg, tilt_min=DEG * c.tilt_min_deg,
                        tilt_max=DEG * c.tilt_max_deg, tilt_step=DEG * c.tilt_step_deg,
                        approach_cone=DEG * c.approach_cone_deg,
-                       rim_tolerance=MM * c.rim_tolerance_mm)
+                       rim_tolerance=MM * c.rim_tolerance_mm, station_margin=c.station_margin)
 
 
 def requirements(r: schema.RequirementsSection) -> Requirements:
