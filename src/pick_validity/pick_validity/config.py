@@ -224,7 +224,7 @@ def check_gripper(gripper: Gripper | SuctionCup) -> Gripper | SuctionCup:
     return gripper
 
 
-def _perpendicular(up: np.ndarray) -> np.ndarray:
+def perpendicular(up: np.ndarray) -> np.ndarray:
     """A unit vector at right angles to `up`: the part axis least along it, made square."""
     axis = np.eye(3)[int(np.argmin(np.abs(up)))]
     axis = axis - (axis @ up) * up
@@ -255,7 +255,7 @@ def check_grasps(grasps: list[GraspPose] | tuple[GraspPose, ...] | tuple[Suction
             point = np.array(check_vector(f'{where}.grasp_point', g.grasp_point, 3,
                                           low=-1.0, high=1.0))
             opening = gripper.cup_diameter if suction else 0.0
-            out.append(Grasp(g.name or f'grasp_{i}', up, _perpendicular(up), opening, point))
+            out.append(Grasp(g.name or f'grasp_{i}', up, perpendicular(up), opening, point))
             continue
         closing = _unit(f'{where}.closing_axis', g.closing_axis)
         angle = math.acos(min(1.0, abs(float(up @ closing))))

@@ -20,6 +20,8 @@ import numpy as np
 from pick_common.parts.geometry import PartGeometry
 from scipy.spatial import ConvexHull, QhullError
 
+from .config import perpendicular
+
 PLANE_TOLERANCE = 1e-7      # m: hull vertices this near a face's plane touch the station
 
 
@@ -47,8 +49,7 @@ def placements(part: PartGeometry, margin: float) -> tuple[Placement, ...]:
         touching = vertices[vertices @ n >= offset - PLANE_TOLERANCE]
         if height <= 0 or len(touching) < 3:
             continue
-        e1 = np.cross(n, np.eye(3)[int(np.argmin(np.abs(n)))])
-        e1 /= np.linalg.norm(e1)
+        e1 = perpendicular(n)
         e2 = np.cross(n, e1)
         flat = np.column_stack([touching @ e1, touching @ e2])
         try:

@@ -33,7 +33,7 @@ import math
 import numpy as np
 from pick_common.parts.geometry import PartGeometry
 
-from .config import Grasp, SuctionCup
+from .config import Grasp, perpendicular, SuctionCup
 from .grasp_fit import crossings, surface
 
 RIM_POINTS = 32
@@ -78,9 +78,7 @@ class Holding:
 
 
 def _basis(up: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    a = np.eye(3)[int(np.argmin(np.abs(up)))]
-    a = a - (a @ up) * up
-    a /= np.linalg.norm(a)
+    a = perpendicular(up)
     return a, np.cross(up, a)
 
 
