@@ -20,9 +20,9 @@ from experiment_manager import experiment_file
 from experiment_manager.analysis import summary as summary_model
 from experiment_manager.analysis.results import FILES, read_text_rows, ResultsWriter
 from experiment_manager.analysis.verdicts import verdicts
+from experiment_manager.analysis.wording import verdict_table
 from experiment_manager.commands import interrupt, supervisor
 from experiment_manager.commands.launcher import executable, WORKER_NODES
-from experiment_manager.commands.run import verdict_table
 from experiment_manager.running.local_backend import LocalBackend
 from experiment_manager.running.scheduler import Runner
 from graph import SMALL, unique_namespace

@@ -80,3 +80,20 @@ def varying(variants: list) -> tuple[tuple[str, ...], bool]:
     keys = tuple(k for k in GRIPPER_WORDS
                  if len({v.gripper_mm[k] for v in variants}) > 1)
     return keys, len({v.grasp_set for v in variants}) > 1
+
+
+def verdict_table(rows: list[tuple[str, str, str, str]]) -> list[str]:
+    """The options' verdicts as aligned columns, option, verdict and the stage that stops
+    most parts ('-' when none is known), from (option, verdict, stops, first reason) each;
+    the first reason, in brackets, on the line below its row."""
+    cells = [(option.replace('`', ''), verdict, stops or '-') for option, verdict, stops, _
+             in rows]
+    head = ('option', 'verdict', 'stops most parts')
+    widths = [max(len(c[k]) for c in [head, *cells]) for k in range(3)]
+
+    def line(c: tuple[str, ...]) -> str:
+        return '  ' + '  '.join(x.ljust(w) for x, w in zip(c, widths, strict=True)).rstrip()
+    out = [line(head)]
+    for c, row in zip(cells, rows, strict=True):
+        out += [line(c), f'      ({row[3]})']
+    return out

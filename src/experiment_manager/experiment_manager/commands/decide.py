@@ -23,6 +23,7 @@ from ..analysis.headlines import headlines
 from ..analysis.redecide import redecide
 from ..analysis.results import write_summary
 from ..analysis.verdicts import verdicts
+from ..analysis.wording import verdict_table
 
 RESULT_FILES = ('experiment.yaml', 'iterations.csv', 'picks.csv', 'checks.csv')
 
@@ -39,11 +40,12 @@ def decide(run_dir: str, write: bool) -> list[str]:
     before = {v.kind: v.verdict for v in verdicts(recorded)} if recorded is not None else {}
     raw = redecide(run_dir, recorded)
     now = summary_model.validate(raw)
-    lines = [run_dir, *headlines(now), 'verdicts:']
+    rows = []
     for v in verdicts(now):
         was = before.get(v.kind)
         moved = f' [was {was}]' if was is not None and was != v.verdict else ''
-        lines.append(f'  {v.option.replace("`", "")}: {v.verdict}{moved} ({v.reasons[0]})')
+        rows.append((v.option, v.verdict + moved, v.stops, v.reasons[0]))
+    lines = [run_dir, *headlines(now), 'verdicts:', *verdict_table(rows)]
     if write:
         write_summary(run_dir, raw)
         lines.append(f'written: {path}, {report.write(run_dir)}')

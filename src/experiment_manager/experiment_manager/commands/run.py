@@ -41,6 +41,7 @@ from tqdm import tqdm
 
 from .. import experiment_file
 from ..analysis import summary as summary_model
+from ..analysis import wording
 from ..analysis.headlines import headlines
 from . import interrupt
 from .claim import claim, NamespaceInUse
@@ -296,23 +297,6 @@ def _run(node: Node, client: LockedActionClient, goal, given: str, graph: Graph,
     print('\n'.join(headlines(summary)))
     # the manager's decisions in one table, each with the stage that stops most parts and
     # its first reason (the report gives them all)
-    print('verdicts:\n' + '\n'.join(verdict_table(
+    print('verdicts:\n' + '\n'.join(wording.verdict_table(
         [(v.option, v.verdict, v.stops_most, v.reasons[0]) for v in result.verdicts])))
     return 0
-
-
-def verdict_table(rows: list[tuple[str, str, str, str]]) -> list[str]:
-    """The options' verdicts as aligned columns, option, verdict and the stage that stops
-    most parts ('-' when none is known), from (option, verdict, stops, first reason) each;
-    the first reason, in brackets, on the line below its row."""
-    cells = [(option.replace('`', ''), verdict, stops or '-') for option, verdict, stops, _
-             in rows]
-    head = ('option', 'verdict', 'stops most parts')
-    widths = [max(len(c[k]) for c in [head, *cells]) for k in range(3)]
-
-    def line(c: tuple[str, ...]) -> str:
-        return '  ' + '  '.join(x.ljust(w) for x, w in zip(c, widths, strict=True)).rstrip()
-    out = [line(head)]
-    for c, row in zip(cells, rows, strict=True):
-        out += [line(c), f'      ({row[3]})']
-    return out
