@@ -168,17 +168,21 @@ def grasp_entry(g: schema.GraspEntry, i: int, suction: bool) -> GraspPose | Suct
 def check_cup(geometry: PartGeometry, setup: Setup) -> None:
     """A suction cup's grasps: each one's point lies on the part's surface, named by its
     place in the file; at least one seals and holds (build_geometry names each one's
-    reason)."""
+    reason). The seals are the check geometry's, computed once; only when it refuses the
+    setup are they computed here, so that a point off the surface is the error said."""
     cup, grasps = setup.gripper, setup.grasps
-    for i, (g, c) in enumerate(zip(grasps, check_grasps(grasps, cup), strict=True)):
-        found = seal(geometry, cup, c)
+    try:
+        seals = build_geometry(setup, geometry).seals
+        refused = None
+    except InvalidArgument as exc:
+        seals = tuple(seal(geometry, cup, c) for c in check_grasps(grasps, cup))
+        refused = InvalidArgument(f'part.{exc.field}', exc.value, exc.rule)
+    for i, (g, found) in enumerate(zip(grasps, seals, strict=True)):
         if found.reason.startswith(OFF_SURFACE):
             raise InvalidArgument(f'part.grasps[{i}].grasp_point_mm (grasp {g.name!r})',
                                   [round(v / MM, 3) for v in g.grasp_point], found.reason)
-    try:
-        build_geometry(setup, geometry)
-    except InvalidArgument as exc:
-        raise InvalidArgument(f'part.{exc.field}', exc.value, exc.rule) from None
+    if refused is not None:
+        raise refused
 
 
 def proposed(geometry: PartGeometry, gripper: Gripper | SuctionCup | None = None
