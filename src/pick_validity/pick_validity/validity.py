@@ -240,8 +240,11 @@ class Validator:
         frames = self.approach_frames(rotations[inner], best, turns)    # (n, T, 3, 3)
         approach = self._approachable(frames)
         placeable = self._placeable(rotations[inner], frames, best) & approach
-        station = (self._put_down(rotations[inner], frames, best) & approach
-                   if self.station_ok is not None else np.zeros_like(approach))
+        station = np.zeros_like(approach)     # only for parts no tilt places as picked
+        if self.station_ok is not None:
+            need = np.flatnonzero(~placeable.any(axis=1) & approach.any(axis=1))
+            station[need] = self._put_down(rotations[inner][need], frames[need],
+                                           best[need]) & approach[need]
         kept: dict[int, np.ndarray] = {}
         world_frames: dict[int, np.ndarray] = {}
         for n, row in enumerate(inner):
