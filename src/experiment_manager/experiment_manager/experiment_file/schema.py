@@ -145,8 +145,7 @@ def _basis(value: Any) -> Any:
 
 
 # a pair's file key -> its field in materials.Contact
-FIELD_OF = {'lateral_friction': 'lateral_friction', 'rolling_friction_mm': 'rolling_friction',
-            'spinning_friction_mm': 'spinning_friction', 'restitution': 'restitution'}
+FIELD_OF = {key: key.removesuffix('_mm') for key in MOVED_KEYS}
 
 
 class MaterialsSection(Section):
