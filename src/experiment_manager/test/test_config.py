@@ -53,6 +53,15 @@ def test_omitted_keys_take_the_documented_defaults():
     assert f.seed == 0 and f.search_order == 'top_first' and len(f.grasps) == 5
     assert f.experiments[0].bins[0].inner_size == pytest.approx((0.1, 0.1, 0.02))
     assert f.experiments[0].bins[0].wall_thickness == pytest.approx(0.003)
+    # the hopper drops on a quarter of the tray's length at its -X end, 0.8 of its width
+    assert f.tray.feeder_zone_center == pytest.approx((-0.073125, 0.0))
+    assert f.tray.feeder_zone_size == pytest.approx((0.04875, 0.12))
+
+
+def test_the_feeder_zone_is_where_the_file_puts_it():
+    f = experiment_file.parse('feeder_zone_mm: {center: [-70, 5], size: [30, 90]}\n' + MINIMAL)
+    assert f.tray.feeder_zone_center == pytest.approx((-0.07, 0.005))
+    assert f.tray.feeder_zone_size == pytest.approx((0.03, 0.09))
 
 
 BAD = [
@@ -115,6 +124,14 @@ BAD = [
     ('moves: [{direction: diagonal}]\n' + MINIMAL,
      r"moves\[0\]\.direction: 'diagonal' must be one of fixed, random"),
     ('experiments: [\n', r'line \d+, column \d+: .* is not valid YAML'),
+    ('feeder_zone_mm: {center: [-80, 0], size: [50, 100]}\n' + MINIMAL,
+     r'feeder_zone_mm: .* reaches from -105 to -55 mm along x and -50 to 50 mm along y: it '
+     r"must lie on the tray's plate, within \+-97\.5 and \+-75 mm of its centre \(tray_mm\)"),
+    ('feeder_zone_mm: {center: [-80, 0], size: [5, 100]}\n' + MINIMAL,
+     r'feeder_zone_mm\.size: \[5\.0, 100\.0\] is smaller than the part \(\d+\.\d mm across '
+     r'in some orientation\): parts cannot be dropped into it'),
+    ('feeder_zone_mm: {center: [0, 0], size: [0, 10]}\n' + MINIMAL,
+     r'feeder_zone_mm\.size\[0\]: 0 must be > 0'),
     (SWEEP + 'grippers: {jaw_depth_mm: []}}\n',
      r'grippers\.jaw_depth_mm: \[\] must be a number or a list of 1 to 64 numbers'),
     (SWEEP + 'grippers: {jaw_depth_mm: [3, x]}}\n',

@@ -5,7 +5,7 @@ calibrates the materials on those counts; and the file's contact materials as pa
 import os
 
 from experiment_manager import experiment_file
-from experiment_manager.analysis import report
+from experiment_manager.analysis import part_sheet, report
 from experiment_manager.analysis import summary as summary_model
 from experiment_manager.analysis.calibration import calibrate, file_keys, log_likelihood
 from experiment_manager.analysis.headlines import headlines
@@ -46,9 +46,12 @@ def test_a_drop_test_counts_the_aspects_its_parts_rest_on_beside_the_measured(tm
     rows = read_csv(os.path.join(str(tmp_path), 'iterations.csv'))
     assert sorted(r['aspect'] for r in rows if r['aspect'] != 'other') == sorted(
         name for name, k in counts.items() for _ in range(k))
+    part_sheet.write_account(experiment_file.parse(FILE), str(tmp_path))   # as a run does
     report.write(str(tmp_path))
     text = open(os.path.join(str(tmp_path), 'report.md'), encoding='utf-8').read()
     assert '## Drop test (`drop`)' in text and 'G-test p' in text
+    assert '(aspects.png)' in text and os.path.getsize(os.path.join(str(tmp_path),
+                                                                    'aspects.png')) > 10_000
     assert os.path.exists(os.path.join(str(tmp_path), 'drop_drop.png'))
     (line,) = headlines(summary_model.validate(summary))
     assert line.startswith(f'  drop (drop_test): {s["drops"]} drops at rest on +y ')
@@ -107,6 +110,56 @@ def test_a_sensitivity_grid_over_a_measured_drop_test_calibrates_it(tmp_path):
     (pair, bases, said), _ = pasted.material_account
     assert pair == 'part_on_surface' and dict(bases)['restitution'] == 'calibrated'
     assert said == 'calibrated to the drop test drop (30 drops measured)'
+
+
+HEIGHTS = FILE + """  - id: fit
+    type: sensitivity
+    of: [drop]
+    iterations: 30
+    grid: 3
+    inputs:
+      drop_test.height_mm: {low: 40, high: 120, source: the effective height of our drops}
+"""
+
+
+def test_a_sensitivity_varies_the_height_its_drop_tests_drop_from():
+    f = experiment_file.parse(HEIGHTS)
+    (x,) = f.experiment('fit').inputs
+    assert x.base == 80.0                     # the drop test's own height_mm
+    heights = {e.id: e.bin.drop_height for e in f.experiments if e.id.startswith('drop')}
+    assert heights == pytest.approx({'drop': 0.08, 'drop@drop_test_height_mm_low': 0.04,
+                                     'drop@drop_test_height_mm_high': 0.12})
+    # the part's setup is the file's in every repeat: only the plate's height moves
+    assert all(e.scenario.setup == f.setup for e in f.experiments if '@' in e.id)
+
+
+@pytest.mark.parametrize('text, rule', [
+    (HEIGHTS.replace('of: [drop]', 'of: [drop, bins]').replace(
+        '  - id: fit', '  - {id: bins, type: bin_static, iterations: 1, parts: 10, '
+        'bins_mm: [[100, 100, 20]]}\n  - id: fit'), 'bins is a bin_static: name drop tests'),
+    (HEIGHTS.replace('of: [drop]', 'of: [drop, drop2]').replace(
+        '  - id: fit', '  - {id: drop2, type: drop_test, iterations: 5, height_mm: 50}\n'
+        '  - id: fit'), 'the drop tests named drop from 50, 80 mm'),
+])
+def test_a_drop_height_input_is_refused_where_it_means_nothing_or_two_things(text, rule):
+    with pytest.raises(InvalidArgument) as err:
+        experiment_file.parse(text)
+    assert err.value.field == 'experiments[2].inputs.drop_test.height_mm'
+    assert rule in err.value.rule
+
+
+def test_a_fitted_drop_height_is_said_beside_the_keys_not_as_one():
+    made = {'a': 60, 'b': 40}
+    points = [({'drop_test.height_mm': h, 'materials.part_on_surface.restitution': 0.3},
+               {'a': a, 'b': 100 - a}) for h, a in ((40, 30), (80, 59), (120, 90))]
+    fit = calibrate('drop', made, points)
+    assert fit['best']['drop_test.height_mm'] == 80
+    assert not any(line.startswith('drop_test') for line in fit['keys'])
+    assert fit['keys'][-1].startswith('# drop_test.height_mm: 80    # 95 %: 80 to 80; the '
+                                      'height the simulated drops fit yours best from')
+    pasted = experiment_file.parse(FILE.replace('experiments:', '\n'.join(fit['keys'])
+                                                + '\nexperiments:'))
+    assert pasted.setup.part.part_on_surface.restitution == pytest.approx(0.3)
 
 
 @pytest.mark.parametrize('key', ['lateral_friction', 'restitution', 'rolling_friction_mm'])

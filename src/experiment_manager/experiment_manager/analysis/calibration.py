@@ -15,6 +15,7 @@ import math
 from pick_common.parts.aspects import agreement
 
 SMOOTH = 0.5            # added to every simulated count
+DROP_HEIGHT = 'drop_test.height_mm'     # the input of a drop test's height (scenarios.INPUTS)
 CHI2_HALF = 1.920729    # half the 95 % quantile of chi-square with one degree of freedom
 
 
@@ -43,7 +44,7 @@ def calibrate(experiment: str, measured: dict[str, int],
     intervals = {name: [min(v[name] for v in near), max(v[name] for v in near)]
                  for name in best}
     keys: dict[str, tuple[float, float, float] | str] = {
-        name: (best[name], *intervals[name]) for name in best}
+        name: (best[name], *intervals[name]) for name in best if name != DROP_HEIGHT}
     for name in best:                   # a material's pair says the values are calibrated
         if name.startswith('materials.'):
             pair, key = name.rsplit('.', 1)
@@ -53,7 +54,19 @@ def calibrate(experiment: str, measured: dict[str, int],
     return {'experiment': experiment, 'best': best, 'intervals': intervals,
             'p': agreement(best_counts, measured),
             'points': [{'values': v, 'log_likelihood': ll} for ll, v, _ in scored],
-            'keys': file_keys(keys)}
+            'keys': file_keys(keys) + height_note(best, intervals)}
+
+
+def height_note(best: dict[str, float], intervals: dict[str, list[float]]) -> list[str]:
+    """A comment on the fitted drop height, which is no key of the cell's: the height the
+    simulated drops fit the user's best from (none when it was not varied)."""
+    if DROP_HEIGHT not in best:
+        return []
+    low, high = intervals[DROP_HEIGHT]
+    return [f'# {DROP_HEIGHT}: {best[DROP_HEIGHT]:.4g}    # 95 %: {low:.4g} to {high:.4g}; the '
+            'height the simulated drops fit yours best from (far from the height you dropped '
+            "from: the simulation's fall differs from your drops'; the cell's own heights are "
+            'bin_drop_mm and hopper_lip_mm)']
 
 
 def file_keys(values: dict[str, tuple[float, float, float] | str]) -> list[str]:

@@ -6,7 +6,9 @@ The inputs (`INPUTS`), in the file's units: each contact pair's friction, rollin
 spinning arms and restitution (materials.part_on_surface.*, materials.part_on_part.*), the
 part's mass (part.mass_g), the gripper's dimensions (gripper.*), and the table moves'
 amplitude, frequency and duration as factors on every move of the cycle (moves.*_scale: the
-cycle may mix moves, so one number in Hz or s would not say which). The design:
+cycle may mix moves, so one number in Hz or s would not say which), and the height drop tests
+drop from (drop_test.height_mm: of a sensitivity whose experiments are all drop tests of one
+height; a calibration fits it as the effective height of the user's drops). The design:
 - one at a time: a scenario at each input's low and one at its high, the others at the file's
   values (`<input>_low`, `<input>_high`, dots as underscores);
 - joint (`joint: K`): K scenarios of a Latin hypercube over all the inputs' ranges (McKay,
@@ -56,8 +58,16 @@ INPUTS = {
     'moves.amplitude_scale': ('moves', 'amplitude', 1.0, 0.0, None, True),
     'moves.frequency_scale': ('moves', 'frequency', 1.0, 0.0, None, True),
     'moves.duration_scale': ('moves', 'duration', 1.0, 0.0, None, True),
+    'drop_test.height_mm': ('drop_test', 'height', MM, 0.0, 1000.0, False),
 }
+DROP_HEIGHT = 'drop_test.height_mm'     # the drop tests' height: of `of`'s drop tests only
 MAX_REPEATS = 200    # scenarios x experiments repeated, per sensitivity experiment
+
+
+def drop_height(scenario: Scenario) -> float | None:
+    """The drop height a scenario sets for the drop tests it repeats, m (None: their own)."""
+    value = dict(scenario.values).get(DROP_HEIGHT)
+    return None if value is None else value * INPUTS[DROP_HEIGHT][2]
 
 
 def base_value(name: str, setup: Setup, mass: float, where: str = '') -> float:
@@ -93,6 +103,8 @@ def apply(values: dict[str, float], setup: Setup, moves: tuple[Vibration, ...], 
     pairs = {'part_on_surface': {}, 'part_on_part': {}}
     for name, value in values.items():
         section, attr, unit = INPUTS[name][:3]
+        if section == 'drop_test':      # the repeats' plates: drop_height
+            continue
         if section == 'materials':
             pair, attr = attr.split('.')
             pairs[pair][attr] = value * unit

@@ -246,6 +246,14 @@ class Move(Section):
 
 
 # --------------------------------------------------------------------------- the file
+class FeederZone(Section):
+    """Where the hopper drops parts on the tray's plate: a rectangle, mm, in the tray's frame
+    (origin at the plate's centre, +X along its length)."""
+
+    center: Vector(2)
+    size: Vector(2, low=0.0, low_open=True)
+
+
 class FileKeys(Section):
     """The file's top level; each section is read by its own model (SECTIONS), each
     experiment by its type's (EXPERIMENTS)."""
@@ -269,6 +277,8 @@ class FileKeys(Section):
     # how high over the floor parts arrive from: a bin's pour, the tray's hopper lip
     bin_drop_mm: Number(0.0, 1000.0) = DROP_HEIGHT[BIN] / MM
     hopper_lip_mm: Number(0.0, 1000.0) = DROP_HEIGHT[TRAY] / MM
+    # where the hopper drops on the tray; None: ContainerSpec.tray's (assumed)
+    feeder_zone_mm: FeederZone | None = None
     experiments: Annotated[list[Any], BeforeValidator(partial(
         list_of, low=1, high=MAX_EXPERIMENTS, what=f'1..{MAX_EXPERIMENTS} experiments'))]
 

@@ -6,6 +6,7 @@ rule under the file's key names."""
 from dataclasses import replace
 
 from pick_common.containers import check_container, ContainerSpec
+from pick_common.errors import InvalidArgument
 from pick_common.specs import check_vibration, MOVES, Vibration
 from pick_validity.config import CheckConfig, Gripper, SuctionCup
 
@@ -44,6 +45,17 @@ def tray(top: schema.FileKeys) -> ContainerSpec:
     tray = replace(ContainerSpec.tray(tuple(MM * s for s in top.tray_mm)),
                    drop_height=MM * top.hopper_lip_mm)
     checked_as(check_container, tray, 'tray_mm')
+    zone = top.feeder_zone_mm
+    if zone is not None:
+        (cx, cy), (sx, sy), (x, y, _) = zone.center, zone.size, top.tray_mm
+        if abs(cx) + sx / 2 > x / 2 + 1e-9 or abs(cy) + sy / 2 > y / 2 + 1e-9:
+            raise InvalidArgument('feeder_zone_mm', {'center': [cx, cy], 'size': [sx, sy]},
+                                  f"reaches from {cx - sx / 2:g} to {cx + sx / 2:g} mm along "
+                                  f"x and {cy - sy / 2:g} to {cy + sy / 2:g} mm along y: it "
+                                  f"must lie on the tray's plate, within +-{x / 2:g} and "
+                                  f'+-{y / 2:g} mm of its centre (tray_mm)')
+        tray = replace(tray, feeder_zone_center=(MM * cx, MM * cy),
+                       feeder_zone_size=(MM * sx, MM * sy))
     return tray
 
 
