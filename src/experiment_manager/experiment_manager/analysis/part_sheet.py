@@ -345,10 +345,40 @@ def write(checks: Validator, path: str) -> str:
     return path
 
 
+def write_aspects(part, path: str) -> str:
+    """Draw each aspect of `part` (a PartGeometry): the part resting on it on a plate, named
+    as a drop test names it, with its quasi-static share, in the drop chart's order."""
+    aspects = part_aspects(part)
+    cols = min(len(aspects), 4)
+    rows = -(-len(aspects) // cols)
+    fig = plt.figure(figsize=(2.4 * cols, 2.5 * rows))
+    for k, a in enumerate(aspects):
+        ax = fig.add_subplot(rows, cols, k + 1, projection='3d')
+        mesh = part.visual.copy()
+        mesh.apply_transform(trimesh.geometry.align_vectors(a.normal, (0.0, 0.0, -1.0)))
+        mesh.apply_translation(-mesh.bounds[0] * (0.0, 0.0, 1.0))
+        lo, hi = mesh.bounds * MM
+        edge = 0.15 * (hi - lo).max()
+        plate = np.array([[lo[0] - edge, lo[1] - edge, 0], [hi[0] + edge, lo[1] - edge, 0],
+                          [hi[0] + edge, hi[1] + edge, 0], [lo[0] - edge, hi[1] + edge, 0]])
+        ax.add_collection3d(Poly3DCollection([plate], facecolor='#e8d88a', alpha=0.3))
+        _draw(ax, mesh, np.eye(3), PIECE_COLOURS[0], 0.9)
+        ax.view_init(elev=25, azim=-60)
+        _frame(ax, np.vstack([plate, mesh.vertices * MM]),
+               f'{a.name}: quasi-static {100 * a.quasi_static:.1f} %')
+        ax.set_axis_off()
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path
+
+
 def write_account(file: ExperimentFile, run_dir: str) -> None:
     """The part's account for a run's report: `part.json` (describe's lines) and `part.png`
-    (the sheet), in the run directory."""
+    (the sheet), in the run directory; with a drop test, `aspects.png` (write_aspects)."""
     checks = validator(file)
     with open(os.path.join(run_dir, 'part.json'), 'w', encoding='utf-8') as f:
         json.dump(describe(file, checks), f, indent=1)
     write(checks, os.path.join(run_dir, 'part.png'))
+    if any(e.type == 'drop_test' for e in file.experiments):
+        write_aspects(checks.part, os.path.join(run_dir, 'aspects.png'))

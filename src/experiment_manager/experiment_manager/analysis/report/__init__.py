@@ -72,6 +72,7 @@ def write(run_dir: str) -> str:
     """Write the report of a run directory; returns the path of report.html."""
     run = read(run_dir)
     run.figures = draw_all(run.summary, lambda name: os.path.join(run_dir, name))
+    run.figures['aspects'] = os.path.exists(os.path.join(run_dir, 'aspects.png'))
     text = markdown(run)
     with open(os.path.join(run_dir, 'report.md'), 'w', encoding='utf-8') as f:
         f.write(text)

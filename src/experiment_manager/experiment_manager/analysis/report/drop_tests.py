@@ -21,6 +21,9 @@ class DropTests(Section):
             lines += ['', f'## Drop test (`{exp_id}`)', '']
             if run.figures.get(f'drop_{exp_id}'):
                 lines += [f'![drop test {exp_id}](drop_{exp_id}.png)', '']
+            if run.figures.get('aspects'):
+                lines += ['![each aspect: the part resting on it, with its quasi-static share]'
+                          '(aspects.png)', '']
             lines += [f'{s.drops} single parts dropped from {fmt(s.height_mm)} mm onto the '
                       f'plate, each at a random orientation, at rest on the aspects below '
                       f'({s.other} on none: leaning or on an edge, left out of the shares). '
