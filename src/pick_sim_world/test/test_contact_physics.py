@@ -8,6 +8,7 @@ import numpy as np
 from pick_common import containers
 from pick_common.containers import ContainerSpec
 from pick_common.errors import InvalidArgument
+from pick_common.parts import insets
 from pick_common.parts.geometry import build_part
 from pick_common.parts.materials import body_values, combined, Contact, TINY
 from pick_common.parts.spec import PartSpec
@@ -68,7 +69,7 @@ def test_a_mesh_part_rests_on_its_geometry_not_on_a_margin(client, tmp_path, nam
     # the lowest point of the geometry the checks collide lies on the floor, within 0.1 mm
     # (it lay 1 mm above it: pybullet's hull margin)
     assert abs(vertices[:, 2].min()) < 1e-4
-    assert bodies.hull_swelling(part) == 0.0
+    assert insets.hull_swelling(part) == 0.0
     # and where the physics touches the floor is on that geometry's surface
     contacts = pb.getContactPoints(physicsClientId=client)
     assert contacts
@@ -79,7 +80,7 @@ def test_a_mesh_part_rests_on_its_geometry_not_on_a_margin(client, tmp_path, nam
 def test_a_piece_thinner_than_two_margins_is_reported_swollen(tmp_path):
     part = _mesh_part(tmp_path, 'plate', trimesh.creation.box((0.01, 0.01, 0.0012)))
     # inset by 0.45 of its 1.2 mm: its faces lie 1 - 0.54 mm outside the plate
-    assert bodies.hull_swelling(part) == pytest.approx(0.00046, abs=1e-9)
+    assert insets.hull_swelling(part) == pytest.approx(0.00046, abs=1e-9)
 
 
 def _floor(client, values) -> int:

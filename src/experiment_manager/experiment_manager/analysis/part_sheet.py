@@ -20,6 +20,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 import numpy as np
 from pick_common.parts.aspects import part_aspects
 from pick_common.parts.geometry import build_part
+from pick_common.parts.insets import HULL_MARGIN, hull_swelling
 from pick_common.parts.primitives import Hull
 from pick_common.parts.spec import states_units
 from pick_validity.config import VACUUM_SOURCE
@@ -77,6 +78,12 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
                      f'{together * 1e9:.1f} mm^3 together, {over:+.1f} '
                      f"% on the part's volume (pieces that overlap count twice)")
         lines.append(f'    made as: {part.collision_note}')
+        swollen = hull_swelling(part)
+        lines.append("    in the physics: each piece inset by pybullet's "
+                     f'{HULL_MARGIN * MM:g} mm margin, so that it collides this surface'
+                     + (f'; pieces thinner than {2 * HULL_MARGIN * MM:g} mm stay swollen by up '
+                        f'to {swollen * MM:.2f} mm (docs/physics.md)' if swollen > 1e-6 else
+                        ' (its edges rounded by the margin)'))
     else:
         lines.append(f'  collision: {len(part.primitives)} piece(s) (boxes and cylinders)')
     account = {pair: (dict(bases), said) for pair, bases, said in file.material_account}
