@@ -369,7 +369,10 @@ def write_aspects(part, path: str) -> str:
         plate = np.array([[lo[0] - edge, lo[1] - edge, 0], [hi[0] + edge, lo[1] - edge, 0],
                           [hi[0] + edge, hi[1] + edge, 0], [lo[0] - edge, hi[1] + edge, 0]])
         ax.add_collection3d(Poly3DCollection([plate], facecolor='#e8d88a', alpha=0.3))
-        _draw(ax, mesh, np.eye(3), PIECE_COLOURS[0], 0.9)
+        light = np.clip(mesh.face_normals @ (0.3, -0.5, 0.8), 0.0, 1.0)[:, None]
+        ax.add_collection3d(Poly3DCollection(
+            mesh.triangles * MM, edgecolor='none',
+            facecolor=(0.35 + 0.65 * light) * matplotlib.colors.to_rgb(PIECE_COLOURS[0])))
         ax.view_init(elev=25, azim=-60)
         _frame(ax, np.vstack([plate, mesh.vertices * MM]),
                f'{a.name}: quasi-static {100 * a.quasi_static:.1f} %')

@@ -11,7 +11,8 @@ from pick_common.parts.geometry import PartGeometry
 
 from . import experiment_keys
 from .errors import checked
-from .model import DROP_PLATE, MM
+from .model import DROP_PLATE, DROP_TEST, MM
+from .scenarios import DROP_HEIGHT
 
 
 def plate(geometry: PartGeometry, height: float, wall: float) -> ContainerSpec:
@@ -36,3 +37,19 @@ def drop_test(e: experiment_keys.DropTestKeys, where: str, geometry: PartGeometr
                                       f'is not an aspect of the part (its aspects: '
                                       f'{", ".join(names)})')
     return {'parts': 1, 'bin': plate_, 'measured': tuple(e.measured.items())}
+
+
+def drop_test_height(of: tuple[str, ...], where: str, earlier: dict) -> float:
+    """The drop height, mm, of the experiments `of` names: all drop tests, of one height."""
+    heights = set()
+    for exp_id in of:
+        source = earlier[exp_id]
+        if source.type != DROP_TEST:
+            raise InvalidArgument(where, DROP_HEIGHT, "varies a drop test's "
+                                  f'height; {exp_id} is a {source.type}: name drop tests only')
+        heights.add(round(source.bin.drop_height / MM, 9))
+    if len(heights) > 1:
+        raise InvalidArgument(where, DROP_HEIGHT, 'varies one height; the '
+                              'drop tests named drop from ' + ', '.join(
+                                  f'{h:g}' for h in sorted(heights)) + ' mm')
+    return heights.pop()

@@ -33,7 +33,7 @@ import yaml
 from . import experiment_keys, grippers, schema, sections
 from . import part as part_section
 from . import scenarios as scenario_inputs
-from .drop_test import drop_test
+from .drop_test import drop_test, drop_test_height
 from .errors import checked as checked_as
 from .errors import read as read_keys
 from .model import (
@@ -159,7 +159,7 @@ def _sensitivity(e: experiment_keys.SensitivityKeys, where: str, c: _Context) ->
         low = scenario_inputs.check_input(name, r.low, f'{at}.low')
         high = scenario_inputs.check_input(name, r.high, f'{at}.high')
         if name == scenario_inputs.DROP_HEIGHT:
-            base = _drop_height(e.of, at, c)
+            base = drop_test_height(e.of, at, c.earlier)
         else:
             base = scenario_inputs.base_value(name, c.setup, c.geometry.mass, at)
         inputs.append(Input(name, round(base, 9), low, high, r.source.strip()))
@@ -187,32 +187,6 @@ def _sensitivity(e: experiment_keys.SensitivityKeys, where: str, c: _Context) ->
     return repeats + [Experiment(id=e.id, type=SENSITIVITY, iterations=e.iterations,
                                  of=tuple(e.of), inputs=inputs, scenarios=found,
                                  grid=e.grid)]
-
-
-def _drop_height(of: tuple[str, ...], where: str, c: _Context) -> float:
-    """The drop height, mm, of the experiments `of` names: all drop tests, of one height."""
-    heights = set()
-    for exp_id in of:
-        source = c.earlier[exp_id]
-        if source.type != DROP_TEST:
-            raise InvalidArgument(where, scenario_inputs.DROP_HEIGHT, "varies a drop test's "
-                                  f'height; {exp_id} is a {source.type}: name drop tests only')
-        heights.add(round(source.bin.drop_height / MM, 9))
-    if len(heights) > 1:
-        raise InvalidArgument(where, scenario_inputs.DROP_HEIGHT, 'varies one height; the '
-                              'drop tests named drop from ' + ', '.join(
-                                  f'{h:g}' for h in sorted(heights)) + ' mm')
-    return heights.pop()
-
-
-def _zone_holds(size: tuple[float, float], geometry: PartGeometry) -> None:
-    """The feeder zone (mm) is wider than the part in any orientation (its enclosing sphere),
-    so that the world can drop parts into it."""
-    across = 2.0 * geometry.radius / MM
-    if min(size) < across:
-        raise InvalidArgument('feeder_zone_mm.size', list(size), f'is smaller than the part '
-                              f'({across:.1f} mm across in some orientation): parts cannot be '
-                              'dropped into it')
 
 
 def _experiment(e: experiment_keys.ExperimentKeys, where: str, c: _Context) -> list[Experiment]:
@@ -334,7 +308,7 @@ def parse(text: str, path: str = '') -> ExperimentFile:
     elif geometry is not None and grasps is not None:
         checked(lambda: part_section.check_fits(geometry, grasps))
     if None not in (top, geometry, tray) and top.feeder_zone_mm is not None:
-        checked(lambda: _zone_holds(top.feeder_zone_mm.size, geometry))
+        checked(lambda: sections.zone_holds(top.feeder_zone_mm.size, geometry))
     context = None
     if None not in (top, geometry, tray, moves, requirements, gripper, grasps, check):
         context = _Context(geometry, tray, MM * top.bin_wall_mm, MM * top.bin_drop_mm,

@@ -7,6 +7,7 @@ from dataclasses import replace
 
 from pick_common.containers import check_container, ContainerSpec
 from pick_common.errors import InvalidArgument
+from pick_common.parts.geometry import PartGeometry
 from pick_common.specs import check_vibration, MOVES, Vibration
 from pick_validity.config import CheckConfig, Gripper, SuctionCup
 
@@ -57,6 +58,16 @@ def tray(top: schema.FileKeys) -> ContainerSpec:
         tray = replace(tray, feeder_zone_center=(MM * cx, MM * cy),
                        feeder_zone_size=(MM * sx, MM * sy))
     return tray
+
+
+def zone_holds(size: tuple[float, float], geometry: PartGeometry) -> None:
+    """The feeder zone (mm) is wider than the part in any orientation (its enclosing sphere),
+    so that the world can drop parts into it."""
+    across = 2.0 * geometry.radius / MM
+    if min(size) < across:
+        raise InvalidArgument('feeder_zone_mm.size', list(size), f'is smaller than the part '
+                              f'({across:.1f} mm across in some orientation): parts cannot be '
+                              'dropped into it')
 
 
 def moves(top: schema.FileKeys) -> tuple[Vibration, ...]:
