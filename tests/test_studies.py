@@ -91,3 +91,12 @@ def test_drop_tests_set_published_drops_beside_the_simulation(tmp_path):
     assert out.count('measured') >= 7 and 'quasi-static' in out
     with open(picture, 'rb') as f:
         assert f.read(8) == b'\x89PNG\r\n\x1a\n'
+
+
+def test_feeder_landing_measures_the_pile_after_every_feed():
+    out = _study('studies.feeder_landing', '--part', 'pth0.yaml', '--runs', '1', '--parts',
+                 '30', '--range', '10,20', '--set-back-mm', '10')
+    # the zone moved 10 mm off the -X wall, its far edge kept
+    assert 'feeder zone centred at -68.12, 0.00 mm, 38.75 x 120.00 mm, walls 27 mm' in out
+    assert ' feeds: pile top median ' in out and "parts over a wall's top after a feed" in out
+    assert 'spilled per run: ' in out

@@ -1,0 +1,106 @@
+"""Where fed parts land on the tray: per feed, how high the pile stands and how many parts
+reach over a wall's top, with the spills of each feeder run, for a hopper lip and a feeder
+zone (the test case's, or one set back from the -X wall).
+
+    tools/ws python -m studies.feeder_landing [--part pth1.yaml] [--runs 4] [--parts 480]
+        [--range 45,55] [--lip-mm 30] [--set-back-mm 0]
+
+Runs `--runs` seeded feeder_emptying runs of the test case's part file on the cores (the
+optimal range given, or the part's sweep's when --range is 'sweep'), the tray's feeder zone
+moved `--set-back-mm` away from the -X wall (its far edge kept: the file key
+feeder_zone_mm). The tray is measured after every feed, before the vibration that follows it;
+printed, over all feeds: the pile's top (the highest point of any part on the tray: median, 90th
+percentile, highest), the feeds after which a part stood higher than the walls, the parts that
+then reached over a wall's inner face higher than its top (resting on or against its top), and
+per run the parts spilled (outside the tray, not through it). Parts' points are the part's
+visual mesh, posed as the world reports it.
+"""
+
+import argparse
+import os
+import tempfile
+
+from bench.paper_case import variant
+from experiment_manager.analysis.results import read_csv, ResultsWriter
+from experiment_manager.running.local_backend import LocalBackend
+from experiment_manager.running.scheduler import Runner
+import numpy as np
+from pick_common.states import PartStates
+import trimesh
+
+OVER_WALL = 0.004   # m: a part this close to a wall's inner face, or past it, leans on it
+
+
+class Landing(LocalBackend):
+    """The cores, measuring the tray after every feed (self.feeds: one row per feed)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.feeds: list[tuple[int, float, int, int]] = []
+
+    def start(self, file) -> None:
+        super().start(file)
+        if getattr(self._world, 'landing', None) is self:
+            return
+        drop = self._world.drop
+
+        def measured_drop(count, zone='container', **kw):
+            out = drop(count, zone=zone, **kw)
+            if zone == 'feeder':
+                self.measure(count, self._world.snapshot(), file.tray)
+            return out
+        self._world.drop, self._world.landing = measured_drop, self
+
+    def measure(self, count: int, states: PartStates, tray) -> None:
+        x, y, wall = tray.inner_size
+        points = np.asarray(self._world.part.visual.vertices)
+        tops, reach = [], []
+        for pose in states.poses:
+            rotation = trimesh.transformations.quaternion_matrix(np.roll(pose[3:], 1))[:3, :3]
+            p = points @ rotation.T + pose[:3]
+            tops.append(p[:, 2].max())
+            reach.append(min(x / 2 - np.abs(p[:, 0]).max(), y / 2 - np.abs(p[:, 1]).max()))
+        tops, reach = np.array(tops), np.array(reach)
+        self.feeds.append((count, float(tops.max()), int((tops > wall).sum()),
+                           int(((reach < OVER_WALL) & (tops > wall)).sum())))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--part', default='pth1.yaml')
+    parser.add_argument('--runs', type=int, default=4)
+    parser.add_argument('--parts', type=int, default=480)
+    parser.add_argument('--range', default='45,55')
+    parser.add_argument('--lip-mm', type=float, default=30.0)
+    parser.add_argument('--set-back-mm', type=float, default=0.0)
+    args = parser.parse_args()
+    span = args.range if args.range == 'sweep' else [int(v) for v in args.range.split(',')]
+    sections = {'hopper_lip_mm': args.lip_mm}
+    experiments = [{'id': 'feeder', 'type': 'feeder_emptying', 'iterations': args.runs,
+                    'parts': args.parts, 'optimal_range': span, 'max_vibrations': 500}]
+    if args.set_back_mm:
+        tray = variant(args.part, experiments).tray
+        (cx, cy), (sx, sy) = tray.feeder_zone_center, tray.feeder_zone_size
+        b = args.set_back_mm / 1000.0
+        sections['feeder_zone_mm'] = {'center': [1000 * (cx + b / 2), 1000 * cy],
+                                      'size': [1000 * (sx - b), 1000 * sy]}
+    file = variant(args.part, experiments, **sections)
+    with tempfile.TemporaryDirectory() as out:
+        with Landing() as backend, ResultsWriter(out, file.text) as writer:
+            Runner(file, [backend], writer).run()
+        rows = read_csv(os.path.join(out, 'iterations.csv'))
+    feeds = np.array(backend.feeds)
+    (cx, cy), (sx, sy) = file.tray.feeder_zone_center, file.tray.feeder_zone_size
+    print(f'{args.part}: lip {args.lip_mm:g} mm, feeder zone centred at {1000 * cx:.2f}, '
+          f'{1000 * cy:.2f} mm, {1000 * sx:.2f} x {1000 * sy:.2f} mm, walls '
+          f'{1000 * file.tray.inner_size[2]:g} mm')
+    top = np.percentile(1000 * feeds[:, 1], [50, 90, 100])
+    print(f'  {len(feeds)} feeds: pile top median {top[0]:.1f} mm, 90th {top[1]:.1f}, '
+          f'highest {top[2]:.1f}; {int((feeds[:, 2] > 0).sum())} feeds left a part higher '
+          f"than the walls; {int(feeds[:, 3].sum())} parts over a wall's top after a feed")
+    print('  spilled per run: ' + ', '.join(str(r['spilled']) for r in rows)
+          + '; vibrations: ' + ', '.join(str(r['vibrations']) for r in rows))
+
+
+if __name__ == '__main__':
+    main()
