@@ -18,8 +18,9 @@ import math
 
 from pick_common.parts.aspects import agreement
 
+from ..experiment_file.scenarios import DROP_HEIGHT
+
 SMOOTH = 0.5            # added to every simulated count
-DROP_HEIGHT = 'drop_test.height_mm'     # the input of a drop test's height (scenarios.INPUTS)
 CHI2_HALF = 1.920729    # half the 95 % quantile of chi-square with one degree of freedom
 
 
