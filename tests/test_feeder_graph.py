@@ -103,6 +103,12 @@ def test_impossible_counts_and_bad_ranges_are_refused(client, nodes):
     more = feeder.cycle(valid_parts=0, parts_on_table=7)
     assert more.error_code == FeedCycle.Result.INVALID_ARGUMENT
     assert 'parts_on_table: 7 must be within [0, 3]' in more.error_msg
+    # a hopper's dose: 2 parts a feed, and the fill goes on to max* after the vibration
+    dosed = feeder.cycle(restart=True, feeder_parts=5, min_count=2, max_count=3, max_feed=2,
+                         parts_on_table=0)
+    assert dosed.error_code == OK and dosed.parts_fed == 2 and dosed.state.max_feed == 2
+    again = feeder.cycle(valid_parts=0, parts_on_table=2)
+    assert again.decision == FeedCycle.Result.DECISION_FEED_AND_VIBRATE and again.parts_fed == 1
     world_error = feeder.cycle(restart=True, parts_on_table=0, instance=5)
     assert world_error.error_code == FeedCycle.Result.UNKNOWN_INSTANCE
     assert 'world drop_parts: instances: 5 does not exist' in world_error.error_msg

@@ -7,6 +7,7 @@ import re
 
 from ament_index_python.packages import get_package_share_directory
 from experiment_manager import experiment_file
+from experiment_manager.experiment_file.plan import plan
 from pick_common.errors import InvalidArgument
 from pick_common.specs import MOVES
 import pytest
@@ -56,6 +57,13 @@ def test_omitted_keys_take_the_documented_defaults():
     # the hopper drops on a quarter of the tray's length at its -X end, 0.8 of its width
     assert f.tray.feeder_zone_center == pytest.approx((-0.073125, 0.0))
     assert f.tray.feeder_zone_size == pytest.approx((0.04875, 0.12))
+
+
+def test_a_feeder_run_s_dose_reaches_its_policy():
+    f = experiment_file.parse(MINIMAL + '  - {id: f, type: feeder_emptying, iterations: 1, '
+                              'parts: 10, optimal_range: [4, 8], max_feed: 3}\n')
+    (unit,) = plan(f, f.experiment('f'), {})
+    assert unit.feeder.max_feed == 3 and unit.feeder.max_count == 8
 
 
 def test_the_feeder_zone_is_where_the_file_puts_it():

@@ -71,7 +71,9 @@ class FeederControllerNode(Node):
             min_count=get('feeder.min_count', d.min_count, 'min* of the optimal range'),
             max_count=get('feeder.max_count', d.max_count, 'max* of the optimal range'),
             max_vibrations=get('feeder.max_vibrations', d.max_vibrations,
-                               'vibrations before a run stops'))
+                               'vibrations before a run stops'),
+            max_feed=get('feeder.max_feed', d.max_feed,
+                         'most parts one feed brings (the hopper dose); 0: no limit'))
         self._policy = FeederPolicy(self._defaults)
         self._lock = threading.Lock()
         self._group = group = ReentrantCallbackGroup()
@@ -93,7 +95,7 @@ class FeederControllerNode(Node):
             header=Header(stamp=self.get_clock().now().to_msg()), state=STATES[s.last],
             parts_in_feeder=s.in_feeder, parts_on_table=s.on_table, parts_picked=s.picked,
             vibrations=s.vibrations, feeds=s.feeds, min_count=cfg.min_count,
-            max_count=cfg.max_count, max_vibrations=cfg.max_vibrations)
+            max_count=cfg.max_count, max_vibrations=cfg.max_vibrations, max_feed=cfg.max_feed)
 
     def _publish_state(self) -> None:
         self._state_pub.publish(self._state_msg())
@@ -199,7 +201,8 @@ class FeederControllerNode(Node):
                     feeder_parts=goal.feeder_parts or d.feeder_parts,
                     min_count=goal.min_count or d.min_count,
                     max_count=goal.max_count or d.max_count,
-                    max_vibrations=goal.max_vibrations or d.max_vibrations))
+                    max_vibrations=goal.max_vibrations or d.max_vibrations,
+                    max_feed=goal.max_feed or d.max_feed))
             step = self._policy.decide(goal.valid_parts, goal.parts_on_table)
             result.decision = step.decision
             if step.feed:

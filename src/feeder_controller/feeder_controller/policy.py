@@ -3,10 +3,13 @@
 After each validity check of the table: if a part is valid, pick it; if none is and the count is
 within [min*, max*], vibrate; if the count is below min*, feed up to max* (or until the feeder is
 empty), then vibrate; stop when the feeder and the table are empty, or at the vibration limit.
+With a dose (max_feed; the paper has none), a feed brings at most max_feed parts, and the feeds
+go on, a vibration after each, until the count reaches max* (a part found valid is picked
+first), as a hopper that doses a refill over time.
 
-Deciding and applying are separate: `decide` changes nothing but the table count it is told;
-`fed` and `vibrated` record what the world actually did, so a failed world command leaves the
-state true.
+Deciding and applying are separate: `decide` changes nothing but the table count it is told
+(and whether a dosed fill goes on); `fed` and `vibrated` record what the world actually did,
+so a failed world command leaves the state true.
 """
 
 from dataclasses import dataclass
@@ -24,18 +27,22 @@ LIMITS = {
     'feeder.max_count': Limit(1, MAX_TABLE_PARTS, integer=True),
     'feeder.min_count': Limit(1, MAX_TABLE_PARTS, integer=True),    # and at most max_count
     'feeder.max_vibrations': Limit(1, MAX_VIBRATIONS, integer=True),
+    'feeder.max_feed': Limit(0, MAX_TABLE_PARTS, integer=True),      # 0: no limit
 }
 
 
 @dataclass(frozen=True)
 class FeederConfig:
     """feeder_parts: parts loaded into the feeder at the start of a run. min_count, max_count:
-    the optimal range [min*, max*] of parts on the table. max_vibrations: the limit."""
+    the optimal range [min*, max*] of parts on the table. max_vibrations: the limit. max_feed:
+    the most parts one feed brings (a hopper that doses a refill over several vibrations); 0,
+    the paper's: the whole shortfall at once."""
 
     feeder_parts: int = 100
     min_count: int = 20
     max_count: int = 30
     max_vibrations: int = 200
+    max_feed: int = 0
 
 
 def check_feeder(cfg: FeederConfig) -> FeederConfig:
@@ -44,6 +51,7 @@ def check_feeder(cfg: FeederConfig) -> FeederConfig:
     high = LIMITS['feeder.max_count'].check('max_count', cfg.max_count)
     check_int('min_count', cfg.min_count, low=1, high=high)
     LIMITS['feeder.max_vibrations'].check('max_vibrations', cfg.max_vibrations)
+    LIMITS['feeder.max_feed'].check('max_feed', cfg.max_feed)
     return cfg
 
 
@@ -57,6 +65,7 @@ class FeederState:
     vibrations: int = 0
     feeds: int = 0
     last: int = -1          # the last decision, -1 before the first
+    filling: bool = False   # below min* once, and not yet fed up to max*
 
     @property
     def picked(self) -> int:
@@ -97,9 +106,14 @@ class FeederPolicy:
             step = Step(PICK)
         elif s.vibrations >= cfg.max_vibrations:
             step = Step(STOP_VIBRATION_LIMIT)
-        elif on_table < cfg.min_count and s.in_feeder > 0:
-            step = Step(FEED_AND_VIBRATE, min(cfg.max_count - on_table, s.in_feeder))
+        elif (on_table < cfg.min_count or s.filling) and s.in_feeder > 0 \
+                and on_table < cfg.max_count:
+            short = min(cfg.max_count - on_table, s.in_feeder)
+            feed = min(short, cfg.max_feed) if cfg.max_feed else short
+            s.filling = feed < short
+            step = Step(FEED_AND_VIBRATE, feed)
         else:
+            s.filling = False
             step = Step(VIBRATE)
         s.last = step.decision
         return step

@@ -52,6 +52,26 @@ def test_pick_when_valid_vibrate_within_range_feed_below_it():
     assert policy.state.picked == 11
 
 
+def test_a_dosed_feed_fills_the_table_over_several_vibrations():
+    policy = FeederPolicy(FeederConfig(feeder_parts=100, min_count=20, max_count=30,
+                                       max_feed=12))
+    fed = []
+    on_table = 0
+    while (step := policy.decide(0, on_table)).decision == FEED_AND_VIBRATE:
+        policy.fed(step.feed)
+        policy.vibrated()
+        on_table += step.feed
+        fed.append(step.feed)
+    # up to max* as without a dose, 12 parts a feed, a vibration after each
+    assert fed == [12, 12, 6] and step.decision == VIBRATE and on_table == 30
+    step = policy.decide(0, 15)
+    assert step.decision == FEED_AND_VIBRATE and step.feed == 12     # not the 15 short
+    policy.fed(12)
+    assert policy.decide(1, 27).decision == PICK        # a valid part is picked first
+    step = policy.decide(0, 26)                         # then the filling goes on to max*
+    assert step.decision == FEED_AND_VIBRATE and step.feed == 4
+
+
 def test_an_empty_feeder_feeds_what_it_has_then_only_vibrates():
     policy = FeederPolicy(FeederConfig(feeder_parts=35, min_count=20, max_count=30))
     policy.decide(0, 0)
@@ -85,6 +105,7 @@ def test_the_vibration_limit_stops_a_run_that_finds_no_valid_part():
     (FeederConfig(feeder_parts=0), r'feeder_parts: 0 must be within'),
     (FeederConfig(max_count=0), r'max_count: 0 must be within'),
     (FeederConfig(max_vibrations=-1), r'max_vibrations: -1 must be within'),
+    (FeederConfig(max_feed=-2), r'max_feed: -2 must be within'),
 ])
 def test_bad_configurations_are_refused(config, rule):
     with pytest.raises(InvalidArgument, match=rule):

@@ -134,6 +134,7 @@ class FeederEmptyingKeys(OnGripper):
     parts: Parts
     optimal_range: Annotated[str | tuple[int, int], BeforeValidator(_range_or_id)]
     max_vibrations: Int(1, 1_000_000) = 500
+    max_feed: Int(1, MAX_PARTS_PER_INSTANCE) | None = None    # a feed's dose; None: no limit
 
 
 class GripperGrid(Section):

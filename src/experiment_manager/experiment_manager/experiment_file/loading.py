@@ -243,6 +243,7 @@ def _experiment(e: experiment_keys.ExperimentKeys, where: str, c: _Context) -> l
             checked_as(check_feeder, FeederConfig(e.parts, *e.optimal_range, e.max_vibrations),
                      where)
         out['max_vibrations'] = e.max_vibrations
+        out['max_feed'] = e.max_feed or 0
         check_fits(f'{where}.optimal_range (max)', high, volume, tray)
     return [Experiment(**out)]
 

@@ -147,6 +147,7 @@ class Experiment:
     optimal_range: tuple[int, int] | None = None
     range_from: str = ''
     max_vibrations: int = 500
+    max_feed: int = 0
     variants: tuple[GripperVariant, ...] = ()
     min_valid: float = 1.0
     of: tuple[str, ...] = ()

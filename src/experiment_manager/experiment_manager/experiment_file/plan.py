@@ -136,7 +136,7 @@ def plan(file: ExperimentFile, exp: Experiment, summary: dict) -> list[Unit]:
             units += [unit(n, i, file.tray, n) for i in range(exp.iterations)]
     else:
         low, high = exp.optimal_range or summary[exp.range_from]['optimal_range']
-        feeder = FeederConfig(exp.parts, low, high, exp.max_vibrations)
+        feeder = FeederConfig(exp.parts, low, high, exp.max_vibrations, exp.max_feed)
         units = [unit(0, i, file.tray, exp.parts, feeder=feeder)
                  for i in range(exp.iterations)]
     return units

@@ -274,6 +274,7 @@ class GraphBackend:
             goal.restart = True
             goal.feeder_parts, goal.min_count = restart.feeder_parts, restart.min_count
             goal.max_count, goal.max_vibrations = restart.max_count, restart.max_vibrations
+            goal.max_feed = restart.max_feed
         result = self._action(self._feed, goal, 'feed_cycle')
         s = result.state
         return FeedStep(result.decision, result.parts_fed, s.vibrations, s.feeds,
