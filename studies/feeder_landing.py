@@ -5,16 +5,16 @@ zone (the test case's, or one set back from the -X wall).
     tools/ws python -m studies.feeder_landing [--part pth1.yaml] [--runs 4] [--parts 480]
         [--range 45,55] [--lip-mm 30] [--set-back-mm 0] [--max-feed N]
 
-Runs `--runs` seeded feeder_emptying runs of the test case's part file on the cores (the
-optimal range given, or the part's sweep's when --range is 'sweep'), the tray's feeder zone
-moved `--set-back-mm` away from the -X wall (its far edge kept: the file key
-feeder_zone_mm), and with `--max-feed` a hopper that doses at most N parts a feed (the
-feeder_emptying key max_feed). The tray is measured after every feed, before the vibration
-that follows it; printed, over all feeds: the pile's top (the highest point of any part on the tray: median, 90th
-percentile, highest), the feeds after which a part stood higher than the walls, the parts that
-then reached over a wall's inner face higher than its top (resting on or against its top), and
-per run the parts spilled (outside the tray, not through it). Parts' points are the part's
-visual mesh, posed as the world reports it.
+Runs `--runs` seeded feeder_emptying runs of the test case's part file on the cores at the
+optimal range given, the tray's feeder zone moved
+`--set-back-mm` away from the -X wall (its far edge kept: the file key feeder_zone_mm), and with
+`--max-feed` a hopper that doses at most N parts a feed (the feeder_emptying key max_feed). The
+tray is measured after every feed, before the vibration that follows it; printed, over all
+feeds: the pile's top (the highest point of any part on the tray: median, 90th percentile,
+highest), the feeds after which a part stood higher than the walls, the parts that then reached
+over a wall's inner face higher than its top (resting on or against its top), and per run the
+parts spilled (outside the tray, not through it). Parts' points are the part's visual mesh,
+posed as the world reports it.
 """
 
 import argparse
@@ -76,7 +76,7 @@ def main() -> None:
     parser.add_argument('--set-back-mm', type=float, default=0.0)
     parser.add_argument('--max-feed', type=int, default=None)
     args = parser.parse_args()
-    span = args.range if args.range == 'sweep' else [int(v) for v in args.range.split(',')]
+    span = [int(v) for v in args.range.split(',')]
     sections = {'hopper_lip_mm': args.lip_mm}
     experiments = [{'id': 'feeder', 'type': 'feeder_emptying', 'iterations': args.runs,
                     'parts': args.parts, 'optimal_range': span, 'max_vibrations': 500,
