@@ -6,15 +6,14 @@ zone (the test case's, or one set back from the -X wall).
         [--range 45,55] [--lip-mm 30] [--set-back-mm 0] [--max-feed N]
 
 Runs `--runs` seeded feeder_emptying runs of the test case's part file on the cores at the
-optimal range given, the tray's feeder zone moved
-`--set-back-mm` away from the -X wall (its far edge kept: the file key feeder_zone_mm), and with
-`--max-feed` a hopper that doses at most N parts a feed (the feeder_emptying key max_feed). The
-tray is measured after every feed, before the vibration that follows it; printed, over all
-feeds: the pile's top (the highest point of any part on the tray: median, 90th percentile,
-highest), the feeds after which a part stood higher than the walls, the parts that then reached
-over a wall's inner face higher than its top (resting on or against its top), and per run the
-parts spilled (outside the tray, not through it). Parts' points are the part's visual mesh,
-posed as the world reports it.
+optimal range given, the tray's feeder zone moved `--set-back-mm` away from the -X wall (its far
+edge kept: the file key feeder_zone_mm), and with `--max-feed` a hopper that doses at most N
+parts a feed (the feeder_emptying key max_feed). The tray is measured after every feed, before
+the vibration that follows it; printed, over all feeds: the pile's top (the highest point of any
+part on the tray: median, 90th percentile, highest), the feeds after which a part stood higher
+than the walls, the parts that then reached over a wall's inner face higher than its top
+(resting on or against its top), and per run the parts spilled (outside the tray, not through
+it). Parts' points are the part's visual mesh, posed as the world reports it.
 """
 
 import argparse
