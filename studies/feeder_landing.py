@@ -4,16 +4,18 @@ zone (the test case's, or one set back from the -X wall).
 
     tools/ws python -m studies.feeder_landing [--part pth1.yaml] [--runs 4] [--parts 480]
         [--range 45,55] [--lip-mm 30] [--set-back-mm 0] [--max-feed N]
+        [--moves spread,forward]
 
 Runs `--runs` seeded feeder_emptying runs of the test case's part file on the cores at the
 optimal range given, the tray's feeder zone moved `--set-back-mm` away from the -X wall (its far
 edge kept: the file key feeder_zone_mm), and with `--max-feed` a hopper that doses at most N
-parts a feed (the feeder_emptying key max_feed). The tray is measured after every feed, before
-the vibration that follows it; printed, over all feeds: the pile's top (the highest point of any
-part on the tray: median, 90th percentile, highest), the feeds after which a part stood higher
-than the walls, the parts that then reached over a wall's inner face higher than its top
-(resting on or against its top), and per run the parts spilled (outside the tray, not through
-it). Parts' points are the part's visual mesh, posed as the world reports it.
+parts a feed (the feeder_emptying key max_feed), with `--moves` another vibration cycle (named
+moves). The tray is measured after every feed, before the vibration that follows it; printed,
+over all feeds: the pile's top (the highest point of any part on the tray: median, 90th
+percentile, highest), the feeds after which a part stood higher than the walls, the parts that
+then reached over a wall's inner face higher than its top (resting on or against its top), and
+per run the parts spilled (outside the tray, not through it). Parts' points are the part's
+visual mesh, posed as the world reports it.
 """
 
 import argparse
@@ -74,9 +76,12 @@ def main() -> None:
     parser.add_argument('--lip-mm', type=float, default=30.0)
     parser.add_argument('--set-back-mm', type=float, default=0.0)
     parser.add_argument('--max-feed', type=int, default=None)
+    parser.add_argument('--moves', default=None, help="the vibration cycle's named moves "
+                        "(default: the part file's)")
     args = parser.parse_args()
     span = [int(v) for v in args.range.split(',')]
-    sections = {'hopper_lip_mm': args.lip_mm}
+    sections = {'hopper_lip_mm': args.lip_mm,
+                **({'moves': args.moves.split(',')} if args.moves else {})}
     experiments = [{'id': 'feeder', 'type': 'feeder_emptying', 'iterations': args.runs,
                     'parts': args.parts, 'optimal_range': span, 'max_vibrations': 500,
                     **({'max_feed': args.max_feed} if args.max_feed else {})}]
@@ -94,8 +99,9 @@ def main() -> None:
     feeds = np.array(backend.feeds)
     (cx, cy), (sx, sy) = file.tray.feeder_zone_center, file.tray.feeder_zone_size
     dose = f'at most {args.max_feed} parts a feed' if args.max_feed else 'no dose'
-    print(f'{args.part}: {dose}, lip {args.lip_mm:g} mm, feeder zone centred at {1000 * cx:.2f}, '
-          f'{1000 * cy:.2f} mm, {1000 * sx:.2f} x {1000 * sy:.2f} mm, walls '
+    cycle = ', '.join(args.moves.split(',')) if args.moves else "the file's cycle"
+    print(f'{args.part}: {dose}, {cycle}, lip {args.lip_mm:g} mm, feeder zone centred at '
+          f'{1000 * cx:.2f}, {1000 * cy:.2f} mm, {1000 * sx:.2f} x {1000 * sy:.2f} mm, walls '
           f'{1000 * file.tray.inner_size[2]:g} mm')
     top = np.percentile(1000 * feeds[:, 1], [50, 90, 100])
     print(f'  {len(feeds)} feeds: pile top median {top[0]:.1f} mm, 90th {top[1]:.1f}, '
