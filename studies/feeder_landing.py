@@ -4,18 +4,18 @@ zone (the test case's, or one set back from the -X wall).
 
     tools/ws python -m studies.feeder_landing [--part pth1.yaml] [--runs 4] [--parts 480]
         [--range 45,55] [--lip-mm 30] [--set-back-mm 0] [--max-feed N]
-        [--moves spread,forward]
+        [--moves spread,forward] [--wall-mm 27]
 
 Runs `--runs` seeded feeder_emptying runs of the test case's part file on the cores at the
 optimal range given, the tray's feeder zone moved `--set-back-mm` away from the -X wall (its far
 edge kept: the file key feeder_zone_mm), and with `--max-feed` a hopper that doses at most N
 parts a feed (the feeder_emptying key max_feed), with `--moves` another vibration cycle (named
-moves). The tray is measured after every feed, before the vibration that follows it; printed,
-over all feeds: the pile's top (the highest point of any part on the tray: median, 90th
-percentile, highest), the feeds after which a part stood higher than the walls, the parts that
-then reached over a wall's inner face higher than its top (resting on or against its top), and
-per run the parts spilled (outside the tray, not through it). Parts' points are the part's
-visual mesh, posed as the world reports it.
+moves), with `--wall-mm` other walls. The tray is measured after every feed, before the
+vibration that follows it; printed, over all feeds: the pile's top (the highest point of any
+part on the tray: median, 90th percentile, highest), the feeds after which a part stood higher
+than the walls, the parts that then reached over a wall's inner face higher than its top
+(resting on or against its top), and per run the parts spilled (outside the tray, not through
+it). Parts' points are the part's visual mesh, posed as the world reports it.
 """
 
 import argparse
@@ -76,6 +76,8 @@ def main() -> None:
     parser.add_argument('--lip-mm', type=float, default=30.0)
     parser.add_argument('--set-back-mm', type=float, default=0.0)
     parser.add_argument('--max-feed', type=int, default=None)
+    parser.add_argument('--wall-mm', type=float, default=None, help="the tray's wall height "
+                        "(default: the file's tray_mm)")
     parser.add_argument('--moves', default=None, help="the vibration cycle's named moves "
                         "(default: the part file's)")
     args = parser.parse_args()
@@ -85,8 +87,11 @@ def main() -> None:
     experiments = [{'id': 'feeder', 'type': 'feeder_emptying', 'iterations': args.runs,
                     'parts': args.parts, 'optimal_range': span, 'max_vibrations': 500,
                     **({'max_feed': args.max_feed} if args.max_feed else {})}]
+    tray = variant(args.part, experiments).tray
+    if args.wall_mm:
+        sections['tray_mm'] = [1000 * tray.inner_size[0], 1000 * tray.inner_size[1],
+                               args.wall_mm]
     if args.set_back_mm:
-        tray = variant(args.part, experiments).tray
         (cx, cy), (sx, sy) = tray.feeder_zone_center, tray.feeder_zone_size
         b = args.set_back_mm / 1000.0
         sections['feeder_zone_mm'] = {'center': [1000 * (cx + b / 2), 1000 * cy],
