@@ -12,7 +12,9 @@ from experiment_manager import experiment_file
 from experiment_manager.analysis import decisions, pictures, report, summary, verdicts
 from experiment_manager.analysis.metrics import rate_interval
 from experiment_manager.analysis.report import Run
+from experiment_manager.analysis.report.table import feeding
 from experiment_manager.analysis.verdicts import FEASIBLE, NOT_ANALYSED, NOT_FEASIBLE, UNDECIDED
+from pick_common.containers import ContainerSpec
 from pick_validity.results import STAGE_PLACEABILITY
 import pytest
 
@@ -58,6 +60,14 @@ def test_a_run_gets_its_report_files(run_dir):
     assert 'No iteration was flagged' in text
     assert re.search(r'The cell would pick [\d.]+ parts per hour \(mean of 1 run; required '
                      r'60\): 4 s per pick', text)
+    # how the parts reached the tray, from the file's keys (the default tray, no dose)
+    assert ('The hopper fed the parts from 30 mm over the plate (`hopper_lip_mm`), or from just '
+            'above the pile where it stood higher, onto the feeder zone x -97.5 to -48.75 mm, '
+            'y -60 to 60 mm (`feeder_zone_mm`) of the 195 x 150 mm tray with 27 mm walls '
+            '(`tray_mm`), the whole shortfall to max* at once') in text
+    dosed = feeding(ContainerSpec.tray(), 12)
+    assert dosed.endswith('at most 12 parts a feed, the fill to max* going on over several '
+                          'vibrations (`max_feed`).')
     # a header people read, and each verdict coloured by what it says
     assert 'Part `radial_capacitor`; gripper body diameter 8 mm, jaw depth 3 mm; seed 11.' in text
     for v in _verdicts(_summary(run_dir)):

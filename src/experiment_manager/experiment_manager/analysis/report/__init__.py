@@ -12,8 +12,12 @@ decisions themselves are verdicts.py's; this package renders them. No rclpy.
 import json
 import os
 
+from pick_common.errors import InvalidArgument
+from pydantic import ValidationError
 import yaml
 
+from ...experiment_file import sections
+from ...experiment_file.schema import FileKeys
 from ...experiment_file.schema import Part as PartKeys
 from .. import stages
 from .. import summary as summary_model
@@ -60,12 +64,19 @@ def read(run_dir: str) -> Run:
         spec = yaml.safe_load(f) or {}
     part = PartKeys.model_validate(spec.get('part') or {})
     checks = os.path.join(run_dir, 'checks.csv')
+    try:        # a run of an older version may hold keys this one no longer reads
+        tray = sections.tray(FileKeys.model_validate(spec))
+    except (ValidationError, InvalidArgument):
+        tray = None
+    max_feed = {e.get('id'): e.get('max_feed') or 0 for e in spec.get('experiments') or []
+                if isinstance(e, dict) and e.get('type') == 'feeder_emptying'}
     return Run(summary=summary_model.read(os.path.join(run_dir, 'summary.json')),
                part_model=part.model, part_dimensions_mm=dict(part.dimensions_mm),
                gripper=spec.get('gripper') or {},
                pictures=_json(os.path.join(run_dir, 'pictures.json')),
                account=_json(os.path.join(run_dir, 'part.json')),
-               stops=stages.turned_down(read_csv(checks)) if os.path.exists(checks) else None)
+               stops=stages.turned_down(read_csv(checks)) if os.path.exists(checks) else None,
+               tray=tray, max_feed=max_feed)
 
 
 def write(run_dir: str) -> str:

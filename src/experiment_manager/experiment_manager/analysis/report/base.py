@@ -5,6 +5,8 @@ has nothing for it."""
 from dataclasses import dataclass, field
 from functools import cached_property
 
+from pick_common.containers import ContainerSpec
+
 from ...experiment_file.schema import Part as PartKeys
 from ..summary import Summary
 from ..verdicts import PAPER, Verdict, verdicts
@@ -17,7 +19,9 @@ class Run:
     the dimensions it gave); gripper: the gripper keys the file gave (mm); figures: which plots
     were drawn, by name (plots.py); pictures: {image file: caption} (pictures.py); account:
     the part's account (part_sheet.describe), with its sheet `part.png`; stops: why parts were
-    turned down, per experiment (stages.turned_down)."""
+    turned down, per experiment (stages.turned_down); tray: the tray the file gave (its walls,
+    feeder zone and hopper lip), None when the file cannot say; max_feed: each feeder run's
+    dose, by experiment id (0: the whole shortfall at once)."""
     summary: Summary
     part_model: str = PartKeys.model_fields['model'].default
     part_dimensions_mm: dict[str, float] = field(default_factory=dict)
@@ -26,6 +30,8 @@ class Run:
     pictures: dict[str, str] | None = None
     account: list[str] | None = None
     stops: dict[str, dict[str, int]] | None = None
+    tray: ContainerSpec | None = None
+    max_feed: dict[str, int] = field(default_factory=dict)
 
     @property
     def paper(self) -> dict | None:

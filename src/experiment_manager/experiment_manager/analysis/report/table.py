@@ -2,6 +2,8 @@
 its optimal range, with warnings where the range is not pinned down) and the feeder emptying
 (its Table 3, and the parts per hour the cell would pick)."""
 
+from pick_common.containers import ContainerSpec, drop_height
+
 from ..wording import count, fmt, table
 from .base import Run, Section
 
@@ -65,6 +67,8 @@ class Feeder(Section):
                          t['vibrations']])
         lines += table(['', 'iterations', 'parts', 'optimal range', 'emptied',
                         'av. vibrations to empty'], rows)
+        if run.tray is not None:
+            lines += ['', feeding(run.tray, run.max_feed.get(exp_id, 0))]
         lines += ['', f'Time per vibration the refill interval allows: '
                   f'{fmt(s.minutes_per_vibration_allowed)} min. Parts spilled over the '
                   f'walls: {s.physics.spilled} (in {s.runs_spilling} runs; a run may '
@@ -82,3 +86,18 @@ class Feeder(Section):
                       '(`cell.image_s`), and the simulated time each feed and vibration took '
                       'until the parts rested.']
         return lines
+
+
+def feeding(tray: ContainerSpec, dose: int) -> str:
+    """How the parts reached the tray, in words, from the file's keys."""
+    (cx, cy), (sx, sy) = tray.feeder_zone_center, tray.feeder_zone_size
+    x, y, z = (1000 * v for v in tray.inner_size)
+    return (f'The hopper fed the parts from {fmt(1000 * drop_height(tray))} mm over the plate '
+            f'(`hopper_lip_mm`), or from just above the pile where it stood higher, onto the '
+            f'feeder zone x {fmt(1000 * (cx - sx / 2), 4)} to {fmt(1000 * (cx + sx / 2), 4)} mm, '
+            f'y {fmt(1000 * (cy - sy / 2), 4)} to {fmt(1000 * (cy + sy / 2), 4)} mm '
+            '(`feeder_zone_mm`) '
+            f'of the {fmt(x)} x {fmt(y)} mm tray with {fmt(z)} mm walls (`tray_mm`), '
+            + (f'at most {dose} parts a feed, the fill to max* going on over several '
+               'vibrations (`max_feed`).' if dose else
+               'the whole shortfall to max* at once (`max_feed` would dose it).'))
