@@ -303,6 +303,34 @@ def test_a_drop_test_through_the_graph_gives_the_cores_aspects(tmp_path, private
     assert '## Drop test (`drop`)' in open(os.path.join(run_dir, 'report.md')).read()
 
 
+DOSED = """id: dosed
+seed: 4
+feeder_zone_mm: {center: [-60, 10], size: [40, 80]}
+experiments:
+  - {id: feeder, type: feeder_emptying, iterations: 1, parts: 30, optimal_range: [10, 20],
+     max_feed: 5, max_vibrations: 60}
+"""
+
+
+def test_a_dosed_feed_onto_a_moved_zone_through_the_graph_gives_the_cores_rows(
+        tmp_path, private_ros_domain):
+    """The feeder zone (in the tray's ContainerGeometry) and the dose (in the feed_cycle
+    goal) reach the nodes: the graph's rows are the cores', every feed at most 5 parts."""
+    path = tmp_path / 'dosed.yaml'
+    path.write_text(DOSED)
+    done = run_command(str(path), '--output', str(tmp_path / 'out'), '--namespace',
+                       unique_namespace('dosed'), '--workers', '1')
+    assert done.returncode == 0, done.stderr
+    run_dir = re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1)
+    file = experiment_file.load(str(path))
+    cores = str(tmp_path / 'cores')
+    with LocalBackend() as backend, ResultsWriter(cores, file.text) as writer:
+        Runner(file, [backend], writer).run()
+    assert rows(run_dir, 'iterations') == rows(cores, 'iterations')
+    (row,) = rows(run_dir, 'iterations')
+    assert int(row['feeds']) >= 30 // 5 and int(row['picks']) > 0
+
+
 def start_replay(client, recording: str, name: str, rate: str) -> tuple[subprocess.Popen, list]:
     """`replay` of worker_0's results at `rate` under the prefix `name` (one per test: no test
     hears another's replay), and the list that receives what it publishes. The replay waits
