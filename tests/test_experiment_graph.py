@@ -54,6 +54,22 @@ def run_command(*args: str, timeout: float = 600.0) -> subprocess.CompletedProce
                           capture_output=True, text=True, timeout=timeout)
 
 
+def graph_and_cores(path: str, tmp_path, label: str, workers: int
+                    ) -> tuple[subprocess.CompletedProcess, str, str, dict]:
+    """The file at `path` run through the graph (`run`, `workers` workers, a namespace of its
+    own) and on the cores in this process: run's output, the graph's run directory, the cores'
+    directory and the cores' summary."""
+    done = run_command(path, '--output', str(tmp_path / 'out'), '--namespace',
+                       unique_namespace(label), '--workers', str(workers))
+    assert done.returncode == 0, done.stderr
+    run_dir = re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1)
+    file = experiment_file.load(path)
+    cores = str(tmp_path / 'cores')
+    with LocalBackend() as backend, ResultsWriter(cores, file.text) as writer:
+        expected = Runner(file, [backend], writer).run()
+    return done, run_dir, cores, expected
+
+
 @pytest.fixture(scope='module')
 def graph_run(tmp_path_factory, private_ros_domain):
     out, logs = tmp_path_factory.mktemp('out'), tmp_path_factory.mktemp('logs')
@@ -248,14 +264,7 @@ def test_a_sensitivity_run_through_the_graph_gives_the_cores_answers_and_records
     moves) on two workers, each switched between scenarios as iterations reach it: the rows
     are the cores', and the sensitivity's summary is in summary.json, the report, the
     recording (an independent reader) and run's output."""
-    done = run_command(SENSITIVITY, '--output', str(tmp_path / 'out'), '--namespace',
-                       unique_namespace('sens'), '--workers', '2')
-    assert done.returncode == 0, done.stderr
-    run_dir = re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1)
-    file = experiment_file.load(SENSITIVITY)
-    cores = str(tmp_path / 'cores')
-    with LocalBackend() as backend, ResultsWriter(cores, file.text) as writer:
-        expected = Runner(file, [backend], writer).run()
+    done, run_dir, cores, expected = graph_and_cores(SENSITIVITY, tmp_path, 'sens', 2)
     for name in FILES:
         assert rows(run_dir, name) == rows(cores, name), name
     with open(os.path.join(run_dir, 'summary.json')) as f:
@@ -288,14 +297,7 @@ def test_a_drop_test_through_the_graph_gives_the_cores_aspects(tmp_path, private
     reaches it in ContainerGeometry) and the rows, aspects and G-test are the cores'."""
     path = tmp_path / 'drops.yaml'
     path.write_text(DROPS)
-    done = run_command(str(path), '--output', str(tmp_path / 'out'), '--namespace',
-                       unique_namespace('drops'), '--workers', '2')
-    assert done.returncode == 0, done.stderr
-    run_dir = re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1)
-    file = experiment_file.load(str(path))
-    cores = str(tmp_path / 'cores')
-    with LocalBackend() as backend, ResultsWriter(cores, file.text) as writer:
-        expected = Runner(file, [backend], writer).run()
+    _, run_dir, cores, expected = graph_and_cores(str(path), tmp_path, 'drops', 2)
     assert rows(run_dir, 'iterations') == rows(cores, 'iterations')
     with open(os.path.join(run_dir, 'summary.json')) as f:
         got = json.load(f)['experiments']['drop']
@@ -318,14 +320,7 @@ def test_a_dosed_feed_onto_a_moved_zone_through_the_graph_gives_the_cores_rows(
     goal) reach the nodes: the graph's rows are the cores', every feed at most 5 parts."""
     path = tmp_path / 'dosed.yaml'
     path.write_text(DOSED)
-    done = run_command(str(path), '--output', str(tmp_path / 'out'), '--namespace',
-                       unique_namespace('dosed'), '--workers', '1')
-    assert done.returncode == 0, done.stderr
-    run_dir = re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1)
-    file = experiment_file.load(str(path))
-    cores = str(tmp_path / 'cores')
-    with LocalBackend() as backend, ResultsWriter(cores, file.text) as writer:
-        Runner(file, [backend], writer).run()
+    _, run_dir, cores, _ = graph_and_cores(str(path), tmp_path, 'dosed', 1)
     assert rows(run_dir, 'iterations') == rows(cores, 'iterations')
     (row,) = rows(run_dir, 'iterations')
     assert int(row['feeds']) >= 30 // 5 and int(row['picks']) > 0
