@@ -240,8 +240,8 @@ def _experiment(e: experiment_keys.ExperimentKeys, where: str, c: _Context) -> l
         else:
             out['optimal_range'] = e.optimal_range
             high = e.optimal_range[1]
-            checked_as(check_feeder, FeederConfig(e.parts, *e.optimal_range, e.max_vibrations),
-                     where)
+            checked_as(check_feeder, FeederConfig(e.parts, *e.optimal_range, e.max_vibrations,
+                                                  e.max_feed or 0), where)
         out['max_vibrations'] = e.max_vibrations
         out['max_feed'] = e.max_feed or 0
         check_fits(f'{where}.optimal_range (max)', high, volume, tray)
