@@ -72,6 +72,9 @@ def test_the_time_ground_decides_on_the_bound_and_says_which():
 def test_spills_are_a_rate_or_a_count_that_must_be_zero():
     clean = [{'time': 1.0, 'spilled': 0}] * 10
     assert decisions.spills(clean, 0).verdict == decisions.FEASIBLE
+    # no spill in 3 runs is not a rate of 0: runs spilling 63 % of the time show none 5 %
+    assert 'runs may still spill up to 63.2 % of the time' in decisions.spills(clean[:3], 0).reason
+    assert 'up to 25.9 %' in decisions.spills(clean, 0).reason
     assert decisions.spills(clean[:9] + [{'time': 1.0, 'spilled': 1}], 0).verdict == \
         decisions.NOT_FEASIBLE
     # at a limit of 1 per refill: none in 10 runs bounds the rate at 3.0 / 10 (Garwood)

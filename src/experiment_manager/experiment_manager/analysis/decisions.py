@@ -137,10 +137,14 @@ def spills(runs: list[dict], limit: int, confidence: float = CONFIDENCE) -> Deci
     if limit == 0:
         kind = 'a count that must be zero'
         verdict = NOT_FEASIBLE if total else FEASIBLE if n else UNDECIDED
-        return Decision(verdict, quantity, float(total), kind, n,
-                        f"{total} parts spilled over the tray's walls in {n} runs; the limit "
-                        'is 0 (requirements.max_spilled_parts: a spilled part is lost)',
-                        {'spilled': total})
+        said = (f"{total} parts spilled over the tray's walls in {n} runs; the limit "
+                'is 0 (requirements.max_spilled_parts: a spilled part is lost)')
+        if n and not total:
+            # no spill is not a rate of 0: how often runs may still spill, unseen in n
+            unseen = float(binomial_bounds(0, n, confidence)[1])
+            said += (f'; runs may still spill up to {_pc(unseen)} of the time '
+                     f'({_one_sided(confidence)} Clopper-Pearson bound, 0 of {n})')
+        return Decision(verdict, quantity, float(total), kind, n, said, {'spilled': total})
     kind = _one_sided(confidence) + ' Poisson bounds (Garwood)'
     if n == 0:
         return Decision(UNDECIDED, quantity, None, kind, 0, 'no feeder run yet')

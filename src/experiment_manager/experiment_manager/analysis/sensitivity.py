@@ -16,6 +16,8 @@ flip it, with the inputs' values there.
 Pure: no rclpy, no files.
 """
 
+from scipy.stats import fisher_exact
+
 from ..experiment_file import ExperimentFile
 from ..experiment_file.model import Experiment
 from ..experiment_file.scenarios import grid_levels, point_key
@@ -88,6 +90,11 @@ def summarise(file: ExperimentFile, exp: Experiment, summaries: dict) -> dict:
     base_said = said(view(None))
     scenarios = [{'name': sc.name, 'values': dict(sc.values), **said(view(sc.name))}
                  for sc in exp.scenarios]
+    # the table's spill and time grounds per scenario (None: the file's), when it is repeated
+    table = last.get('feeder_emptying')
+    spill_runs = ({name: _spill_runs(view(name)[table])
+                   for name in [None, *(sc.name for sc in exp.scenarios)]}
+                  if table in exp.of else {})
     by_name = {s['name']: s for s in scenarios}
     tornado = {}
     for key in ANSWERS:
@@ -108,7 +115,8 @@ def summarise(file: ExperimentFile, exp: Experiment, summaries: dict) -> dict:
                         'source': x.source} for x in exp.inputs],
             'base': base_said, 'scenarios': scenarios, 'tornado': tornado,
             'ranges': _ranges(base_said, scenarios),
-            'robustness': _held_said(_robustness(exp, base_said, scenarios), held),
+            'robustness': _held_said(_robustness(exp, base_said, scenarios, spill_runs),
+                                     held),
             **({'map': m} if (m := _map(exp, base_said, scenarios)) else {}),
             **({'calibration': c} if (c := _calibrations(file, exp, base, summaries)) else {}),
             'faults': _faults(repeats), 'physics': _physics(repeats)}
@@ -177,16 +185,38 @@ def _ranges(base: dict, scenarios: list[dict]) -> dict:
     return out
 
 
-def _robustness(exp: Experiment, base: dict, scenarios: list[dict]) -> list[dict]:
+def _spill_runs(feeder: dict) -> dict:
+    """A feeder_emptying summary's runs, those that spilled, and its two grounds' verdicts."""
+    grounds = feeder['decision']
+    return {'runs': feeder['iterations'], 'spilling': feeder['runs_spilling'],
+            'spills': grounds['spills']['verdict'], 'time': grounds['time']['verdict']}
+
+
+def _spills_p(here: dict, there: dict) -> float | None:
+    """For a table's flip on its spills alone (`here` the scenario's _spill_runs, `there` the
+    file's): Fisher's exact p (two-sided) that its runs spilling and the file's are one rate;
+    None for a flip the spills do not make alone."""
+    if here['spills'] == there['spills'] or here['time'] != there['time']:
+        return None
+    a, b = (here['spilling'], here['runs']), (there['spilling'], there['runs'])
+    return float(fisher_exact([[a[0], a[1] - a[0]], [b[0], b[1] - b[0]]]).pvalue)
+
+
+def _robustness(exp: Experiment, base: dict, scenarios: list[dict],
+                spill_runs: dict | None = None) -> list[dict]:
     """Per option of the base verdicts: whether it holds in every scenario, and where not,
-    the scenarios that flip it (their verdict and their inputs' values), with a line for the
-    terminal."""
+    the scenarios that flip it (their verdict and their inputs' values; for the table, a
+    flip on its spills alone with `spills_p`, _spills_p, and its words say which such flips
+    so few runs do not tell from the file's), with a line for the terminal."""
     inputs = {x.name: x for x in exp.inputs}
     out = []
     for option, verdict in base['verdicts'].items():
         flips = [{'scenario': s['name'], 'verdict': s['verdicts'].get(option),
                   'values': s['values']} for s in scenarios
                  if s['verdicts'].get(option) != verdict]
+        for f in flips if option == 'vibrating table' and spill_runs else ():
+            if (p := _spills_p(spill_runs[f['scenario']], spill_runs[None])) is not None:
+                f['spills_p'] = p
         if not flips:
             said = (f'{verdict} over all ranges ({len(scenarios)} scenarios: '
                     + ', '.join(inputs) + ')')
@@ -199,10 +229,34 @@ def _robustness(exp: Experiment, base: dict, scenarios: list[dict]) -> list[dict
                     + f' ({len(flips)} of {len(scenarios)} scenarios)')
             if all(f['verdict'] == UNDECIDED for f in flips):
                 said += ': the runs there do not settle it, which is not a flip to the other side'
+            said += _drawn(flips, spill_runs)
         out.append({'option': option, 'verdict': verdict, 'holds': not flips,
                     'flips': flips, 'said': said, 'line': f'{option} {said}',
                     'sources': {k: inputs[k].source for f in flips for k in f['values']}})
     return out
+
+
+def _drawn(flips: list[dict], spill_runs: dict | None) -> str:
+    """Words for the flips on spills alone whose runs do not tell them from the file's
+    (Fisher's exact p at least 0.05): how many, their runs spilling beside the file's, and
+    whether any count of runs this few could have (the smallest p they allow)."""
+    drawn = [f for f in flips if f.get('spills_p', 0.0) >= 0.05]
+    if not drawn:
+        return ''
+    base = spill_runs[None]
+    runs = [spill_runs[f['scenario']] for f in drawn]
+    counts = sorted({(r['spilling'], r['runs']) for r in runs})
+    ps = sorted({round(f['spills_p'], 2) for f in drawn})
+    # the smallest p any count allows: all runs spilling on one side, none on the other
+    least = max(fisher_exact([[r['runs'], 0], [0, base['runs']]]).pvalue for r in runs)
+    return (f'. {len(drawn)} of these flip on spills alone, with runs spilling '
+            + ', '.join(f'{k} of {n}' for k, n in counts)
+            + f" there against {base['spilling']} of {base['runs']} at the file's values, "
+            "which so few runs do not tell apart (Fisher's exact p "
+            + ' to '.join(f'{p:.2f}' for p in (ps[0], ps[-1])[:len(ps)])
+            + (f'; no count of so few runs could: the least p they allow is {least:.2f}'
+               if least >= 0.05 else '')
+            + "): more runs would tell the draw's from the input's")
 
 
 def _faults(repeats: dict) -> dict:
