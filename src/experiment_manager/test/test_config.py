@@ -265,7 +265,7 @@ def test_the_installed_share_holds_the_paper_test_case():
     for name in ('pth0.yaml', 'pth1.yaml', 'pth2.yaml', 'grippers_pth0.yaml',
                  'pth0_robustness.yaml', 'pth1_robustness.yaml', 'pth2_robustness.yaml',
                  'pth0_gripper_map.yaml', 'pth0_options.yaml', 'pth1_options.yaml',
-                 'pth2_options.yaml'):
+                 'pth2_options.yaml', 'pth0_spills.yaml', 'pth2_spills.yaml'):
         assert experiment_file.load(os.path.join(share, 'test_case', name)).experiments
 
 
@@ -284,6 +284,23 @@ def test_the_robustness_files_are_their_part_with_a_sensitivity_experiment(name)
         part.requirements, part.cell, part.tray)
     sensitivity = robust.experiments[-1]
     assert sensitivity.type == 'sensitivity' and all(x.source for x in sensitivity.inputs)
+
+
+@pytest.mark.parametrize('name', ['pth0_spills.yaml', 'pth2_spills.yaml'])
+def test_the_spill_files_are_their_part_and_its_feeder_runs_on_the_same_seeds(name):
+    # the first runs must be the sensitivity's own (the same part, cell, seeds and range)
+    case = os.path.join(HERE, '..', 'config', 'test_case')
+    part = experiment_file.load(os.path.join(case, name.split('_')[0] + '.yaml'))
+    spills = experiment_file.load(os.path.join(case, name))
+    assert (spills.id, spills.seed, spills.part, spills.gripper, spills.setup, spills.moves,
+            spills.requirements, spills.cell, spills.tray) == (
+        part.id, part.seed, part.part, part.gripper, part.setup, part.moves,
+        part.requirements, part.cell, part.tray)
+    feeder, theirs = spills.experiment('feeder'), part.experiment('feeder')
+    assert (feeder.type, feeder.parts, feeder.max_vibrations) == (
+        theirs.type, theirs.parts, theirs.max_vibrations)
+    assert [x.name for x in spills.experiment('spills').inputs] == [
+        'materials.part_on_surface.restitution', 'moves.amplitude_scale']
 
 
 @pytest.mark.parametrize('name', ['pth0_options.yaml', 'pth1_options.yaml',

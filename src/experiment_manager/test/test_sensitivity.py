@@ -267,32 +267,38 @@ def test_a_flip_names_the_scenario_and_its_values_and_undecided_is_not_called_a_
         'vibrating table FEASIBLE over all ranges (2 scenarios: gripper.jaw_depth_mm)']
 
 
-def test_a_table_flip_on_spills_alone_says_whether_its_runs_tell_it_from_the_files():
+def test_a_table_flip_its_spills_make_says_whether_its_runs_tell_it_from_the_files():
     robust = experiment_file.parse(sensitivity(
         'iterations: 3, of: [emptying], inputs: {'
         'gripper.jaw_depth_mm: {low: 2, high: 6, source: catalogue}}')).experiment('robust')
-    base = {'verdicts': {'vibrating table': 'NOT FEASIBLE'}}
-    scenarios = [{'name': f'gripper_jaw_depth_mm_{end}', 'values': {'gripper.jaw_depth_mm': v},
-                  'verdicts': {'vibrating table': 'FEASIBLE'}}
-                 for end, v in (('low', 2.0), ('high', 6.0))]
 
     def runs(spilling, n=3, spills='FEASIBLE', time='FEASIBLE'):
         return {'runs': n, 'spilling': spilling, 'spills': spills, 'time': time}
-    # 1 of 3 runs spilled at the file's values, none of 3 in either scenario: p = 1
-    spill_runs = {None: runs(1, spills='NOT FEASIBLE'), 'gripper_jaw_depth_mm_low': runs(0),
-                  'gripper_jaw_depth_mm_high': runs(0, time='NOT FEASIBLE')}
-    (table,) = _robustness(robust, base, scenarios, spill_runs)
+
+    def scenarios(low, high):
+        return [{'name': f'gripper_jaw_depth_mm_{end}', 'values': {'gripper.jaw_depth_mm': v},
+                 'verdicts': {'vibrating table': verdict}}
+                for end, v, verdict in (('low', 2.0, low), ('high', 6.0, high))]
+    # none of 3 runs spilled at the file's values; 1 of 3 at the low end, whose time ground is
+    # UNDECIDED too (its spills make the NOT FEASIBLE: p = 1); the high end UNDECIDED by its
+    # time alone
+    base = {'verdicts': {'vibrating table': 'FEASIBLE'}}
+    spill_runs = {None: runs(0),
+                  'gripper_jaw_depth_mm_low': runs(1, spills='NOT FEASIBLE', time='UNDECIDED'),
+                  'gripper_jaw_depth_mm_high': runs(0, time='UNDECIDED')}
+    (table,) = _robustness(robust, base, scenarios('NOT FEASIBLE', 'UNDECIDED'), spill_runs)
     low, high = table['flips']
-    assert low['spills_p'] == pytest.approx(1.0) and 'spills_p' not in high   # time moved too
-    assert ("1 of these flip on spills alone, with runs spilling 0 of 3 there against 1 of 3 "
+    assert low['spills_p'] == pytest.approx(1.0) and 'spills_p' not in high
+    assert ("1 of these flip on their spills, with runs spilling 1 of 3 there against 0 of 3 "
             "at the file's values" in table['line'])
     assert 'the least p they allow is 0.10' in table['line']
-    # 30 runs a side tell 0 from 15 spilling apart: the flip is said, not called a draw
+    # 30 runs a side tell 15 spilling from none: the flips are said, not called a draw
+    base = {'verdicts': {'vibrating table': 'NOT FEASIBLE'}}
     spill_runs = {None: runs(15, 30, spills='NOT FEASIBLE'),
                   'gripper_jaw_depth_mm_low': runs(0, 30), 'gripper_jaw_depth_mm_high': runs(0, 30)}
-    (table,) = _robustness(robust, base, scenarios, spill_runs)
+    (table,) = _robustness(robust, base, scenarios('FEASIBLE', 'FEASIBLE'), spill_runs)
     assert all(f['spills_p'] < 1e-4 for f in table['flips'])
-    assert 'spills alone' not in table['line']
+    assert 'flip on their spills' not in table['line']
 
 
 def test_a_grid_maps_the_verdicts_over_two_inputs():

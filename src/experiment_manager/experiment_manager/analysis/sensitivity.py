@@ -23,6 +23,7 @@ from ..experiment_file.model import Experiment
 from ..experiment_file.scenarios import grid_levels, point_key
 from . import calibration, metrics
 from . import summary as summary_model
+from .decisions import combined
 from .verdicts import NOT_ANALYSED, UNDECIDED, verdicts
 from .wording import fmt
 
@@ -192,11 +193,12 @@ def _spill_runs(feeder: dict) -> dict:
             'spills': grounds['spills']['verdict'], 'time': grounds['time']['verdict']}
 
 
-def _spills_p(here: dict, there: dict) -> float | None:
-    """For a table's flip on its spills alone (`here` the scenario's _spill_runs, `there` the
-    file's): Fisher's exact p (two-sided) that its runs spilling and the file's are one rate;
-    None for a flip the spills do not make alone."""
-    if here['spills'] == there['spills'] or here['time'] != there['time']:
+def _spills_p(here: dict, there: dict, verdict: str) -> float | None:
+    """For a table's flip to `verdict` made by its spills (`here` the scenario's _spill_runs,
+    `there` the file's: the file's time ground with the scenario's spills gives `verdict`):
+    Fisher's exact p (two-sided) that its runs spilling and the file's are one rate; None for
+    a flip its spills do not make."""
+    if here['spills'] == there['spills'] or combined([there['time'], here['spills']]) != verdict:
         return None
     a, b = (here['spilling'], here['runs']), (there['spilling'], there['runs'])
     return float(fisher_exact([[a[0], a[1] - a[0]], [b[0], b[1] - b[0]]]).pvalue)
@@ -206,7 +208,7 @@ def _robustness(exp: Experiment, base: dict, scenarios: list[dict],
                 spill_runs: dict | None = None) -> list[dict]:
     """Per option of the base verdicts: whether it holds in every scenario, and where not,
     the scenarios that flip it (their verdict and their inputs' values; for the table, a
-    flip on its spills alone with `spills_p`, _spills_p, and its words say which such flips
+    flip its spills make with `spills_p`, _spills_p, and its words say which such flips
     so few runs do not tell from the file's), with a line for the terminal."""
     inputs = {x.name: x for x in exp.inputs}
     out = []
@@ -215,7 +217,8 @@ def _robustness(exp: Experiment, base: dict, scenarios: list[dict],
                   'values': s['values']} for s in scenarios
                  if s['verdicts'].get(option) != verdict]
         for f in flips if option == 'vibrating table' and spill_runs else ():
-            if (p := _spills_p(spill_runs[f['scenario']], spill_runs[None])) is not None:
+            if (p := _spills_p(spill_runs[f['scenario']], spill_runs[None], f['verdict'])
+                    ) is not None:
                 f['spills_p'] = p
         if not flips:
             said = (f'{verdict} over all ranges ({len(scenarios)} scenarios: '
@@ -237,7 +240,7 @@ def _robustness(exp: Experiment, base: dict, scenarios: list[dict],
 
 
 def _drawn(flips: list[dict], spill_runs: dict | None) -> str:
-    """Words for the flips on spills alone whose runs do not tell them from the file's
+    """Words for the flips their spills make whose runs do not tell them from the file's
     (Fisher's exact p at least 0.05): how many, their runs spilling beside the file's, and
     whether any count of runs this few could have (the smallest p they allow)."""
     drawn = [f for f in flips if f.get('spills_p', 0.0) >= 0.05]
@@ -249,7 +252,7 @@ def _drawn(flips: list[dict], spill_runs: dict | None) -> str:
     ps = sorted({round(f['spills_p'], 2) for f in drawn})
     # the smallest p any count allows: all runs spilling on one side, none on the other
     least = max(fisher_exact([[r['runs'], 0], [0, base['runs']]]).pvalue for r in runs)
-    return (f'. {len(drawn)} of these flip on spills alone, with runs spilling '
+    return (f'. {len(drawn)} of these flip on their spills, with runs spilling '
             + ', '.join(f'{k} of {n}' for k, n in counts)
             + f" there against {base['spilling']} of {base['runs']} at the file's values, "
             "which so few runs do not tell apart (Fisher's exact p "

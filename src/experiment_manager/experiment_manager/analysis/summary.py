@@ -210,7 +210,7 @@ class Flip(_Record):
     scenario: str
     verdict: str | None
     values: dict[str, NUMBER]
-    # the table's flip on its spills alone: Fisher's exact p, its runs spilling against the file's
+    # a table flip its spills make: Fisher's exact p, its runs spilling against the file's
     spills_p: float | None = None
 
 
