@@ -64,10 +64,15 @@ def test_a_run_gets_its_report_files(run_dir):
     assert ('The hopper fed the parts from 30 mm over the plate (`hopper_lip_mm`), or from just '
             'above the pile where it stood higher, onto the feeder zone x -97.5 to -48.75 mm, '
             'y -60 to 60 mm (`feeder_zone_mm`) of the 195 x 150 mm tray with 27 mm walls '
-            '(`tray_mm`), the whole shortfall to max* at once') in text
+            '(`tray_mm`), the whole shortfall to max* at once (`max_feed` would dose it). The '
+            "file sets no `hopper_lip_mm`, `feeder_zone_mm`, `tray_mm`: those are today's "
+            'defaults, which a run made by an older version may not have had') in text
     dosed = feeding(ContainerSpec.tray(), 12)
     assert dosed.endswith('at most 12 parts a feed, the fill to max* going on over several '
                           'vibrations (`max_feed`).')
+    assert feeding(ContainerSpec.tray(), 0, ('hopper_lip_mm',)).endswith(
+        "The file sets no `hopper_lip_mm`: that is today's default, which a run made by an "
+        'older version may not have had (parts arrive from a height since 2026-11-28).')
     # a header people read, and each verdict coloured by what it says
     assert 'Part `radial_capacitor`; gripper body diameter 8 mm, jaw depth 3 mm; seed 11.' in text
     for v in _verdicts(_summary(run_dir)):

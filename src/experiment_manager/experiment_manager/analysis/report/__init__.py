@@ -34,7 +34,7 @@ from .pictures import Pictures, TurnedDown
 from .plots import draw_all, plot_tornado, tornado_bars
 from .sampling import Sampling
 from .sensitivity import Sensitivity
-from .table import Feeder, Sweep
+from .table import Feeder, FEEDING, Sweep
 from .verdict import Head
 
 SECTIONS: tuple[Section, ...] = (Head(), Part(), Sampling(), StaticBins(), BinEmptying(),
@@ -76,7 +76,7 @@ def read(run_dir: str) -> Run:
                pictures=_json(os.path.join(run_dir, 'pictures.json')),
                account=_json(os.path.join(run_dir, 'part.json')),
                stops=stages.turned_down(read_csv(checks)) if os.path.exists(checks) else None,
-               tray=tray, max_feed=max_feed)
+               tray=tray, unset=tuple(k for k in FEEDING if k not in spec), max_feed=max_feed)
 
 
 def write(run_dir: str) -> str:

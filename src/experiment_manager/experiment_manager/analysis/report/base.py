@@ -20,8 +20,9 @@ class Run:
     were drawn, by name (plots.py); pictures: {image file: caption} (pictures.py); account:
     the part's account (part_sheet.describe), with its sheet `part.png`; stops: why parts were
     turned down, per experiment (stages.turned_down); tray: the tray the file gave (its walls,
-    feeder zone and hopper lip), None when the file cannot say; max_feed: each feeder run's
-    dose, by experiment id (0: the whole shortfall at once)."""
+    feeder zone and hopper lip), None when the file cannot say; unset: those of its keys the
+    file does not set (`tray`'s values for them are today's defaults); max_feed: each feeder
+    run's dose, by experiment id (0: the whole shortfall at once)."""
     summary: Summary
     part_model: str = PartKeys.model_fields['model'].default
     part_dimensions_mm: dict[str, float] = field(default_factory=dict)
@@ -31,6 +32,7 @@ class Run:
     account: list[str] | None = None
     stops: dict[str, dict[str, int]] | None = None
     tray: ContainerSpec | None = None
+    unset: tuple[str, ...] = ()
     max_feed: dict[str, int] = field(default_factory=dict)
 
     @property

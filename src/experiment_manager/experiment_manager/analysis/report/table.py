@@ -68,7 +68,7 @@ class Feeder(Section):
         lines += table(['', 'iterations', 'parts', 'optimal range', 'emptied',
                         'av. vibrations to empty'], rows)
         if run.tray is not None:
-            lines += ['', feeding(run.tray, run.max_feed.get(exp_id, 0))]
+            lines += ['', feeding(run.tray, run.max_feed.get(exp_id, 0), run.unset)]
         lines += ['', f'Time per vibration the refill interval allows: '
                   f'{fmt(s.minutes_per_vibration_allowed)} min. Parts spilled over the '
                   f'walls: {s.physics.spilled} (in {s.runs_spilling} runs; a run may '
@@ -88,8 +88,14 @@ class Feeder(Section):
         return lines
 
 
-def feeding(tray: ContainerSpec, dose: int) -> str:
-    """How the parts reached the tray, in words, from the file's keys."""
+# the file keys the feeding words give (report.read: those the file does not set)
+FEEDING = ('hopper_lip_mm', 'feeder_zone_mm', 'tray_mm')
+
+
+def feeding(tray: ContainerSpec, dose: int, unset: tuple[str, ...] = ()) -> str:
+    """How the parts reached the tray, in words, from the file's keys; `unset`, those of
+    FEEDING the file does not set, are said to be today's defaults (a run of an older version
+    may have had others: parts arrive from a height since 2026-11-28)."""
     (cx, cy), (sx, sy) = tray.feeder_zone_center, tray.feeder_zone_size
     x, y, z = (1000 * v for v in tray.inner_size)
     return (f'The hopper fed the parts from {fmt(1000 * drop_height(tray))} mm over the plate '
@@ -100,4 +106,9 @@ def feeding(tray: ContainerSpec, dose: int) -> str:
             f'of the {fmt(x)} x {fmt(y)} mm tray with {fmt(z)} mm walls (`tray_mm`), '
             + (f'at most {dose} parts a feed, the fill to max* going on over several '
                'vibrations (`max_feed`).' if dose else
-               'the whole shortfall to max* at once (`max_feed` would dose it).'))
+               'the whole shortfall to max* at once (`max_feed` would dose it).')
+            + (f' The file sets no {", ".join(f"`{k}`" for k in unset)}: '
+               + ("that is today's default" if len(unset) == 1 else
+                  "those are today's defaults")
+               + ', which a run made by an older version may not have had (parts arrive '
+               'from a height since 2026-11-28).' if unset else ''))
