@@ -187,18 +187,22 @@ def _ranges(base: dict, scenarios: list[dict]) -> dict:
 
 
 def _spill_runs(feeder: dict) -> dict:
-    """A feeder_emptying summary's runs, those that spilled, and its two grounds' verdicts."""
+    """A feeder_emptying summary's runs, those that spilled, the parts a run may spill and its
+    two grounds' verdicts."""
     grounds = feeder['decision']
     return {'runs': feeder['iterations'], 'spilling': feeder['runs_spilling'],
-            'spills': grounds['spills']['verdict'], 'time': grounds['time']['verdict']}
+            'limit': feeder['max_spilled'], 'spills': grounds['spills']['verdict'],
+            'time': grounds['time']['verdict']}
 
 
 def _spills_p(here: dict, there: dict, verdict: str) -> float | None:
     """For a table's flip to `verdict` made by its spills (`here` the scenario's _spill_runs,
     `there` the file's: the file's time ground with the scenario's spills gives `verdict`):
     Fisher's exact p (two-sided) that its runs spilling and the file's are one rate; None for
-    a flip its spills do not make."""
-    if here['spills'] == there['spills'] or combined([there['time'], here['spills']]) != verdict:
+    a flip its spills do not make, or where a run may spill parts (requirements.
+    max_spilled_parts above 0: the ground is then parts per refill, not runs that spilled)."""
+    if (there['limit'] or here['spills'] == there['spills']
+            or combined([there['time'], here['spills']]) != verdict):
         return None
     a, b = (here['spilling'], here['runs']), (there['spilling'], there['runs'])
     return float(fisher_exact([[a[0], a[1] - a[0]], [b[0], b[1] - b[0]]]).pvalue)
