@@ -2,13 +2,21 @@
 against the quasi-static prediction and a real drop test's counts, and a sensitivity grid that
 calibrates the materials on those counts; and the file's contact materials as pairs."""
 
+import math
 import os
 
 from experiment_manager import experiment_file
 from experiment_manager.analysis import part_sheet, report
 from experiment_manager.analysis import summary as summary_model
-from experiment_manager.analysis.calibration import calibrate, file_keys, log_likelihood
+from experiment_manager.analysis.calibration import (
+    calibrate,
+    CHI2_HALF,
+    file_keys,
+    log_likelihood,
+    noise,
+)
 from experiment_manager.analysis.headlines import headlines
+from experiment_manager.analysis.report.base import Run
 from experiment_manager.analysis.results import read_csv, ResultsWriter
 from experiment_manager.running.local_backend import LocalBackend
 from experiment_manager.running.scheduler import Runner
@@ -104,6 +112,11 @@ def test_a_sensitivity_grid_over_a_measured_drop_test_calibrates_it(tmp_path):
     printed = headlines(summary_model.validate(summary))
     assert '    calibrated on drop (G-test p' in '\n'.join(printed)
     assert any(line.startswith('          restitution: ') for line in printed)
+    # 30 simulated drops a point: the noise alone reorders points often, and it is said
+    assert fit['noise_sd'] > 0 and 0 < fit['noise_outside'] <= 1
+    assert any(line.startswith("    the simulation's own noise: two points") for line in printed)
+    page = report.markdown(Run(summary_model.validate(summary)))
+    assert "\nThe simulation's own noise: two points of the likeliest's shares" in page
     # the keys pasted into the file give its values and say they were calibrated, and where
     pasted = experiment_file.parse(FILE.replace('experiments:', '\n'.join(fit['keys'])
                                                 + '\nexperiments:'))
@@ -157,6 +170,19 @@ def test_few_simulated_drops_separate_scenarios_less_than_many():
         return (log_likelihood(made, {'a': 0.6 * n, 'b': 0.4 * n})
                 - log_likelihood(made, {'a': 0.45 * n, 'b': 0.55 * n}))
     assert 0 < gap(40) < 0.7 * gap(4000)
+
+
+def test_the_noise_of_a_ranking_is_measured_and_falls_with_more_simulated_drops():
+    # binom4's measured counts against ~400 simulated drops of like shares (docs/drop-tests.md)
+    made = {'a': 4, 'b': 119, 'c': 167, 'd': 104, 'e': 10}
+    few = {'a': 14, 'b': 88, 'c': 183, 'd': 100, 'e': 7}
+    sd = noise(made, few)
+    assert sd == noise(made, dict(few))                 # seeded: the same counts, the same
+    assert sd > CHI2_HALF                               # the interval is the noise's
+    assert noise(made, {k: 16 * v for k, v in few.items()}) < 0.5 * sd
+    outside = calibrate('drop', made, [({'e': 0.1}, few)])['noise_outside']
+    assert outside == pytest.approx(math.erfc(CHI2_HALF / (sd * math.sqrt(2))))
+    assert noise(made, {}) == 0.0
 
 
 def test_a_fitted_drop_height_is_said_beside_the_keys_not_as_one():

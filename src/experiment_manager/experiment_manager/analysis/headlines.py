@@ -1,6 +1,7 @@
 """The headline of each experiment of a run, a line each, as `run` prints them in the terminal
 after the run (the report gives the rest)."""
 
+from .calibration import noise_said
 from .summary import Summary
 from .wording import gripper_label, sampling_end
 
@@ -45,6 +46,8 @@ def headlines(summary: Summary) -> list[str]:
                 lines.append(f'    calibrated on {c.experiment} (G-test p {c.p:.3g} there); '
                              'the file keys, with 95 % intervals:')
                 lines += [f'      {k}' for k in c.keys]
+                if said := noise_said(c.noise_sd, c.noise_outside):
+                    lines.append(f'    {said}')
         else:
             v = s.vibrations_to_empty.mean
             rate = s.parts_per_hour.mean

@@ -249,6 +249,10 @@ class Calibration(_Record):
     p: float
     points: list[Point]
     keys: list[str]
+    # the simulation's noise: SD of a log likelihood difference between two points of one true
+    # shares, and how often it alone puts such a point outside the interval
+    noise_sd: float | None = None
+    noise_outside: float | None = None
 
 
 class Sensitivity(_Experiment):

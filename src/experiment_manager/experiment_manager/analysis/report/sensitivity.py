@@ -2,6 +2,7 @@
 whether each verdict holds over their ranges, the tornado chart, a verdict map over a grid of
 two inputs, and each scenario's answers and verdicts."""
 
+from ..calibration import noise_said
 from ..sensitivity import ANSWERS
 from ..summary import Sensitivity as SensitivitySummary
 from ..wording import count, fmt, table
@@ -72,4 +73,6 @@ def section(exp_id: str, s: SensitivitySummary, plotted: bool) -> list[str]:
                   'scenarios within 1.92 of its log likelihood (no finer than the grid). '
                   'File keys to paste (the interval as a sensitivity range):', '', '```']
         lines += c.keys + ['```']
+        if said := noise_said(c.noise_sd, c.noise_outside):
+            lines += ['', said[0].upper() + said[1:] + '.']
     return lines
