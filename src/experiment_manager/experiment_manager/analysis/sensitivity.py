@@ -204,8 +204,12 @@ def _spills_p(here: dict, there: dict, verdict: str) -> float | None:
     if (there['limit'] or here['spills'] == there['spills']
             or combined([there['time'], here['spills']]) != verdict):
         return None
-    a, b = (here['spilling'], here['runs']), (there['spilling'], there['runs'])
-    return float(fisher_exact([[a[0], a[1] - a[0]], [b[0], b[1] - b[0]]]).pvalue)
+    return _one_rate_p(here['spilling'], here['runs'], there['spilling'], there['runs'])
+
+
+def _one_rate_p(k: int, n: int, j: int, m: int) -> float:
+    """Fisher's exact p (two-sided) that k of n and j of m are draws of one rate."""
+    return float(fisher_exact([[k, n - k], [j, m - j]]).pvalue)
 
 
 def _robustness(exp: Experiment, base: dict, scenarios: list[dict],
@@ -255,12 +259,12 @@ def _drawn(flips: list[dict], spill_runs: dict | None) -> str:
     counts = sorted({(r['spilling'], r['runs']) for r in runs})
     ps = sorted({round(f['spills_p'], 2) for f in drawn})
     # the smallest p any count allows: all runs spilling on one side, none on the other
-    least = max(fisher_exact([[r['runs'], 0], [0, base['runs']]]).pvalue for r in runs)
+    least = max(_one_rate_p(r['runs'], r['runs'], 0, base['runs']) for r in runs)
     return (f'. {len(drawn)} of these flip on their spills, with runs spilling '
             + ', '.join(f'{k} of {n}' for k, n in counts)
             + f" there against {base['spilling']} of {base['runs']} at the file's values, "
             "which so few runs do not tell apart (Fisher's exact p "
-            + ' to '.join(f'{p:.2f}' for p in (ps[0], ps[-1])[:len(ps)])
+            + ' to '.join(f'{p:.2f}' for p in sorted({ps[0], ps[-1]}))
             + (f'; no count of so few runs could: the least p they allow is {least:.2f}'
                if least >= 0.05 else '')
             + "): more runs would tell the draw's from the input's")
