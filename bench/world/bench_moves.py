@@ -19,7 +19,6 @@ from pick_common.parts.spec import PartSpec
 from pick_common.specs import MOVES, SceneSpec
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
-import pybullet as pb
 
 LYING = (0.0, 0.7071068, 0.0, 0.7071068)     # the capacitor's axis along x
 
@@ -31,8 +30,7 @@ def carry(move: str, offset: float) -> tuple[np.ndarray, np.ndarray, float, floa
     with World(scene, PhysicsConfig()) as world:
         ids, _ = world.drop(3, zone='feeder')
         for pid, y in zip(ids, (-0.03, 0.0, 0.03), strict=True):
-            pb.resetBasePositionAndOrientation(world._bodies[pid], [offset, y, 0.004], LYING,
-                                               physicsClientId=world._client)
+            world.engine.set_pose(world.body(pid), [offset, y, 0.004], LYING)
         world.settle()
         before = world.snapshot().poses[:, :2].mean(axis=0)
         report = world.vibrate(MOVES[move])

@@ -26,7 +26,6 @@ from pick_common.errors import InvalidArgument
 from pick_common.states import PartStates
 from pick_sim_world.stepping import speed_limit
 from pick_validity.results import STAGE_VALID
-import pybullet as pb
 import pytest
 from scipy import stats as scipy_stats
 
@@ -248,8 +247,7 @@ class Worker(LocalBackend):
             return super().drop(count, zone)
         world = self._world
         ids, _ = world.drop(count, zone=zone)
-        pb.resetBaseVelocity(world._bodies[ids[0]], [math.nan, 0, 0], [0, 0, 0],
-                             physicsClientId=world._client)
+        world.engine.set_velocity(world.body(ids[0]), [math.nan, 0, 0])
         return world.snapshot(), world.settle()
 
     def start(self, file) -> None:
@@ -384,8 +382,7 @@ def test_parts_fallen_far_from_the_container_are_not_sent_to_the_check():
         backend.reset(container, u.seed)
         states, _ = backend.drop(20, 'container')
         world = backend._world
-        pb.resetBasePositionAndOrientation(world._bodies[int(states.ids[0])], [0, 0, -80.0],
-                                           [0, 0, 0, 1], physicsClientId=world._client)
+        world.engine.set_pose(world.body(int(states.ids[0])), [0, 0, -80.0])
         states = backend.parts()
         iteration = Iteration(file, u, backend)
         report, _ = iteration.check(states, True)
@@ -423,11 +420,9 @@ def test_the_health_of_an_iteration_counts_spilled_tunnelled_and_thrown_parts_ap
         x = file.tray.inner_size[0]
         for pid, where in zip(states.ids[:2].tolist(), ([x, 0.0, 0.05], [0.0, 0.0, -0.05]),
                               strict=True):
-            pb.resetBasePositionAndOrientation(world._bodies[pid], where, [0, 0, 0, 1],
-                                               physicsClientId=world._client)
+            world.engine.set_pose(world.body(pid), where)
         thrown = int(states.ids[2])
-        pb.resetBaseVelocity(world._bodies[thrown], [0.0, 0.0, 4.0], [0.0, 0.0, 0.0],
-                             physicsClientId=world._client)
+        world.engine.set_velocity(world.body(thrown), [0.0, 0.0, 4.0])
         report = world.settle(max_settle_time=0.3)
         iteration.reports += [settle, report]
         health = iteration.health()

@@ -1,12 +1,11 @@
 """Building a PyBullet scene: the engine's settings, the part's collision shape, containers
-(a static bin, or a tray whose motion tray.py prescribes) and part bodies.
+(a static bin, or a tray whose motion tray.py prescribes) and part bodies, and the queries of
+the scene's bodies the world asks.
 
-Every function takes the PyBullet client it works on; the World owns the client.
+Every function takes the Engine (engine.py, SI units) it works on; the World owns it.
 """
 
 from collections.abc import Mapping, Sequence
-import hashlib
-import os
 
 import numpy as np
 from pick_common import containers
@@ -14,12 +13,12 @@ from pick_common.containers import ContainerSpec
 from pick_common.parts.geometry import PartGeometry
 from pick_common.parts.insets import inset_hull
 from pick_common.parts.materials import BodyValues
-from pick_common.parts.primitives import Box, Cylinder
+from pick_common.parts.primitives import box, Hull
 from pick_common.states import quaternion_multiply, rotate
-import pybullet as pb
 import trimesh
 
 from .config import GRAVITY, PhysicsConfig, solver_iterations
+from .engine import Engine
 
 INSTANCE_GAP = 0.05             # m between the outer walls of neighbouring instances
 TRAY_MASS = 3.0                 # kg; the tray is a dynamic body whose motion is prescribed
@@ -35,77 +34,51 @@ def instance_pitch(spec: ContainerSpec) -> float:
     return containers.outer_size(spec)[0] + INSTANCE_GAP
 
 
-def configure(client: int, physics: PhysicsConfig, kind: str) -> None:
+def configure(engine: Engine, physics: PhysicsConfig, kind: str) -> None:
     """Empty the simulation and set gravity and the solver settings for containers of `kind`."""
-    pb.resetSimulation(physicsClientId=client)
-    pb.setGravity(0.0, 0.0, -GRAVITY, physicsClientId=client)
-    pb.setPhysicsEngineParameter(
-        fixedTimeStep=physics.time_step,
-        numSolverIterations=solver_iterations(physics, kind),
-        warmStartingFactor=physics.warm_starting_factor,
-        contactBreakingThreshold=physics.contact_breaking_threshold,
-        deterministicOverlappingPairs=1, physicsClientId=client)
+    engine.reset(GRAVITY, physics.time_step, solver_iterations(physics, kind),
+                 physics.warm_starting_factor, physics.contact_breaking_threshold)
 
 
-def create_part_shape(client: int, part: PartGeometry, directory: str) -> int:
-    """The part's collision compound as one PyBullet shape. Convex hulls are inset (insets:
-    pybullet's margin taken off) and written as OBJ files into `directory` (pybullet takes
-    hull vertices only from a file, one hull each)."""
-    kinds, radii, lengths, halves, files, positions, orientations = [], [], [], [], [], [], []
+def create_part_shape(engine: Engine, part: PartGeometry, directory: str) -> int:
+    """The part's collision compound as one shape, in the frame of its body: a mesh part's
+    mass centre and principal axes (part.mass_frame), a built-in's own frame. So nothing of
+    the file's frame reaches the physics: Bullet's contact-breaking threshold grows with a
+    piece's distance from its body's origin (getAngularMotionDisc), and Bullet's inertia
+    estimate follows the frame's axes. Convex hulls are inset by the engine's hull margin
+    (insets), so that the hull the engine grows by its margin is the part's surface; their
+    file goes into `directory` (Engine.shape)."""
+    margin = engine.hull_margin
+    to_body = np.eye(4)
+    if part.mass_frame is not None:
+        centre, axes = part.mass_frame
+        rotation = trimesh.transformations.quaternion_matrix([axes[3], *axes[:3]])[:3, :3]
+        to_body[:3, :3], to_body[:3, 3] = rotation.T, -rotation.T @ centre
+    pieces = []
     for p in part.primitives:
-        radius = length = 0.0
-        half = [0.0, 0.0, 0.0]
-        path = ''
-        if isinstance(p, Box):
-            kind, half = pb.GEOM_BOX, list(p.half)
-        elif isinstance(p, Cylinder):
-            kind, radius, length = pb.GEOM_CYLINDER, p.radius, p.length
-        else:
-            kind = pb.GEOM_MESH
-            hull = trimesh.convex.convex_hull(inset_hull(p.vertices, p.faces))
-            # named by its content: pybullet keeps a file's mesh by its path for the life of
-            # the process, resets included, so a reused name would bring back an old part
-            digest = hashlib.sha256(hull.vertices.tobytes() + hull.faces.tobytes())
-            path = os.path.join(directory, f'hull_{digest.hexdigest()[:20]}.obj')
-            hull.export(path)
-        kinds.append(kind)
-        radii.append(radius)
-        lengths.append(length)
-        halves.append(half)
-        files.append(path)
-        positions.append(list(p.position))
-        orientations.append(list(p.orientation))
-    return pb.createCollisionShapeArray(
-        kinds, radii=radii, lengths=lengths, halfExtents=halves, fileNames=files,
-        meshScales=[[1.0, 1.0, 1.0]] * len(kinds), collisionFramePositions=positions,
-        collisionFrameOrientations=orientations, physicsClientId=client)
+        if isinstance(p, Hull):
+            hull = trimesh.convex.convex_hull(inset_hull(p.vertices, p.faces, margin))
+            hull.apply_transform(to_body)
+            pieces.append(Hull(np.asarray(hull.vertices, dtype=np.float64),
+                               np.asarray(hull.faces, dtype=np.int64)))
+        else:       # a built-in's box or cylinder, in its own frame (its body's)
+            pieces.append(p)
+    return engine.shape(pieces, directory)
 
 
-def create_container(client: int, spec: ContainerSpec, origin: np.ndarray,
+def create_container(engine: Engine, spec: ContainerSpec, origin: np.ndarray,
                      surface: BodyValues) -> int:
     """The container's body at `origin` (world frame, m): a static bin, or a tray of TRAY_MASS
     whose state tray.TrayDrive prescribes before every step (so parts feel its velocity); its
     coefficients `surface` (materials.body_values: with the part's, the file's pairs)."""
-    boxes = containers.wall_boxes(spec)
-    shape = pb.createCollisionShapeArray(
-        [pb.GEOM_BOX] * len(boxes), halfExtents=[list(h) for h, _ in boxes],
-        collisionFramePositions=[list(p) for _, p in boxes], physicsClientId=client)
+    shape = engine.shape([box(h, p) for h, p in containers.wall_boxes(spec)])
     mass = 0.0 if spec.kind == containers.BIN else TRAY_MASS
-    body = pb.createMultiBody(mass, shape, basePosition=origin.tolist(),
-                              useMaximalCoordinates=True, physicsClientId=client)
-    pb.changeDynamics(body, -1, linearDamping=0.0, angularDamping=0.0,
-                      activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING,
-                      physicsClientId=client, **_coefficients(surface))
+    body = engine.body(mass, shape, origin)
+    engine.set_contact(body, surface, damping=0.0)
     return body
 
 
-def _coefficients(values: BodyValues) -> dict[str, float]:
-    return {'lateralFriction': values.lateral_friction,
-            'rollingFriction': values.rolling_friction,
-            'spinningFriction': values.spinning_friction, 'restitution': values.restitution}
-
-
-def create_part(client: int, shape: int, part: PartGeometry, pose: np.ndarray,
+def create_part(engine: Engine, shape: int, part: PartGeometry, pose: np.ndarray,
                 values: BodyValues) -> int:
     """A part body of `shape` at `pose` (7,) in the world frame, with the part's coefficients
     `values` (materials.body_values).
@@ -115,22 +88,28 @@ def create_part(client: int, shape: int, part: PartGeometry, pose: np.ndarray,
     test isConvex()), and a part is a compound, so a swept sphere changed no pose (tested bit
     for bit, world README "Thrown parts"). Streamed drops keep falls short instead, and the
     world reports parts that tunnel or are thrown."""
-    inertial = {}
-    if part.mass_frame is not None:     # a mesh's own mass centre and principal axes
-        centre, axes = part.mass_frame
-        inertial = {'baseInertialFramePosition': centre.tolist(),
-                    'baseInertialFrameOrientation': axes.tolist()}
-    body = pb.createMultiBody(part.mass, shape, basePosition=pose[:3].tolist(),
-                              baseOrientation=pose[3:].tolist(), useMaximalCoordinates=True,
-                              physicsClientId=client, **inertial)
-    pb.changeDynamics(body, -1, activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING,
-                      physicsClientId=client, **_coefficients(values))
+    base = body_poses(pose[None], part)[0]
+    body = engine.body(part.mass, shape, base[:3], base[3:], part.moments)
+    engine.set_contact(body, values)
     return body
 
 
+def body_poses(poses: np.ndarray, part: PartGeometry) -> np.ndarray:
+    """The poses (N, 7) of the parts' bodies, which are of a mesh part's mass centre's frame
+    (part.mass_frame), from poses of the part's own frame; the same poses for a built-in
+    model. The inverse of part_frame_poses."""
+    if part.mass_frame is None or not len(poses):
+        return poses
+    centre, axes = part.mass_frame
+    out = poses.copy()
+    out[:, :3] = poses[:, :3] + rotate(poses[:, 3:], centre)
+    out[:, 3:] = quaternion_multiply(poses[:, 3:], axes)
+    return out
+
+
 def part_frame_poses(poses: np.ndarray, part: PartGeometry) -> np.ndarray:
-    """The poses (N, 7) of a part's own frame from PyBullet's base poses, which are of its mass
-    centre's frame (part.mass_frame); the same poses for a built-in model."""
+    """The poses (N, 7) of a part's own frame from its bodies' poses (body_poses); the same
+    poses for a built-in model."""
     if part.mass_frame is None or not len(poses):
         return poses
     centre, axes = part.mass_frame
@@ -148,44 +127,24 @@ def part_centres(poses: np.ndarray, part: PartGeometry) -> np.ndarray:
     return poses[:, :3] + rotate(poses[:, 3:], part.center)
 
 
-def base_poses(client: int, bodies: list[int]) -> np.ndarray:
-    """World-frame poses (N, 7) of bodies, xyz + xyzw."""
-    poses = np.empty((len(bodies), 7))
-    for row, body in enumerate(bodies):
-        position, orientation = pb.getBasePositionAndOrientation(body, physicsClientId=client)
-        poses[row, :3] = position
-        poses[row, 3:] = orientation
-    return poses
-
-
-def bodies_near(client: int, body: int, reach: float) -> list[int]:
-    """The bodies whose bounding boxes come within `reach` (m) of `body`'s (itself included)."""
-    low, high = pb.getAABB(body, physicsClientId=client)
-    near = pb.getOverlappingObjects(np.subtract(low, reach).tolist(),
-                                    np.add(high, reach).tolist(), physicsClientId=client)
-    return [b for b, _ in near or ()]
-
-
-def max_penetration(client: int) -> float:
+def max_penetration(engine: Engine) -> float:
     """The deepest overlap of any two bodies in contact now, m (0 when none overlap)."""
-    contacts = pb.getContactPoints(physicsClientId=client)
-    return max(0.0, -min((c[8] for c in contacts), default=0.0))
+    return max(0.0, -min((d for _, _, d in engine.contacts()), default=0.0))
 
 
-def touching(client: int, bodies: Sequence[int]) -> set[int]:
+def touching(engine: Engine, bodies: Sequence[int]) -> set[int]:
     """The bodies that a body of `bodies` touches (is within the contact-breaking threshold
     of), by the contacts of the last step; `bodies` themselves among them only where two of
     them touch."""
     found = set()
     for body in bodies:
-        found.update(contact[2] for contact in pb.getContactPoints(bodyA=body,
-                                                                   physicsClientId=client))
+        found.update(other for _, other, _ in engine.contacts(body))
     return found
 
 
-def parts_touching(client: int, bodies_of: Mapping[int, int], ids: list[int]) -> set[int]:
+def parts_touching(engine: Engine, bodies_of: Mapping[int, int], ids: list[int]) -> set[int]:
     """The parts not in `ids` that a part of `ids` touches (touching); `bodies_of`: part id ->
     body."""
     part_of = {body: pid for pid, body in bodies_of.items() if pid not in ids}
-    touched = touching(client, [bodies_of[pid] for pid in ids])
+    touched = touching(engine, [bodies_of[pid] for pid in ids])
     return {part_of[b] for b in touched if b in part_of}

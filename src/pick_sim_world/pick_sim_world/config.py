@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 from pick_common import containers
 from pick_common.errors import InvalidArgument, Limit
+from pick_common.parts.insets import ENGINE_UNIT
 
 GRAVITY = 9.81                  # m/s^2, standard gravity
 
@@ -19,6 +20,7 @@ LIMITS = {
     'physics.tray_solver_iterations': Limit(1, 500, integer=True),
     'physics.warm_starting_factor': Limit(0.0, 1.0),
     'physics.contact_breaking_threshold': Limit(1e-5, 0.1),
+    'physics.length_unit': Limit(1e-3, 1.0),
     'settle.check_period': Limit(1e-5, 1.0),         # and at least physics.time_step
     'settle.window': Limit(1e-5, 10.0),              # and at least settle.check_period
     'settle.linear_tolerance': Limit(0.0, 0.1, low_open=True),
@@ -50,8 +52,16 @@ class PhysicsConfig:
     the solver throws parts: a TO-220 lying still gained 3.6 m/s and 494 rad/s in one step,
     which the same state solved from a warm start of 0 did not; bench_throws.py counts the parts
     thrown and off the tray per setting (600 moves: 5 off the tray at 1, none at 0.85).
-    contact_breaking_threshold: m (Bullet's default 0.02 m suits metre-sized bodies; for mm
-    parts 0.001 m cuts the contact count).
+    contact_breaking_threshold: how near two shapes keep a contact, as a factor of each shape's
+    bounding radius (Bullet's relative threshold, engine.py: at 0.001 a 10 mm cube reports the
+    floor within 0.009 mm of its surface, in metres and in centimetres alike). 0.02, Bullet's
+    own (gContactBreakingThreshold): in centimetres at 0.001 and 0.002 a lying 6 mm cylinder
+    kept one contact point and sank 0.36 mm into the floor, creeping at 0.8 to 3.9 mm/s, where
+    at 0.005 to 0.02 it kept two and rested 0.2 to 0.4 um deep (0.001 served in metres, where
+    every hull's 1 mm margin held its contacts).
+    length_unit: m per length unit of the engine: 0.01, centimetres, where parts of 0.5 to 100
+    mm measure Bullet's 0.05 to 10 units and pybullet's fixed hull margin is 0.01 mm (in
+    metres, 1 mm: a fifth of a 5 mm part; engine.py). 1 simulates in metres, for comparisons.
     settle_*: a part rests when over the last `settle_window` s its position changed by at most
     `settle_linear_tolerance` m and its orientation by at most `settle_angular_tolerance` rad;
     the scene is settled when at most `settle_moving_fraction` of its parts (rounded down) do
@@ -67,7 +77,8 @@ class PhysicsConfig:
     solver_iterations: int = 100
     tray_solver_iterations: int = 50
     warm_starting_factor: float = 0.85
-    contact_breaking_threshold: float = 0.001
+    contact_breaking_threshold: float = 0.02
+    length_unit: float = ENGINE_UNIT
     settle_check_period: float = 0.05
     settle_window: float = 0.2
     settle_linear_tolerance: float = 0.0005
@@ -92,6 +103,7 @@ def check_physics(cfg: PhysicsConfig) -> PhysicsConfig:
     check('physics.tray_solver_iterations', cfg.tray_solver_iterations)
     check('physics.warm_starting_factor', cfg.warm_starting_factor)
     check('physics.contact_breaking_threshold', cfg.contact_breaking_threshold)
+    check('physics.length_unit', cfg.length_unit)
     check('settle.check_period', cfg.settle_check_period, cfg.time_step)
     check('settle.window', cfg.settle_window, cfg.settle_check_period)
     check('settle.linear_tolerance', cfg.settle_linear_tolerance)

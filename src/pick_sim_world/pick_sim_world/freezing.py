@@ -20,9 +20,8 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 from pick_common.states import quaternion_angles
-import pybullet as pb
 
-from .bodies import bodies_near
+from .engine import Engine, Mass
 
 
 class Freezer:
@@ -31,36 +30,29 @@ class Freezer:
     leaving it thaws every part and restores the trays, whatever happened inside. Parts enter
     it as `check` first sees them, so a drop's stream can add them layer by layer."""
 
-    def __init__(self, client: int, trays: Sequence[int], linear_tolerance: float,
+    def __init__(self, engine: Engine, trays: Sequence[int], linear_tolerance: float,
                  angular_tolerance: float, window: float) -> None:
-        self._client = client
+        self._engine = engine
         self._trays = list(trays)
         self._linear, self._angular, self._window = linear_tolerance, angular_tolerance, window
         self.frozen: set[int] = set()               # bodies
         self._anchor: dict[int, np.ndarray] = {}    # body -> the pose it has stayed near
         self._since: dict[int, float] = {}          # body -> time it has stayed near it, s
         self._last: dict[int, np.ndarray] = {}      # body -> its pose at the last check
-        self._part_mass: tuple[float, list[float]] | None = None
-        self._tray_mass: tuple[float, list[float]] | None = None
-
-    def _mass(self, body: int) -> tuple[float, list[float]]:
-        info = pb.getDynamicsInfo(body, -1, physicsClientId=self._client)
-        return info[0], list(info[2])
+        self._part_mass: Mass | None = None
+        self._tray_mass: Mass | None = None
 
     def __enter__(self) -> 'Freezer':
         if self._trays:
-            self._tray_mass = self._mass(self._trays[0])
+            self._tray_mass = self._engine.mass(self._trays[0])
             for tray in self._trays:
-                pb.changeDynamics(tray, -1, mass=0.0, physicsClientId=self._client)
+                self._engine.set_mass(tray, None)
         return self
 
     def __exit__(self, *exc) -> None:
         self.thaw(list(self.frozen))
-        if self._trays:
-            mass, inertia = self._tray_mass
-            for tray in self._trays:
-                pb.changeDynamics(tray, -1, mass=mass, localInertiaDiagonal=inertia,
-                                  physicsClientId=self._client)
+        for tray in self._trays:
+            self._engine.set_mass(tray, self._tray_mass)
 
     def abandon(self) -> None:
         """Forget every body: the scene they were in is gone (rebuilt after a fault)."""
@@ -68,34 +60,28 @@ class Freezer:
 
     def freeze(self, bodies: Iterable[int]) -> None:
         """Make `bodies` static and asleep, at rest."""
-        c = self._client
+        e = self._engine
         for body in bodies:
             if body in self.frozen:
                 continue
             if self._part_mass is None:
-                self._part_mass = self._mass(body)
-            pb.resetBaseVelocity(body, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), physicsClientId=c)
-            pb.changeDynamics(body, -1, mass=0.0, physicsClientId=c)
-            pb.changeDynamics(body, -1, activationState=pb.ACTIVATION_STATE_SLEEP,
-                              physicsClientId=c)
+                self._part_mass = e.mass(body)
+            e.set_velocity(body, (0.0, 0.0, 0.0))
+            e.set_mass(body, None)
+            e.sleep(body)
             self.frozen.add(body)
 
     def thaw(self, bodies: Iterable[int]) -> None:
         """Give frozen `bodies` their mass and inertia back, at rest and with sleeping
         disabled again (as bodies.create_part makes them); they must rest a whole window
         before they freeze again."""
-        c = self._client
+        e = self._engine
         for body in bodies:
             if body not in self.frozen:
                 continue
-            mass, inertia = self._part_mass
-            pb.changeDynamics(body, -1, mass=mass, localInertiaDiagonal=inertia,
-                              physicsClientId=c)
-            pb.resetBaseVelocity(body, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), physicsClientId=c)
-            pb.changeDynamics(body, -1, activationState=pb.ACTIVATION_STATE_WAKE_UP,
-                              physicsClientId=c)
-            pb.changeDynamics(body, -1, activationState=pb.ACTIVATION_STATE_DISABLE_SLEEPING,
-                              physicsClientId=c)
+            e.set_mass(body, self._part_mass)
+            e.set_velocity(body, (0.0, 0.0, 0.0))
+            e.wake(body)
             self.frozen.discard(body)
             self._since.pop(body, None)      # anchored afresh at the next check
 
@@ -119,12 +105,12 @@ class Freezer:
         stayed near their anchor pose for a window."""
         if not len(bodies):
             return
-        c = self._client
         if self.frozen:
             woken = set()
             movers, shift = self.movers(bodies, poses)
             for i in np.flatnonzero(movers):
-                woken.update(b for b in bodies_near(c, bodies[i], shift[i]) if b in self.frozen)
+                woken.update(b for b in self._engine.near(bodies[i], shift[i])
+                             if b in self.frozen)
             self.thaw(woken)
         frozen = np.array([b in self.frozen for b in bodies], dtype=bool)
         anchor = np.array([self._anchor.get(b, p) for b, p in zip(bodies, poses, strict=True)])

@@ -1,7 +1,7 @@
 """The physics health of an operation (a drop, a vibration, a removal, a settle), told once at
 its end: where the parts ended (outside their containers; tunnelled: a centre in or under the
 floor or in a wall), the deepest penetration, the fastest part and the parts thrown faster than
-the speed a fall and a tray's bounce can give (stepping.speed_limit). Pure core: PyBullet's
+the speed a fall and a tray's bounce can give (stepping.speed_limit). Pure core: the engine's
 contact query, numpy; no rclpy."""
 
 from collections.abc import Sequence
@@ -12,9 +12,10 @@ from pick_common.parts.geometry import PartGeometry
 from pick_common.states import PartStates, SettleReport
 
 from . import bodies, stepping
+from .engine import Engine
 
 
-def finished(last: SettleReport, before: Sequence[SettleReport], client: int,
+def finished(last: SettleReport, before: Sequence[SettleReport], engine: Engine,
              container: ContainerSpec, part: PartGeometry, state: PartStates,
              peaks: dict[int, float], tray_speed: float) -> SettleReport:
     """`last` (how the operation ended) with the times and steps of its earlier runs `before`
@@ -29,7 +30,7 @@ def finished(last: SettleReport, before: Sequence[SettleReport], client: int,
     if len(state.ids):
         gone = containers.tunnelled(container, bodies.part_centres(state.poses, part))
         last.tunnelled_ids = [int(i) for i in state.ids[gone]]
-    last.max_penetration = bodies.max_penetration(client)
+    last.max_penetration = bodies.max_penetration(engine)
     limit = stepping.speed_limit(container, part, tray_speed)
     last.max_speed = max(peaks.values(), default=0.0)
     last.thrown_ids = sorted(pid for pid, v in peaks.items() if v > limit)

@@ -19,10 +19,9 @@ from pick_common.containers import ContainerSpec
 from pick_common.errors import PhysicsFault
 from pick_common.parts.geometry import PartGeometry
 from pick_common.states import Progress, quaternion_angles
-import pybullet as pb
 
-from .bodies import base_poses
 from .config import GRAVITY, PhysicsConfig
+from .engine import Engine
 from .freezing import Freezer
 
 ProgressCallback = Callable[[Progress], bool]
@@ -56,7 +55,7 @@ class Outcome:
     peak_speeds: list[float]
 
 
-def raise_peak_speeds(client: int, bodies: Sequence[int], floor: float,
+def raise_peak_speeds(engine: Engine, bodies: Sequence[int], floor: float,
                       peaks: list[float], indices: Sequence[int]) -> None:
     """Raise peaks[i] to body i's linear speed (m/s, of its centre of mass) where that is
     higher and the body's origin is at or above `floor` (world z, m), for each i of `indices`
@@ -65,13 +64,12 @@ def raise_peak_speeds(client: int, bodies: Sequence[int], floor: float,
     raise the peak, which most steps' speeds do not."""
     for i in indices:
         b = bodies[i]
-        speed = math.hypot(*pb.getBaseVelocity(b, physicsClientId=client)[0])
-        if speed > peaks[i] and \
-                pb.getBasePositionAndOrientation(b, physicsClientId=client)[0][2] >= floor:
+        speed = engine.speed(b)
+        if speed > peaks[i] and engine.position(b)[2] >= floor:
             peaks[i] = speed
 
 
-def step(client: int, ids: Sequence[int], bodies: Sequence[int], cfg: PhysicsConfig,
+def step(engine: Engine, ids: Sequence[int], bodies: Sequence[int], cfg: PhysicsConfig,
          phase: str, duration: float, progress: ProgressCallback | None,
          before_step: Callable[[], None] | None = None,
          stop_when_settled: bool = True, floor: float = 0.0,
@@ -89,7 +87,7 @@ def step(client: int, ids: Sequence[int], bodies: Sequence[int], cfg: PhysicsCon
     bodies = list(bodies)
     tolerated = int(cfg.settle_moving_fraction * len(ids))
     history: deque[np.ndarray] = deque(maxlen=window + 1)
-    history.append(base_poses(client, bodies))
+    history.append(engine.poses(bodies))
     awake = range(len(bodies))     # indices of the bodies not frozen
     if freezer is not None:
         freezer.check(bodies, history[0], 0.0)     # where the parts start from
@@ -103,10 +101,10 @@ def step(client: int, ids: Sequence[int], bodies: Sequence[int], cfg: PhysicsCon
         for _ in range(min(per_check, total_steps - steps)):
             if before_step is not None:
                 before_step()
-            pb.stepSimulation(physicsClientId=client)
+            engine.step()
             steps += 1
-            raise_peak_speeds(client, bodies, floor, peaks, awake)
-        poses = base_poses(client, bodies)
+            raise_peak_speeds(engine, bodies, floor, peaks, awake)
+        poses = engine.poses(bodies)
         if not np.isfinite(poses).all():
             bad = [ids[i] for i in np.flatnonzero(~np.isfinite(poses).all(axis=1))]
             raise PhysicsFault(f'parts {bad[:10]} got non-finite poses after '

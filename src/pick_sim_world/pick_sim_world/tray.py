@@ -15,9 +15,9 @@ import math
 import numpy as np
 from pick_common.specs import CENTRE, RANDOM, Vibration
 from pick_common.states import TrayMotion
-import pybullet as pb
 
 from .config import GRAVITY
+from .engine import Engine
 
 MIN_STEPS_PER_CYCLE = 8     # physics steps per vibration period; fewer and the world sub-steps
 
@@ -97,9 +97,9 @@ class TrayDrive:
     call it before every physics step. `start` begins a vibration of some trays, `stop` ends it
     and returns the motion they delivered, measured from their states after each step."""
 
-    def __init__(self, client: int, bodies: Sequence[int], origins: Sequence[np.ndarray],
+    def __init__(self, engine: Engine, bodies: Sequence[int], origins: Sequence[np.ndarray],
                  mass: float) -> None:
-        self._client = client
+        self._engine = engine
         self._bodies = list(bodies)
         self._origins = [np.asarray(o, dtype=float) for o in origins]
         self._lift = [0.0, 0.0, mass * GRAVITY]
@@ -133,10 +133,8 @@ class TrayDrive:
     def _measure(self) -> None:
         positions, velocities = [], []
         for k in self._moving:
-            p, _ = pb.getBasePositionAndOrientation(self._bodies[k], physicsClientId=self._client)
-            v, _ = pb.getBaseVelocity(self._bodies[k], physicsClientId=self._client)
-            positions.append(np.subtract(p, self._origins[k]))
-            velocities.append(v)
+            positions.append(self._engine.position(self._bodies[k]) - self._origins[k])
+            velocities.append(self._engine.velocity(self._bodies[k])[0])
         self._positions.append(np.array(positions))
         self._velocities.append(np.array(velocities))
 
@@ -149,14 +147,11 @@ class TrayDrive:
             self._step += 1
         else:
             here = velocity = self._amplitudes      # zeros: held at the origins
+        engine = self._engine
         for k, body in enumerate(self._bodies):
-            pb.resetBasePositionAndOrientation(body, (self._origins[k] + here[k]).tolist(),
-                                               (0.0, 0.0, 0.0, 1.0),
-                                               physicsClientId=self._client)
-            pb.resetBaseVelocity(body, velocity[k].tolist(), (0.0, 0.0, 0.0),
-                                 physicsClientId=self._client)
-            pb.applyExternalForce(body, -1, self._lift, (0.0, 0.0, 0.0), pb.LINK_FRAME,
-                                  physicsClientId=self._client)
+            engine.set_pose(body, (self._origins[k] + here[k]).tolist())
+            engine.set_velocity(body, velocity[k].tolist())
+            engine.push(body, self._lift)
 
     def motion(self) -> TrayMotion | None:
         """The motion delivered so far, of the tray that tracked its command worst (over its own

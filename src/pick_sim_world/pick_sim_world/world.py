@@ -2,8 +2,9 @@
 with its own container, parts and random generator (the paper's "demo instances", figure 10).
 It drops and feeds parts, vibrates trays, removes parts, and settles.
 
-Pure core: PyBullet (DIRECT mode), numpy and trimesh; no rclpy. `World` keeps the scene's
-state and delegates: bodies.py builds the scene, selection.py checks what a request names,
+Pure core: PyBullet (DIRECT mode, through engine.py, which simulates in centimetres and
+speaks SI), numpy and trimesh; no rclpy. `World` keeps the scene's state and delegates:
+bodies.py builds the scene, selection.py checks what a request names,
 spawning.py places new parts, tray.py moves the trays, stepping.py steps until the parts rest,
 health.py tells how an operation ended, camera.py takes pictures.
 
@@ -26,11 +27,11 @@ from pick_common.parts.geometry import build_part, PartGeometry
 from pick_common.parts.materials import body_values
 from pick_common.specs import CENTRE, check_scene, check_vibration, SceneSpec, Vibration
 from pick_common.states import PartStates, Progress, SettleReport
-import pybullet as pb
 
 from . import bodies, camera, health, selection, spawning, stepping
 from .camera import Overlay
 from .config import check_physics, PhysicsConfig
+from .engine import Engine
 from .freezing import Freezer
 from .stepping import ProgressCallback
 from .tray import TrayDrive, vibration_plan
@@ -54,7 +55,7 @@ class World:
     def __init__(self, scene: SceneSpec | None = None,
                  physics: PhysicsConfig | None = None) -> None:
         self._physics = check_physics(physics or PhysicsConfig())
-        self._client = pb.connect(pb.DIRECT)
+        self._engine = Engine(self._physics.length_unit)
         self._tmp = tempfile.mkdtemp(prefix='pick_sim_world_')
         self._instances: list[Instance] = []
         self._bodies: dict[int, int] = {}        # part id -> body
@@ -75,6 +76,15 @@ class World:
     @property
     def physics(self) -> PhysicsConfig:
         return self._physics
+
+    @property
+    def engine(self) -> Engine:
+        """The engine the world steps (engine.py): its bodies' states in SI units."""
+        return self._engine
+
+    def body(self, part_id: int) -> int:
+        """The engine's body of a part. Raises UnknownPart for an id not in the scene."""
+        return self._bodies[selection.part_ids([part_id], self._bodies)[0]]
 
     @property
     def part(self) -> PartGeometry:
@@ -103,7 +113,7 @@ class World:
         self._build(scene, part)
 
     def _build(self, scene: SceneSpec, part: PartGeometry) -> None:
-        c = self._client
+        c = self._engine
         bodies.configure(c, self._physics, scene.container.kind)
         self._scene, self._part = scene, part
         self._instances, self._bodies, self._owner = [], {}, {}
@@ -129,19 +139,14 @@ class World:
 
     def close(self) -> None:
         """Disconnect from PyBullet and remove temporary files. Idempotent."""
-        if self._client is not None and self._client >= 0:
-            try:
-                pb.disconnect(physicsClientId=self._client)
-            except pb.error:
-                pass
-            self._client = None
+        self._engine.close()
         shutil.rmtree(self._tmp, ignore_errors=True)
 
     def render(self, width: int, height: int, distance: float, yaw: float = 30.0,
                pitch: float = -60.0, target: Sequence[float] = (0.0, 0.0, 0.0),
                overlays: Sequence[Overlay] = ()) -> np.ndarray:
         """A picture of the world (camera.render): (height, width, 3) uint8 RGB."""
-        return camera.render(self._client, width, height, distance, yaw, pitch, target,
+        return camera.render(self._engine, width, height, distance, yaw, pitch, target,
                              overlays)
 
     def __enter__(self) -> 'World':
@@ -159,7 +164,7 @@ class World:
         wanted = self._instance_ids(instances)
         ids = [pid for k in wanted for pid in self._instances[k].part_ids]
         owners = np.array([self._owner[i] for i in ids], dtype=np.int64)
-        base = bodies.base_poses(self._client, [self._bodies[i] for i in ids])
+        base = self._engine.poses([self._bodies[i] for i in ids])
         if len(ids):
             base[:, :3] -= np.array([self._instances[k].origin for k in owners])
         inside = np.zeros(len(ids), dtype=bool)
@@ -237,7 +242,7 @@ class World:
         self._at_rest = False
         for pose in poses:
             world_pose = np.concatenate([pose[:3] + inst.origin, pose[3:]])
-            body = bodies.create_part(self._client, self._part_shape, self._part, world_pose,
+            body = bodies.create_part(self._engine, self._part_shape, self._part, world_pose,
                                       self._part_values)
             pid = self._next_id
             self._next_id += 1
@@ -302,13 +307,13 @@ class World:
         within the contact-breaking threshold): lifting such a part out moves nothing else.
         """
         ids = selection.part_ids(part_ids, self._bodies)
-        touching = bodies.parts_touching(self._client, self._bodies, ids)
+        touching = bodies.parts_touching(self._engine, self._bodies, ids)
         # From a scene at rest, only the parts the removed ones touched settle at first: no
         # other part felt a force change. The rest start frozen, and wake when a moving part
         # comes near (freezing.py).
         local = self._at_rest and self._physics.settle_freeze
         for pid in ids:
-            pb.removeBody(self._bodies.pop(pid), physicsClientId=self._client)
+            self._engine.remove(self._bodies.pop(pid))
             self._instances[self._owner.pop(pid)].part_ids.remove(pid)
         if settle and (touching or not self._at_rest):
             asleep = [b for p, b in self._bodies.items() if p not in touching] if local else []
@@ -354,13 +359,13 @@ class World:
         if not p.settle_freeze:
             return nullcontext()
         trays = [inst.body for inst in self._instances] if self._drive is not None else []
-        return Freezer(self._client, trays, p.settle_linear_tolerance,
+        return Freezer(self._engine, trays, p.settle_linear_tolerance,
                        p.settle_angular_tolerance, p.settle_window)
 
     def _finished(self, last: SettleReport, before: Sequence[SettleReport] = ()) -> SettleReport:
         """The report of a whole operation, once, at its end (health.finished), with the
         operation's peak speeds: they start again from zero."""
-        report = health.finished(last, before, self._client, self._scene.container, self._part,
+        report = health.finished(last, before, self._engine, self._scene.container, self._part,
                                  self.snapshot(), self._peaks, self._tray_speed)
         self._peaks, self._tray_speed = {}, 0.0
         return report
@@ -376,8 +381,8 @@ class World:
         physics = self._physics
         if time_step is not None and time_step != physics.time_step:
             physics = replace(physics, time_step=time_step)
-        c = self._client
-        pb.setPhysicsEngineParameter(fixedTimeStep=physics.time_step, physicsClientId=c)
+        c = self._engine
+        c.set_time_step(physics.time_step)
         try:
             out = stepping.step(c, ids, [self._bodies[i] for i in ids], physics, phase,
                                 duration, progress, self._drive, stop_when_settled,
@@ -388,8 +393,7 @@ class World:
             self._build(self._scene, self._part)
             raise
         finally:
-            pb.setPhysicsEngineParameter(fixedTimeStep=self._physics.time_step,
-                                         physicsClientId=c)
+            c.set_time_step(self._physics.time_step)
         self._sim_time += out.steps * physics.time_step
         self._at_rest = out.settled
         for pid, speed in zip(ids, out.peak_speeds, strict=True):

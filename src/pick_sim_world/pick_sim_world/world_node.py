@@ -168,7 +168,12 @@ class WorldNode(Node):
                                          "share of the last step's contact impulses the "
                                          'solver starts from'),
             contact_breaking_threshold=setting('physics.contact_breaking_threshold',
-                                               cfg.contact_breaking_threshold, 'm'),
+                                               cfg.contact_breaking_threshold,
+                                               "contact distance, a factor of each shape's "
+                                               'bounding radius'),
+            length_unit=setting('physics.length_unit', cfg.length_unit,
+                                "m per length unit the engine simulates in (0.01: cm, Bullet's "
+                                'scale for small parts)'),
             settle_check_period=setting('settle.check_period', cfg.settle_check_period,
                                         'simulated s between rest checks'),
             settle_window=setting('settle.window', cfg.settle_window,

@@ -13,7 +13,6 @@ from pick_common.parts.spec import PartSpec
 from pick_common.specs import MOVES, SceneSpec
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
-import pybullet as pb
 import pytest
 
 ARM = PartSpec().part_on_surface.rolling_friction
@@ -22,8 +21,7 @@ FLAT = (np.sin(np.pi / 4), 0.0, 0.0, np.cos(np.pi / 4))    # its back (-Y) down
 
 
 def _masses(world: World) -> set[float]:
-    return {pb.getDynamicsInfo(world._bodies[pid], -1, physicsClientId=world._client)[0]
-            for pid in world.snapshot().ids.tolist()}
+    return {world.engine.mass(world.body(pid)).kg for pid in world.snapshot().ids.tolist()}
 
 
 @pytest.mark.parametrize('freeze', [True, False], ids=['freeze', 'no-freeze'])
@@ -78,7 +76,7 @@ def test_the_tray_is_dynamic_again_after_a_settle_and_vibrates_as_commanded():
         tray = world.instances[0].body
         for _ in range(2):
             report = world.vibrate(MOVES['spread'])
-            assert pb.getDynamicsInfo(tray, -1, physicsClientId=world._client)[0] > 0
+            assert world.engine.mass(tray).kg > 0
             assert report.tray.error < 0.05
         assert _masses(world) == {world.part.mass}
 

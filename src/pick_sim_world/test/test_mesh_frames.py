@@ -14,7 +14,6 @@ from pick_common.specs import SceneSpec
 from pick_common.states import rotate
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
-import pybullet as pb
 import pytest
 import trimesh
 
@@ -51,10 +50,10 @@ def test_the_world_puts_the_mass_where_the_material_is(tmp_path):
     with World(SceneSpec(ContainerSpec.tray(), spec, 1, 0), PhysicsConfig()) as world:
         world.drop(1)
         state = world.snapshot()
-        body = world._bodies[int(state.ids[0])]
+        body = world.body(int(state.ids[0]))
         # PyBullet's base pose is the mass centre's (with maximal coordinates its
         # getDynamicsInfo reports no usable inertial frame: the base pose is the check)
-        base, _ = pb.getBasePositionAndOrientation(body, physicsClientId=world._client)
+        base = world.engine.position(body)
         origin = world.instances[0].origin
     # the snapshot is of the file's frame: the box's centre, where the pose puts it, is the
     # body's mass centre, resting in the tray

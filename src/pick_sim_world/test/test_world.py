@@ -19,7 +19,6 @@ from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.stepping import speed_limit
 from pick_sim_world.tray import centring_share, vibration_amplitude
 from pick_sim_world.world import World
-import pybullet as pb
 import pytest
 import trimesh
 
@@ -68,9 +67,7 @@ def test_spawn_poses_do_not_overlap_and_respect_the_region():
         part = world.part
         for zone in ('container', 'feeder'):
             poses = world.spawn_poses(0, 60, zone)
-            centres = poses[:, :3] + np.array([
-                pb.multiplyTransforms([0, 0, 0], q, part.center.tolist(), [0, 0, 0, 1])[0]
-                for q in poses[:, 3:]])
+            centres = poses[:, :3] + rotate(poses[:, 3:], part.center)
             gaps = np.linalg.norm(centres[:, None] - centres[None], axis=2)
             np.fill_diagonal(gaps, np.inf)
             assert gaps.min() >= 2 * part.radius - 1e-9
@@ -96,7 +93,7 @@ def test_vibration_scatters_and_turns_parts_and_the_tray_returns_home():
                                          duration=1.0))
         after = world.snapshot()
         tray = world.instances[0]
-        home, _ = pb.getBasePositionAndOrientation(tray.body, physicsClientId=world._client)
+        home = world.engine.position(tray.body)
     moved = np.linalg.norm(after.poses[:, :3] - before.poses[:, :3], axis=1)
     turned = quaternion_angles(after.poses[:, 3:], before.poses[:, 3:])
     assert report.settled and report.escaped_ids == []
@@ -121,9 +118,7 @@ def test_the_tray_delivers_its_commanded_motion_at_any_time_step(time_step):
 
         def sample(p):
             if p.phase == 'vibrating':
-                at, _ = pb.getBasePositionAndOrientation(tray.body,
-                                                         physicsClientId=world._client)
-                shift = np.subtract(at, tray.origin)
+                shift = world.engine.position(tray.body) - tray.origin
                 gaps.append(np.linalg.norm(shift - peak * math.sin(omega * p.sim_time)))
                 reached.append(np.linalg.norm(shift))
             return True
@@ -150,13 +145,10 @@ def test_a_full_feed_leaves_no_part_in_or_under_the_floor(seed):
 def test_a_spilled_and_a_tunnelled_part_are_told_apart():
     with _world(ContainerSpec.tray()) as world:
         ids, _ = world.drop(6)
-        c = world._client
         x, y, _ = world.scene.container.inner_size
         # One part under the floor (inside the footprint), one beside the tray, over a wall.
-        pb.resetBasePositionAndOrientation(world._bodies[ids[0]], [0.0, 0.0, -0.05],
-                                           [0, 0, 0, 1], physicsClientId=c)
-        pb.resetBasePositionAndOrientation(world._bodies[ids[1]], [x, 0.0, 0.05],
-                                           [0, 0, 0, 1], physicsClientId=c)
+        world.engine.set_pose(world.body(ids[0]), [0.0, 0.0, -0.05])
+        world.engine.set_pose(world.body(ids[1]), [x, 0.0, 0.05])
         report = world.settle(max_settle_time=0.3)
     assert report.tunnelled_ids == [ids[0]] and report.spilled_ids == [ids[1]]
     assert sorted(report.escaped_ids) == sorted(ids[:2])
@@ -190,9 +182,9 @@ def test_the_solver_throws_no_part_off_a_vibrating_tray():
                          ids=['bin', 'tray'])
 def test_the_solver_runs_the_iterations_of_its_container(container, wanted):
     with _world(container, solver_iterations=70, tray_solver_iterations=40) as world:
-        used = pb.getPhysicsEngineParameters(physicsClientId=world._client)
+        used = world.engine.parameters()
         world.reset()       # a rebuild configures the solver again
-        again = pb.getPhysicsEngineParameters(physicsClientId=world._client)
+        again = world.engine.parameters()
     assert used['numSolverIterations'] == again['numSolverIterations'] == wanted
 
 
@@ -263,9 +255,8 @@ def test_a_rolling_capacitor_rolls_on_and_stops_before_the_wall():
         heading /= np.linalg.norm(heading)
         radius = BUILTIN_MODELS['radial_capacitor'][0]['body_diameter'] / 2
         velocity = 0.1 * heading
-        pb.resetBaseVelocity(world._bodies[pid], velocity.tolist(),
-                             (np.cross([0.0, 0.0, 1.0], velocity) / radius).tolist(),
-                             physicsClientId=world._client)
+        world.engine.set_velocity(world.body(pid), velocity,
+                                  np.cross([0.0, 0.0, 1.0], velocity) / radius)
         report = world.settle(max_settle_time=4.0)
         end = world.snapshot().poses[0]
     travelled = np.linalg.norm(end[:2] - start[:2])
@@ -275,8 +266,7 @@ def test_a_rolling_capacitor_rolls_on_and_stops_before_the_wall():
 def test_a_part_thrown_faster_than_gravity_and_the_tray_allow_is_a_fault():
     with _world(ContainerSpec.tray()) as world:
         ids, _ = world.drop(6)
-        pb.resetBaseVelocity(world._bodies[ids[0]], [0.0, 0.0, 3.0], [0.0, 0.0, 0.0],
-                             physicsClientId=world._client)
+        world.engine.set_velocity(world.body(ids[0]), [0.0, 0.0, 3.0])
         report = world.settle(max_settle_time=0.2)
     assert report.thrown_ids == [ids[0]] and report.max_speed == pytest.approx(3.0, abs=0.05)
     assert report.escaped_ids == [ids[0]] and report.spilled_ids == []
@@ -329,9 +319,9 @@ def test_centring_carries_parts_off_centre_toward_the_middle_where_a_flip_does_n
         with _world(ContainerSpec.tray(), seed=3, instances=instances) as world:
             ids, _ = world.drop(3, instances=[0], zone='feeder')
             for pid, y in zip(ids, (-0.03, 0.0, 0.03), strict=True):
-                pb.resetBasePositionAndOrientation(
-                    world._bodies[pid], np.add(world.instances[0].origin, [0.05, y, 0.004]),
-                    [0.0, 0.7071068, 0.0, 0.7071068], physicsClientId=world._client)
+                world.engine.set_pose(
+                    world.body(pid), np.add(world.instances[0].origin, [0.05, y, 0.004]),
+                    [0.0, 0.7071068, 0.0, 0.7071068])
             world.settle()
             before = world.snapshot([0]).poses[:, 0].mean()
             report = world.vibrate(move)
@@ -362,8 +352,7 @@ def _tipped(vibration: Vibration, seed: int, shakes: int = 10) -> bool:
     """Stand a capacitor on the end of its body, leads up, mid-tray; vibrate; has it tipped?"""
     with _world(ContainerSpec.tray(), seed=seed) as world:
         (pid,), _ = world.drop(1)
-        pb.resetBasePositionAndOrientation(world._bodies[pid], [0.0, 0.0, 0.0056],
-                                           [1.0, 0.0, 0.0, 0.0], physicsClientId=world._client)
+        world.engine.set_pose(world.body(pid), [0.0, 0.0, 0.0056], [1.0, 0.0, 0.0, 0.0])
         world.settle()
         for _ in range(shakes):
             world.vibrate(vibration)
@@ -416,10 +405,10 @@ def _lone_and_piled(world: World) -> tuple[list[int], list[int]]:
     the world reads). Not 0.5 mm: a part 0.36 mm from its neighbour touches nothing, and lifting
     it out moves nothing (a scene that once did)."""
     ids = world.snapshot().ids.tolist()
-    bodies = [world._bodies[i] for i in ids]
+    bodies = [world.body(i) for i in ids]
 
     def near(body, distance):
-        return any(pb.getClosestPoints(body, other, distance, physicsClientId=world._client)
+        return any(world.engine.closest(body, other, distance)
                    for other in bodies if other != body)
 
     return ([i for i, b in zip(ids, bodies, strict=True) if not near(b, 0.005)],
@@ -490,8 +479,7 @@ def test_cancel_from_the_progress_callback_stops_the_operation():
 def test_nan_state_is_detected_and_the_scene_reset():
     with _world() as world:
         ids, _ = world.drop(5)
-        body = world._bodies[ids[0]]
-        pb.resetBaseVelocity(body, [math.nan, 0, 0], [0, 0, 0], physicsClientId=world._client)
+        world.engine.set_velocity(world.body(ids[0]), [math.nan, 0, 0])
         with pytest.raises(PhysicsFault, match=r'parts \[0\] got non-finite poses'):
             world.settle()
         assert len(world.snapshot().ids) == 0
@@ -587,16 +575,17 @@ def test_bad_settle_time_is_refused():
 
 
 def test_a_moving_fraction_ends_the_settle_earlier_and_names_the_parts_still_moving():
-    """60 TO-220s rest after about 4 s; with 5 % tolerated the drop ends when at most 3 parts
-    still move (on the same trajectory: same seed), and a further settle brings those to rest."""
+    """120 TO-220s rest after about 4 s; with 5 % tolerated the drop ends when at most 6 parts
+    still move (on the same trajectory: same seed), and a further settle brings those to rest.
+    (60 of them, the former scene, came to rest all at once at the tolerated check.)"""
     bin_ = ContainerSpec(inner_size=(0.12, 0.10, 0.03))
     with _world(bin_, 'to220', settle_moving_fraction=0.0) as strict:
-        _, full = strict.drop(60)
+        _, full = strict.drop(120)
     with _world(bin_, 'to220', settle_moving_fraction=0.05) as world:
-        _, early = world.drop(60)
+        _, early = world.drop(120)
         rest = world.settle()
     assert full.settled and full.unsettled_ids == []
-    assert early.settled and 0 < len(early.unsettled_ids) <= 3
+    assert early.settled and 0 < len(early.unsettled_ids) <= 6
     assert early.sim_time < full.sim_time and rest.settled
     with pytest.raises(InvalidArgument, match=r'settle.moving_fraction: 0.6 must be <= 0.5'):
         _world(settle_moving_fraction=0.6)

@@ -36,11 +36,13 @@ class PartGeometry:
     mass_frame: a mesh part's mass centre (3,) m and principal axes (4,) xyzw, in the part
     frame, from its geometry at uniform density (`mass.mass_properties`), wherever the file
     puts its origin: the physics' mass centre. None for a built-in model, whose frame origin
-    (its body's centre) is the physics' mass centre, its leads and tab left out of it. The
-    moments of inertia are Bullet's estimate from the shape's bounds in that frame, for every
-    part: a thin part's true moments made the solver diverge (a 12 x 4 x 2 mm box at its solid
-    moments, 8 times below Bullet's about its long axis, got NaN poses within 0.05 s at
-    1/480 s).
+    (its body's centre) is the physics' mass centre, its leads and tab left out of it.
+    moments: a mesh part's principal moments of inertia (3,) kg m^2 about those axes, from the
+    same solids: the physics' inertia. None for a built-in model, whose moments are Bullet's
+    estimate from the bounds of its shape in its frame. Bullet's estimate for a mesh part
+    depended on the file's frame and tessellation (KiCad's 5 mm capacitor: 0.0016 to 0.0044
+    kg mm^2 about its principal axes from its STEP, its STL and the STL turned, whose true
+    moments are 0.0016 to 0.0018).
     collision_note: how a mesh part's pieces were made, in words (pieces.convex_cover); empty
     for a built-in model.
     """
@@ -54,6 +56,7 @@ class PartGeometry:
     radius: float
     volume: float
     mass_frame: tuple[np.ndarray, np.ndarray] | None = None
+    moments: np.ndarray | None = None
     collision_note: str = ''
 
 
@@ -92,7 +95,8 @@ def visual_mesh(p: Primitive) -> trimesh.Trimesh:
 
 def _finish(spec: PartSpec, dims: Mapping[str, float], mass: float,
             collision: list[Primitive], visual: trimesh.Trimesh,
-            volume: float, mass_frame=None, collision_note: str = '') -> PartGeometry:
+            volume: float, mass_frame=None, moments=None,
+            collision_note: str = '') -> PartGeometry:
     corners = np.vstack([primitive_mesh(p).bounds for p in collision])
     low, high = corners.min(axis=0), corners.max(axis=0)
     # a mesh's sphere about its mass centre: its bounding box would move with the file's axes
@@ -103,7 +107,7 @@ def _finish(spec: PartSpec, dims: Mapping[str, float], mass: float,
     return PartGeometry(spec=spec, dimensions=dict(dims), mass=mass,
                         primitives=tuple(collision), visual=visual, center=center,
                         radius=radius, volume=float(volume), mass_frame=mass_frame,
-                        collision_note=collision_note)
+                        moments=moments, collision_note=collision_note)
 
 
 def _builtin(spec: PartSpec) -> PartGeometry:
@@ -124,8 +128,8 @@ def _mesh_part(spec: PartSpec) -> PartGeometry:
     volume = mesh.volume if mesh.is_watertight else sum(h.volume for h in hulls)
     # The mass where the material is: the solid itself when it is closed, else its hulls.
     solids = [mesh] if mesh.is_watertight and mesh.volume > 0 else hulls
-    centre, axes, _ = mass_properties(solids, mass)
-    return _finish(spec, {}, mass, collision, mesh, volume, (centre, axes), note)
+    centre, axes, moments = mass_properties(solids, mass)
+    return _finish(spec, {}, mass, collision, mesh, volume, (centre, axes), moments, note)
 
 
 def build_part(spec: PartSpec) -> PartGeometry:
