@@ -1,21 +1,35 @@
 """How a part comes to rest on a flat floor: its aspects, which aspect a resting pose shows,
 the quasi-static prediction, and drop counts against a measurement.
 
-An aspect is a face of the part's convex hull it can stand on (a face onto which the mass
-centre projects: trimesh.poses.compute_stable_poses), named from its outward normal in the
-part's frame: `+x` ... `-z` when the normal lies within MERGE_ANGLE of an axis; `side_<axis>`
-for the many narrow faces of a round body's side, all perpendicular to its axis (more than
-ROUND_FACES of them: merged into one, as a user counts a cylinder on its side); `face_<k>`
-otherwise, numbered by falling quasi-static share (equal shares by
-the normal, +x first, then +y, +z). Faces whose normals lie within MERGE_ANGLE
-of each other are one aspect. The quasi-static share of a face is trimesh's: the solid angle
-of the directions of gravity that roll the part onto it without momentum.
+An aspect is what a part can rest on, named from its geometry in the part's frame, not from
+its tessellation: the same part from its STEP file and from STL exports of it at other
+tessellations has the same aspects by the same names (but for faces of a few tenths of a
+percent quasi-static share that a tessellation makes or unmakes: the facets of a chamfer,
+the face a lead's tip and a rim span; KiCad's 5 mm capacitor, test_part_files.py). The part
+rests on a face of its convex hull onto which its mass centre projects
+(trimesh.poses.compute_stable_poses, which also gives each face's quasi-static share: the
+solid angle of the directions of gravity that roll the part onto it without momentum). Those
+faces are grouped:
+- a round side: faces whose normals lie within MERGE_ANGLE of one circle of directions about
+  an axis, at least ROUND_FACES directions (MERGE_ANGLE apart) in an arc with no gap wider
+  than ROUND_GAP that spans at least ROUND_SPAN: a tessellated cylinder's side (its normals
+  square to its axis) or a cone's (a chamfer's, a tapered body's), which a user counts as
+  one. Found from the faces themselves, about any axis; a cylinder's named `side_x`, `side_y`
+  or `side_z` when its axis lies within MERGE_ANGLE of a frame axis, a cone's `cone_+x` ...
+  `cone_-z` by the way its normals lean, else `side_1`, `cone_1` ... by falling share;
+- a flat face: faces whose normals lie within MERGE_ANGLE of each other (a face tessellated
+  into triangles), named `+x` ... `-z` when its normal lies within MERGE_ANGLE of an axis,
+  else `face_1`, `face_2` ... by falling share (equal shares by the normal, +x first).
+A resting pose shows the aspect gravity points through in the part's frame: a round side's
+when gravity lies within MATCH_ANGLE of its circle (a cylinder rests on its side at any roll,
+between its facets' normals), a flat face's when within MATCH_ANGLE of its normal; OTHER
+otherwise (leaning, on an edge).
 
 Pure: numpy, scipy and trimesh; no simulator.
 """
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import math
 
 import numpy as np
@@ -28,7 +42,9 @@ from .spec import geometry_key, PartSpec
 
 MERGE_ANGLE = math.radians(5.0)     # faces this close in normal are one aspect
 MATCH_ANGLE = math.radians(10.0)    # a pose this far from every aspect is OTHER
-ROUND_FACES = 8                     # more faces than this around one axis: a round side
+ROUND_FACES = 8                     # the fewest facet directions around a round side
+ROUND_GAP = math.radians(45.0)      # the widest gap between a round side's directions
+ROUND_SPAN = math.radians(90.0)     # the least a round side's directions span around it
 OTHER = 'other'                     # a pose on no aspect (leaning, balanced on an edge)
 AXES = {'+x': (1, 0, 0), '-x': (-1, 0, 0), '+y': (0, 1, 0), '-y': (0, -1, 0),
         '+z': (0, 0, 1), '-z': (0, 0, -1)}
@@ -37,13 +53,115 @@ AXES = {'+x': (1, 0, 0), '-x': (-1, 0, 0), '+y': (0, 1, 0), '-y': (0, -1, 0),
 @dataclass(frozen=True)
 class Aspect:
     """name; normal: the unit outward normal (3,) of the face the part rests on, in the part
-    frame (a round side's: its likeliest face's); normals: every face's of the aspect (K, 3);
-    quasi_static: its share without momentum."""
+    frame (a round side's: its faces' mean, or its likeliest face's); normals: every face's of
+    the aspect (K, 3); quasi_static: its share without momentum; axis: a round side's axis
+    (3,), unit, in the part frame (None for a flat face), and level: the cosine of its
+    normals' angle to the axis (0 for a cylinder's side)."""
 
     name: str
     normal: tuple[float, float, float]
     normals: np.ndarray
     quasi_static: float
+    axis: tuple[float, float, float] | None = None
+    level: float = 0.0
+
+
+def _directions(normals: np.ndarray, shares: np.ndarray) -> list[list[int]]:
+    """The faces grouped by normal: each group the faces within MERGE_ANGLE of its likeliest
+    one, likeliest group first."""
+    cos_merge = math.cos(MERGE_ANGLE)
+    groups: list[list[int]] = []
+    for i in sorted(range(len(normals)), key=lambda i: (-shares[i], *(-normals[i]).round(9))):
+        for g in groups:
+            if normals[g[0]] @ normals[i] > cos_merge:
+                g.append(i)
+                break
+        else:
+            groups.append([i])
+    return groups
+
+
+def _round_sides(normals: np.ndarray, groups: list[list[int]]
+                 ) -> list[tuple[np.ndarray, float, list[int]]]:
+    """The round sides among the face groups (module docstring): each (axis (3,), the cosine
+    of its normals' angle to the axis: 0 for a cylinder, toward +axis for a cone; the indices
+    of its groups), most groups first. A round side's normals lie on one circle of
+    directions, the plane axis . n = cosine, which a direction and its two nearest fix."""
+    heads = np.array([normals[g[0]] for g in groups])
+    if len(heads) < ROUND_FACES:
+        return []
+    cos = np.clip(heads @ heads.T, -1.0, 1.0)
+    near = (cos < math.cos(MERGE_ANGLE)) & (cos > math.cos(ROUND_GAP))
+    sin_merge = math.sin(MERGE_ANGLE)
+    candidates = []
+    for k in range(len(heads)):
+        others = np.flatnonzero(near[k])
+        if len(others) < 2:
+            continue
+        a, b = others[np.argsort(-cos[k, others])[:2]]       # its two nearest directions
+        axis = np.cross(heads[a] - heads[k], heads[b] - heads[k])
+        if np.linalg.norm(axis) < 1e-12:
+            continue
+        axis /= np.linalg.norm(axis)
+        level = float(axis @ heads[k])
+        if abs(level) < sin_merge:           # a cylinder: one sign for the axis, any run
+            level = 0.0
+            axis = axis if axis @ [1.0, 2.0, 4.0] >= 0 else -axis
+        elif level < 0:                       # a cone: its axis the way its normals lean
+            axis, level = -axis, -level
+        candidates.append((tuple(np.round(axis, 9)), round(level, 9)))
+    found, used = [], set()
+    for axis, level in sorted(set(candidates)):
+        axis = np.array(axis)
+        circle = [k for k in range(len(heads)) if k not in used
+                  and abs(float(heads[k] @ axis) - level) < sin_merge]
+        members = [circle[k] for arc in _arcs(heads[circle], axis) for k in arc]
+        if len(members) >= ROUND_FACES:
+            found.append((axis, level, members))
+            used.update(members)
+    return sorted(found, key=lambda f: -len(f[2]))
+
+
+def _arcs(directions: np.ndarray, axis: np.ndarray) -> list[list[int]]:
+    """The runs of `directions` (square to `axis`) around it with no gap wider than ROUND_GAP,
+    at least ROUND_FACES directions each and spanning at least ROUND_SPAN, as indices into
+    `directions`."""
+    if len(directions) < ROUND_FACES:
+        return []
+    first = directions[0] - (directions[0] @ axis) * axis
+    if np.linalg.norm(first) < 1e-9:
+        return []
+    first /= np.linalg.norm(first)
+    second = np.cross(axis, first)
+    angles = np.arctan2(directions @ second, directions @ first) % (2 * math.pi)
+    order = np.argsort(angles)
+    gaps = np.diff(np.append(angles[order], angles[order[0]] + 2 * math.pi))
+    if (gaps <= ROUND_GAP).all():
+        return [order.tolist()] if len(order) >= ROUND_FACES else []
+    start = int(np.argmax(gaps > ROUND_GAP)) + 1        # just after a wide gap
+    runs, run = [], []
+    for k in range(len(order)):
+        index = (start + k) % len(order)
+        run.append(int(order[index]))
+        if gaps[index] > ROUND_GAP:
+            runs.append(run)
+            run = []
+    runs.append(run)
+
+    def spans(run: list[int]) -> float:
+        return float(np.sum(np.diff(np.unwrap(angles[run]))))
+
+    return [r for r in runs if len(r) >= ROUND_FACES and spans(r) >= ROUND_SPAN]
+
+
+def _axis_name(direction: np.ndarray, signed: bool) -> str | None:
+    """'+x' ... '-z' (or 'x', 'y', 'z' unsigned) when `direction` lies within MERGE_ANGLE of a
+    frame axis, else None."""
+    for name, axis in AXES.items():
+        cos = float(direction @ axis)
+        if (cos if signed else abs(cos)) > math.cos(MERGE_ANGLE):
+            return name if signed else name[1]
+    return None
 
 
 def stable_aspects(mesh: trimesh.Trimesh, centre: Sequence[float]) -> list[Aspect]:
@@ -53,39 +171,38 @@ def stable_aspects(mesh: trimesh.Trimesh, centre: Sequence[float]) -> list[Aspec
         mesh.convex_hull, center_mass=np.asarray(centre, dtype=float))
     normals = np.array([t[:3, :3].T @ [0.0, 0.0, -1.0] for t in transforms])
     shares = np.asarray(shares, dtype=float) / max(float(np.sum(shares)), 1e-300)
-    groups: dict[str, list[int]] = {}
-    left = list(range(len(normals)))
-    for axis_name, axis in (('x', 0), ('y', 1), ('z', 2)):     # a round body's side
-        side = [i for i in left if abs(normals[i][axis]) < math.sin(MERGE_ANGLE)]
-        if len(side) > ROUND_FACES:
-            groups[f'side_{axis_name}'] = side
-            left = [i for i in left if i not in side]
-    cos_merge = math.cos(MERGE_ANGLE)
-    for name, axis in AXES.items():
-        on = [i for i in left if normals[i] @ axis > cos_merge]
-        if on:
-            groups[name] = on
-            left = [i for i in left if i not in on]
-    clusters: list[list[int]] = []
-    for i in sorted(left, key=lambda i: (-round(shares[i], 6), *(-normals[i]).round(6))):
-        for c in clusters:
-            if normals[c[0]] @ normals[i] > cos_merge:
-                c.append(i)
-                break
+    groups = _directions(normals, shares)
+    sides = _round_sides(normals, groups)
+    in_sides = {k for _, _, members in sides for k in members}
+    found = []          # (name or None, member faces, axis or None, level)
+    for axis, level, members in sides:
+        faces = [i for k in members for i in groups[k]]
+        if level == 0.0:
+            name = _axis_name(axis, False)
+            found.append((name and f'side_{name}', faces, axis, level))
         else:
-            clusters.append([i])
-    # by falling share, a tie (a mirror pair) by the normal, +x first: the same names on any run
-    clusters.sort(key=lambda c: (-round(float(shares[c].sum()), 6), *(-normals[c[0]]).round(6)))
-    groups.update({f'face_{k + 1}': c for k, c in enumerate(clusters)})
+            name = _axis_name(axis, True)
+            found.append((name and f'cone_{name}', faces, axis, level))
+    for k, g in enumerate(groups):
+        if k not in in_sides:
+            found.append((_axis_name(normals[g[0]], True), g, None, 0.0))
     aspects = []
-    for name, members in groups.items():
-        best = members[int(np.argmax(shares[members]))]
-        mean = normals[members].mean(axis=0)
+    for name, faces, axis, level in found:
+        best = faces[int(np.argmax(shares[faces]))]
+        mean = normals[faces].mean(axis=0)
         normal = mean / np.linalg.norm(mean) if np.linalg.norm(mean) > 0.5 else normals[best]
-        aspects.append(Aspect(name, tuple(float(v) for v in normal), normals[members],
-                              float(shares[members].sum())))
-    return sorted(aspects, key=lambda a: (-round(a.quasi_static, 6), *(-np.array(a.normal))
-                                          .round(6)))
+        aspects.append(Aspect(name or '', tuple(float(v) for v in normal), normals[faces],
+                              float(shares[faces].sum()),
+                              None if axis is None else tuple(float(v) for v in axis), level))
+    # unnamed ones numbered by falling share, a tie (a mirror pair) by the normal, +x first
+    aspects.sort(key=lambda a: (-round(a.quasi_static, 6), *(-np.array(a.normal)).round(6)))
+    counts = {'side': 0, 'cone': 0, 'face': 0}
+    for k, a in enumerate(aspects):
+        if not a.name:
+            kind = 'face' if a.axis is None else 'side' if a.level == 0.0 else 'cone'
+            counts[kind] += 1
+            aspects[k] = replace(a, name=f'{kind}_{counts[kind]}')
+    return aspects
 
 
 _BY_GEOMETRY: dict[tuple, tuple[Aspect, ...]] = {}
@@ -110,15 +227,28 @@ def spec_aspects(spec: PartSpec) -> tuple[Aspect, ...]:
 
 def classify(aspects: Sequence[Aspect], orientations: np.ndarray) -> list[str]:
     """The aspect each resting part shows, by the direction of gravity in its frame (the
-    orientations (N, 4) xyzw of the part frame in a frame whose z is up); OTHER when no aspect
-    lies within MATCH_ANGLE."""
+    orientations (N, 4) xyzw of the part frame in a frame whose z is up): a round side's when
+    gravity lies within MATCH_ANGLE of its circle of normals (for a cylinder, the plane square
+    to its axis), a flat face's when within MATCH_ANGLE of one of its normals, the nearer when
+    both; OTHER when none is."""
     conjugates = np.asarray(orientations, dtype=float) * [-1.0, -1.0, -1.0, 1.0]
     down = rotate(conjugates, np.array([0.0, 0.0, -1.0])) if len(conjugates) else np.empty(
         (0, 3))
     out = []
     for d in down:
-        best = max(((float(np.max(a.normals @ d)), a.name) for a in aspects), default=(-1, ''))
-        out.append(best[1] if best[0] > math.cos(MATCH_ANGLE) else OTHER)
+        best, name = MATCH_ANGLE, OTHER
+        for a in aspects:
+            if a.axis is not None:
+                off = abs(math.asin(max(-1.0, min(1.0, float(d @ a.axis))))
+                          - math.asin(a.level))
+                # on the side's arc: between its facets' directions, not past its ends
+                if float(np.max(a.normals @ d)) < math.cos(ROUND_GAP):
+                    continue
+            else:
+                off = math.acos(min(1.0, float(np.max(a.normals @ d))))
+            if off <= best:
+                best, name = off, a.name
+        out.append(name)
     return out
 
 
