@@ -29,14 +29,13 @@ from .config import (
 from .geometry import (
     contains,
     CylinderShape,
-    grasped_extent,
     gripper_shapes,
     part_shapes,
     rotations_about_x,
     Shape,
     suction_shapes,
 )
-from .grasp_fit import check_grasps_fit, GraspFit, round_axis
+from .grasp_fit import body_bottom, check_grasps_fit, GraspFit, round_axis
 from .regrasp import Placement, placements
 from .suction import Holding, holding, Seal, seal
 
@@ -94,7 +93,7 @@ def build_geometry(setup: Setup, part: PartGeometry | None = None) -> CheckGeome
     place_axis, seat_offset = check_place(setup.place)
     angles = tilts(setup.config)
     shapes = part_shapes(part)
-    depths = tuple(_finger_depth(shapes, gripper, g) for g in grasps)
+    depths = tuple(_finger_depth(part, gripper, g) for g in grasps)
     jaws = tuple(gripper_shapes(gripper, g.jaw_opening, depth)
                  for g, depth in zip(grasps, depths, strict=True))
     return CheckGeometry(
@@ -111,11 +110,13 @@ def _placements(part: PartGeometry, config: CheckConfig) -> tuple[Placement, ...
     return placements(part, config.station_margin) if config.regrasp_station else ()
 
 
-def _finger_depth(shapes: tuple[Shape, ...], gripper: Gripper, grasp: Grasp) -> float:
+def _finger_depth(part: PartGeometry, gripper: Gripper, grasp: Grasp) -> float:
     """How far below the grasp point the fingertips go, m: to `finger_clearance` above the
-    grasped part's bottom, between the grasp point and V below it."""
-    extent = grasped_extent(shapes, grasp.point, grasp.up)
-    return min(gripper.jaw_height, max(0.0, extent - gripper.finger_clearance))
+    bottom of the body the jaws close on (grasp_fit.body_bottom), between the grasp point
+    and V below it."""
+    bottom = body_bottom(part, grasp.point, grasp.closing, grasp.up, gripper.jaw_depth,
+                         gripper.jaw_height + gripper.finger_clearance)
+    return min(gripper.jaw_height, max(0.0, bottom - gripper.finger_clearance))
 
 
 def _free_axis(part: PartGeometry, shapes: tuple[Shape, ...], grasp: Grasp) -> np.ndarray:

@@ -7,7 +7,6 @@ shared; a query sets the object's transform.
 Rotations are (..., 3, 3) float64 arrays whose columns are the child axes; quaternions xyzw.
 """
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 import math
 
@@ -157,16 +156,6 @@ def contains(shape: Shape, point: np.ndarray) -> bool:
         return bool(math.hypot(local[0], local[1]) <= shape.radius + 1e-12
                     and abs(local[2]) <= shape.half_length + 1e-12)
     return bool(Delaunay(shape.vertices).find_simplex(local) >= 0)
-
-
-def grasped_extent(shapes: Sequence[Shape], point: np.ndarray, up: np.ndarray) -> float:
-    """How far the grasped part reaches below the grasp point along -up, m: over the shape
-    that holds the point, or over every shape when none does (a grasp point in a gap)."""
-    point = np.asarray(point, dtype=np.float64)
-    holding = [s for s in shapes if contains(s, point)] or list(shapes)
-    down = -np.asarray(up, dtype=np.float64)
-    reach = max(float(support(s, s.rotation[None], s.center[None], down)[0]) for s in holding)
-    return reach - float(point @ down)
 
 
 def place(shape: Shape, rotation: np.ndarray, translation: np.ndarray) -> tuple[np.ndarray,

@@ -200,11 +200,13 @@ def test_a_round_body_is_found_in_a_mesh(tmp_path, roll):
 
 
 def test_the_fingertips_reach_down_the_grasped_part():
-    # Side grasp of a lying capacitor: the body (radius 2.5 mm) is the primitive holding the
-    # grasp point, so the fingertips go 2.5 mm - clearance below the body's axis.
+    # Side grasp of a lying capacitor: the body the jaws close on (radius 2.5 mm) ends 2.5 mm
+    # below its axis, so the fingertips go 2.5 mm - clearance below it; from the top, the
+    # body ends 5.5 mm below its centre, where only its two leads go on (a fifth of it).
     v = _validator()
-    assert math.isclose(v.finger_depths[0], RADIUS - 0.001)
-    assert math.isclose(_validator(grasps=(TOP,)).finger_depths[0], 0.0055 + 0.002 - 0.001)
+    assert v.finger_depths[0] == pytest.approx(RADIUS - 0.001, abs=1e-7)
+    assert _validator(grasps=(TOP,)).finger_depths[0] == pytest.approx(0.0055 + 0.002 - 0.001,
+                                                                       abs=1e-7)
     # Lying 0.5 mm into the floor (as resting parts do in the physics): with no clearance the
     # fingertips, and nothing else, go through the floor at every tilt.
     sunk = _lying(0, 0)
