@@ -19,7 +19,9 @@ faces are grouped:
   `cone_-z` by the way its normals lean, else `side_1`, `cone_1` ... by falling share;
 - a flat face: faces whose normals lie within MERGE_ANGLE of each other (a face tessellated
   into triangles), named `+x` ... `-z` when its normal lies within MERGE_ANGLE of an axis,
-  else `face_1`, `face_2` ... by falling share (equal shares by the normal, +x first).
+  else `face_1`, `face_2` ... by falling share in steps of SHARE_STEP, within a step by the
+  normal (+x first, then +y, +z, in steps of 0.1): a mirror pair's two shares differ with
+  the tessellation in their fourth decimal.
 A resting pose shows the aspect gravity points through in the part's frame: a round side's
 when gravity lies within MATCH_ANGLE of its circle (a cylinder rests on its side at any roll,
 between its facets' normals), a flat face's when within MATCH_ANGLE of its normal; OTHER
@@ -45,6 +47,7 @@ MATCH_ANGLE = math.radians(10.0)    # a pose this far from every aspect is OTHER
 ROUND_FACES = 8                     # the fewest facet directions around a round side
 ROUND_GAP = math.radians(45.0)      # the widest gap between a round side's directions
 ROUND_SPAN = math.radians(90.0)     # the least a round side's directions span around it
+SHARE_STEP = 0.005                  # shares this close number aspects by their normals
 OTHER = 'other'                     # a pose on no aspect (leaning, balanced on an edge)
 AXES = {'+x': (1, 0, 0), '-x': (-1, 0, 0), '+y': (0, 1, 0), '-y': (0, -1, 0),
         '+z': (0, 0, 1), '-z': (0, 0, -1)}
@@ -117,7 +120,11 @@ def _round_sides(normals: np.ndarray, groups: list[list[int]]
                   and abs(float(heads[k] @ axis) - level) < sin_merge]
         members = [circle[k] for arc in _arcs(heads[circle], axis) for k in arc]
         if len(members) >= ROUND_FACES:
-            found.append((axis, level, members))
+            # the circle refined: the plane through every member's direction (least squares)
+            fit = np.linalg.svd(heads[members] - heads[members].mean(axis=0))[2][-1]
+            fit = fit if fit @ axis >= 0 else -fit
+            level = float(np.mean(heads[members] @ fit)) if level else 0.0
+            found.append((fit, level, members))
             used.update(members)
     return sorted(found, key=lambda f: -len(f[2]))
 
@@ -195,7 +202,8 @@ def stable_aspects(mesh: trimesh.Trimesh, centre: Sequence[float]) -> list[Aspec
                               float(shares[faces].sum()),
                               None if axis is None else tuple(float(v) for v in axis), level))
     # unnamed ones numbered by falling share, a tie (a mirror pair) by the normal, +x first
-    aspects.sort(key=lambda a: (-round(a.quasi_static, 6), *(-np.array(a.normal)).round(6)))
+    aspects.sort(key=lambda a: (-round(a.quasi_static / SHARE_STEP),
+                                *(-np.array(a.normal)).round(1), -a.quasi_static))
     counts = {'side': 0, 'cone': 0, 'face': 0}
     for k, a in enumerate(aspects):
         if not a.name:
