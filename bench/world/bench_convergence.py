@@ -65,6 +65,8 @@ SETTINGS = {
     # every part stepped to the end of every settle: an earlier default
     'no-freeze': replace(DEFAULT, settle_freeze=False),
     'dt/2-no-freeze': replace(FINER, time_step=DEFAULT.time_step / 2, settle_freeze=False),
+    # the world in metres, as it simulated before (and its contact-breaking factor then)
+    'metres': replace(DEFAULT, length_unit=1.0, contact_breaking_threshold=0.001),
 }
 # a setting's materials section (an experiment file's), for both pairs
 MATERIALS = {'arms-1mm': {pair: {'rolling_friction_mm': 1.0, 'spinning_friction_mm': 1.0}

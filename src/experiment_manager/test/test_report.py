@@ -341,7 +341,9 @@ def test_pictures_re_simulate_the_recorded_iteration(run_dir):
         if stage in drawn and stage != STAGE_PLACEABILITY}
     if any(STAGE_PLACEABILITY in stops(e.id) for e in file.experiments):
         expected.add('stopped_placeability.png')
-    assert len(expected) > 3 and set(captions) == expected, captions
+    # the small run's scenes stop parts at one stage or more (at neighbours alone since the
+    # world simulates in centimetres): at least one stopped part is drawn
+    assert len(expected) >= 3 and set(captions) == expected, captions
     for name, caption in captions.items():
         if name in ('bin.png', 'tray.png'):
             assert 'poses identical to the recorded ones' in caption, caption

@@ -79,8 +79,10 @@ def test_the_example_runs_end_to_end(tmp_path):
     assert 'mass centre at (2.54, 1.11, 8.86) mm in its frame' in text
     assert ('9 convex piece(s) of 11, 22, 17, 16, 17, 14, 14, 14, 25 vertices, 496.8 mm^3 '
             'together, +2.0 %') in text and 'cut into convex pieces by CoACD' in text
-    # its thinnest pieces cannot take pybullet's margin off whole: said, with how much
-    assert 'pieces thinner than 2 mm stay swollen by up to 0.76 mm' in text
+    # in centimetres every piece takes pybullet's margin off whole (in metres its thinnest
+    # stayed swollen by up to 0.76 mm, which the report said)
+    assert ("each piece inset by pybullet's 0.01 mm margin, so that it collides this surface "
+            '(its edges rounded by the margin)') in text and 'swollen' not in text
     assert '](part.png)' in text and os.path.getsize(tmp_path / 'part.png') > 10_000
     assert '## Why parts were turned down' in text and 'stops most' in text
 

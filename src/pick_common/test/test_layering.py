@@ -52,23 +52,3 @@ def test_the_mesh_stack_is_seen_where_it_is_loaded():
     # the check above can fail: the same probe sees trimesh where a part is built
     assert 'trimesh' in _loaded('pick_common.parts.geometry')
 
-
-def test_in_the_world_only_its_engine_speaks_to_pybullet():
-    """The world simulates in centimetres and speaks SI: engine.py converts every length,
-    velocity and force, so no other module of the package may call PyBullet (one would hand
-    it metres)."""
-    import ast
-    import pathlib
-
-    import pick_sim_world
-
-    def imports(path: pathlib.Path) -> set[str]:
-        tree = ast.parse(path.read_text())
-        return ({a.name.split('.')[0] for n in ast.walk(tree) if isinstance(n, ast.Import)
-                 for a in n.names}
-                | {(n.module or '').split('.')[0] for n in ast.walk(tree)
-                   if isinstance(n, ast.ImportFrom)})
-
-    root = pathlib.Path(pick_sim_world.__file__).parent
-    assert sorted(p.name for p in root.glob('*.py') if 'pybullet' in imports(p)) == [
-        'engine.py']

@@ -101,10 +101,8 @@ class World:
 
     def reset(self, scene: SceneSpec | None = None, seed: int | None = None) -> None:
         """Build `scene` (or rebuild the current one) with no parts; `seed` overrides its seed.
-
-        Everything is checked before the current world is touched: a bad scene raises and leaves
-        the world as it was.
-        """
+        Everything is checked before the current world is touched: a bad scene raises and
+        leaves the world as it was."""
         scene = scene or self._scene
         if seed is not None:
             scene = SceneSpec(scene.container, scene.part, scene.instance_count, seed)
@@ -201,15 +199,13 @@ class World:
     def drop(self, count: int, instances: Iterable[int] | None = None, zone: str = 'container',
              max_settle_time: float | None = None,
              progress: ProgressCallback | None = None) -> tuple[list[int], SettleReport]:
-        """Drop `count` parts into each instance (or its feeder zone) as a stream, then settle.
-
-        One spawn layer at a time from the container's drop height (containers.drop_height)
+        """Drop `count` parts into each instance (or its feeder zone) as a stream, then settle:
+        one spawn layer at a time from the container's drop height (containers.drop_height)
         or just above the parts there where higher, the next when it has landed
-        (spawning.layer_interval), never a tall column (which at 1/240 s sent parts through a
-        10 mm floor). Returns the new part
-        ids and the report of the whole operation. Raises InvalidArgument when the count is
-        out of range or the parts do not fit, UnknownInstance for a bad instance id.
-        """
+        (spawning.layer_interval), never a tall column (which sent parts through a 10 mm
+        floor). Returns the new part ids and the report of the whole operation. Raises
+        InvalidArgument when the count is out of range or the parts do not fit,
+        UnknownInstance for a bad instance id."""
         targets = self._instance_ids(instances)
         count = spawning.check_count(count, {k: len(self._instances[k].part_ids)
                                              for k in targets}, self._part, self._scene.container)
