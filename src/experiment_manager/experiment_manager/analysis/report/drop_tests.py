@@ -1,6 +1,10 @@
 """Each drop_test: the aspects its parts came to rest on, beside the quasi-static prediction
 and the user's own drop test when the file gives its counts, and how to make one."""
 
+import math
+
+from pick_common.parts import aspects
+
 from ..wording import fmt, pct, table
 from .base import Run, Section
 
@@ -25,8 +29,12 @@ class DropTests(Section):
                 lines += ['![each aspect: the part resting on it, with its quasi-static share]'
                           '(aspects.png)', '']
             lines += [f'{s.drops} single parts dropped from {fmt(s.height_mm)} mm onto the '
-                      f'plate, each at a random orientation, at rest on the aspects below '
-                      f'({s.other} on none: leaning or on an edge, left out of the shares). '
+                      f'plate, each at a random orientation, at rest on the aspects below: a '
+                      'part rests on an aspect when gravity lies within '
+                      f"{math.degrees(aspects.MATCH_ANGLE):g} degrees of its face's normal (of "
+                      f"a round side's circle of normals). {s.other} rested on none, left out "
+                      "of the shares: leaning on the plate's wall, or at rest on an edge or on a "
+                      'face the quasi-static analysis finds the part cannot stand on. '
                       'Quasi-static: the share of orientations that would roll onto the face '
                       'without momentum.', '']
             measured = s.measured is not None
