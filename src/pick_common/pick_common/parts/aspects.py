@@ -113,20 +113,32 @@ def _round_sides(normals: np.ndarray, groups: list[list[int]]
         elif level < 0:                       # a cone: its axis the way its normals lean
             axis, level = -axis, -level
         candidates.append((tuple(np.round(axis, 9)), round(level, 9)))
+    candidates = sorted(set(candidates))
+
+    def members_of(axis: np.ndarray, level: float, used: set[int]) -> list[int]:
+        circle = [k for k in np.flatnonzero(np.abs(heads @ axis - level) < sin_merge)
+                  if k not in used]
+        return [circle[k] for arc in _arcs(heads[circle], axis) for k in arc]
+
     found, used = [], set()
-    for axis, level in sorted(set(candidates)):
-        axis = np.array(axis)
-        circle = [k for k in range(len(heads)) if k not in used
-                  and abs(float(heads[k] @ axis) - level) < sin_merge]
-        members = [circle[k] for arc in _arcs(heads[circle], axis) for k in arc]
-        if len(members) >= ROUND_FACES:
-            # the circle refined: the plane through every member's direction (least squares)
-            fit = np.linalg.svd(heads[members] - heads[members].mean(axis=0))[2][-1]
-            fit = fit if fit @ axis >= 0 else -fit
-            level = float(np.mean(heads[members] @ fit)) if level else 0.0
-            found.append((fit, level, members))
-            used.update(members)
-    return sorted(found, key=lambda f: -len(f[2]))
+    while True:        # the circle with the most faces first, then the next among the rest
+        best = max(((np.array(a), lv, members_of(np.array(a), lv, used))
+                    for a, lv in candidates), key=lambda c: len(c[2]), default=None)
+        if best is None or len(best[2]) < ROUND_FACES:
+            break
+        axis, level, members = best
+        # the circle refined: the plane through every member's direction (least squares)
+        fit = np.linalg.svd(heads[members] - heads[members].mean(axis=0))[2][-1]
+        fit = fit if fit @ axis >= 0 else -fit
+        fitted = float(np.mean(heads[members] @ fit))
+        if abs(fitted) < sin_merge:
+            fitted, fit = 0.0, fit if fit @ [1.0, 2.0, 4.0] >= 0 else -fit
+        again = members_of(fit, fitted, used)
+        if len(again) >= len(members):
+            axis, level, members = fit, fitted, again
+        found.append((axis, level, members))
+        used.update(members)
+    return found
 
 
 def _arcs(directions: np.ndarray, axis: np.ndarray) -> list[list[int]]:
@@ -182,14 +194,15 @@ def stable_aspects(mesh: trimesh.Trimesh, centre: Sequence[float]) -> list[Aspec
     sides = _round_sides(normals, groups)
     in_sides = {k for _, _, members in sides for k in members}
     found = []          # (name or None, member faces, axis or None, level)
+    taken = set()
     for axis, level, members in sides:
         faces = [i for k in members for i in groups[k]]
-        if level == 0.0:
-            name = _axis_name(axis, False)
-            found.append((name and f'side_{name}', faces, axis, level))
-        else:
-            name = _axis_name(axis, True)
-            found.append((name and f'cone_{name}', faces, axis, level))
+        name = (f'side_{_axis_name(axis, False)}' if level == 0.0 and _axis_name(axis, False)
+                else f'cone_{_axis_name(axis, True)}' if level and _axis_name(axis, True)
+                else None)
+        name = None if name in taken else name      # two about one axis: numbered
+        taken.add(name)
+        found.append((name, faces, axis, level))
     for k, g in enumerate(groups):
         if k not in in_sides:
             found.append((_axis_name(normals[g[0]], True), g, None, 0.0))
