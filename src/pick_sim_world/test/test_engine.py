@@ -47,3 +47,26 @@ def test_what_goes_in_in_si_comes_out_in_si_and_falls_at_g(unit):
         assert engine.speed(body) == pytest.approx(np.hypot(0.3, 9.81 * t), rel=1e-6)
     finally:
         engine.close()
+
+
+def test_the_parameter_file_states_the_physics_defaults():
+    """config/world.yaml says it states the defaults: its physics and settle settings are the
+    code's (it kept the contact-breaking factor of the world in metres, 0.001, after the
+    default became 0.02)."""
+    from dataclasses import fields
+    import os
+
+    from pick_sim_world.config import PhysicsConfig
+    import yaml
+
+    path = os.path.join(os.path.dirname(__file__), '..', 'config', 'world.yaml')
+    with open(path, encoding='utf-8') as f:
+        stated = yaml.safe_load(f)['/**']['ros__parameters']
+    names = {'max_settle_time': 'settle.max_time', 'settle_freeze': 'settle.freeze'}
+    default = PhysicsConfig()
+    for field in fields(PhysicsConfig):
+        name = names.get(field.name) or (
+            f'settle.{field.name[len("settle_"):]}' if field.name.startswith('settle_')
+            else f'physics.{field.name}')
+        if name in stated or name.startswith('physics.'):
+            assert stated.get(name) == pytest.approx(getattr(default, field.name)), name
