@@ -31,6 +31,7 @@ Runs are spread over a process per CPU. What it costs: docs/physics.md, "Converg
 
 import argparse
 from dataclasses import replace
+import json
 import multiprocessing
 import os
 import statistics
@@ -84,8 +85,11 @@ def _feeder(part_file: str, optimal_range: list[int]) -> tuple:
 
 
 WORKLOADS = {
+    # the sweeps at their three counts only: a sweep whose fit peaks at its last count goes on
+    # (extend), and the settings would not share their counts
     'sweep': ('pth0.yaml', lambda n: [{'id': 'sweep', 'type': 'table_sweep', 'iterations': n,
-                                       'counts': {'first': 30, 'last': 90, 'step': 30}}],
+                                       'counts': {'first': 30, 'last': 90, 'step': 30},
+                                       'extend': False}],
               ('valid', 'tunnelled', 'max_penetration', 'wall_time')),
     'feeder': _feeder('pth0.yaml', [80, 90]),
     # the other parts' feeder runs (the reduced test case's optimal ranges)
@@ -114,11 +118,11 @@ WORKLOADS = {
                       ('candidates', 'container_free', 'unsettled', 'tunnelled',
                        'max_penetration', 'wall_time')),
     'sweep-pth1': ('pth1.yaml', lambda n: [{'id': 'sweep', 'type': 'table_sweep',
-                                            'iterations': n,
+                                            'iterations': n, 'extend': False,
                                             'counts': {'first': 20, 'last': 60, 'step': 20}}],
                    ('candidates', 'valid', 'tunnelled', 'max_penetration', 'wall_time')),
     'sweep-pth2': ('pth2.yaml', lambda n: [{'id': 'sweep', 'type': 'table_sweep',
-                                            'iterations': n,
+                                            'iterations': n, 'extend': False,
                                             'counts': {'first': 20, 'last': 60, 'step': 20}}],
                    ('candidates', 'valid', 'tunnelled', 'max_penetration', 'wall_time')),
 }
@@ -152,9 +156,11 @@ def value(row: dict, column: str) -> float:
     return float(row[column])
 
 
-def interval(values: list[float]) -> tuple[float, float]:
+def interval(values: list[float]) -> tuple[float, float] | None:
     """Mean and the half width of its 95 % confidence interval (metrics.interval; 0 for one
-    value)."""
+    value); None for no value."""
+    if not values:
+        return None
     low, high = metrics.interval(values)
     return statistics.fmean(values), 0.0 if low is None else (high - low) / 2
 
@@ -166,6 +172,9 @@ def main() -> None:
     parser.add_argument('--settings', default=','.join(SETTINGS),
                         help='comma-separated names of SETTINGS')
     parser.add_argument('--finest', default=FINEST, help='the reference setting')
+    parser.add_argument('--rows', default='',
+                        help="a JSON file the runs' rows are written to, or read from when it "
+                             'exists (the tables again without running)')
     args = parser.parse_args()
     workloads = args.workloads.split(',')
     unknown = set(args.settings.split(',') + [args.finest]) - set(SETTINGS)
@@ -173,11 +182,18 @@ def main() -> None:
         parser.error(f'--settings: unknown {sorted(unknown)}; known: {", ".join(SETTINGS)}')
     settings = [s for s in SETTINGS if s in args.settings.split(',') or s == args.finest]
     jobs = [(s, w, args.seeds) for w in workloads for s in settings]
-    start = time.perf_counter()
-    with multiprocessing.Pool(min(len(jobs), os.cpu_count() or 1)) as pool:
-        results = pool.map(job, jobs, chunksize=1)
-    print(f'{len(jobs)} jobs, {args.seeds} seeds per group, '
-          f'{(time.perf_counter() - start) / 60:.1f} min wall on {os.cpu_count()} CPUs')
+    if args.rows and os.path.exists(args.rows):
+        with open(args.rows, encoding='utf-8') as f:
+            results = [tuple(r) for r in json.load(f)]
+    else:
+        start = time.perf_counter()
+        with multiprocessing.Pool(min(len(jobs), os.cpu_count() or 1)) as pool:
+            results = pool.map(job, jobs, chunksize=1)
+        print(f'{len(jobs)} jobs, {args.seeds} seeds per group, '
+              f'{(time.perf_counter() - start) / 60:.1f} min wall on {os.cpu_count()} CPUs')
+        if args.rows:
+            with open(args.rows, 'w', encoding='utf-8') as f:
+                json.dump(results, f, default=str)
     by = {(s, w): rows for s, w, rows in results}
     for w in workloads:
         columns = WORKLOADS[w][2]
@@ -191,9 +207,12 @@ def main() -> None:
             for s in settings:
                 cells = []
                 for c in columns:
-                    mean, half = interval([value(r, c) for r in by[(s, w)]
-                                           if int(r['group']) == g])
-                    far = c in finest and c != 'wall_time' and \
+                    got = interval([value(r, c) for r in by[(s, w)] if int(r['group']) == g])
+                    if got is None:         # a group this setting did not run
+                        cells.append('-')
+                        continue
+                    mean, half = got
+                    far = finest[c] is not None and c != 'wall_time' and \
                         abs(mean - finest[c][0]) > finest[c][1] + 1e-12
                     cells.append(f'{mean:.3g} +- {half:.2g}' + (' *' if far else ''))
                 print(f'| {s} | ' + ' | '.join(cells) + ' |')
