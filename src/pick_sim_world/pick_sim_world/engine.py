@@ -15,9 +15,10 @@ Bullet's own tolerances stay at their values in its units, which is what scaling
 is for. In centimetres: a hull's margin 0.001 units = 0.01 mm (pick_common.parts.insets
 takes it off each hull); the linear slop pybullet sets, 1e-5 units = 0.1 um; the depth past
 which Bullet resolves a contact by split impulses instead of a velocity bias, 0.04 units =
-0.4 mm (btContactSolverInfo's default, which pybullet leaves). The contact-breaking threshold is a factor of each shape's bounding
-radius (btCollisionDispatcher's relative threshold; measured: at 0.001, a 10 mm hull cube
-reports the floor within 0.009 mm in either unit), so it needs no scaling. One velocity is a
+0.4 mm (btContactSolverInfo's default, which pybullet leaves). The contact-breaking
+threshold is a factor of each shape's bounding radius (btCollisionDispatcher's relative
+threshold; measured: at 0.001, a 10 mm hull cube reports the floor within 0.009 mm in either
+unit), so it needs no scaling. One velocity is a
 physical one and is kept in SI: Bullet gives no restitution below 0.2 units/s of approach
 (btContactSolverInfo's restitution velocity threshold); at 0.2 cm/s a part resting on the
 floor, which gravity gives 9.81 m/s^2 x 1/480 s = 20 mm/s each step, would bounce every step,
