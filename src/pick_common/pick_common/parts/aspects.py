@@ -197,9 +197,8 @@ def stable_aspects(mesh: trimesh.Trimesh, centre: Sequence[float]) -> list[Aspec
     taken = set()
     for axis, level, members in sides:
         faces = [i for k in members for i in groups[k]]
-        name = (f'side_{_axis_name(axis, False)}' if level == 0.0 and _axis_name(axis, False)
-                else f'cone_{_axis_name(axis, True)}' if level and _axis_name(axis, True)
-                else None)
+        name = (_axis_name(axis, False) if level == 0.0 else _axis_name(axis, True))
+        name = name and (f'side_{name}' if level == 0.0 else f'cone_{name}')
         name = None if name in taken else name      # two about one axis: numbered
         taken.add(name)
         found.append((name, faces, axis, level))
