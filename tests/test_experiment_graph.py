@@ -113,6 +113,15 @@ def test_the_graph_gives_the_results_of_the_cores(graph_run, core_run):
         assert os.path.exists(os.path.join(run_dir, name)), name
     for name in FILES:
         assert rows(run_dir, name) == rows(core_run, name), name
+    # what the run ran with, every default applied, written once at its start: the report's
+    with open(os.path.join(run_dir, 'resolved.json'), encoding='utf-8') as f:
+        ran = json.load(f)
+    file = experiment_file.load(SMALL)
+    assert ran['gripper'] == {'type': 'jaws', **{
+        k.file_key: round(getattr(file.gripper, k.field) / k.factor, 6)
+        for k in file.gripper.KEYS}}
+    assert [a['name'] for a in ran['part']['aspects']] == [a.name for a in file.aspects]
+    assert ran['tray']['hopper_lip_mm'] == file.tray.drop_height * 1000
 
 
 def test_every_recorded_message_decodes_and_matches_the_results(graph_run):

@@ -94,7 +94,8 @@ def test_a_suction_request_is_checked_with_the_cup_as_the_core_checks_it(check, 
     # the world's capacitors, checked with a 3 mm cup on their flat ends and, lying, at four
     # rolls: the request carries the cup and its grasps; the node answers as the core does
     from pick_validity import conversions as validity_conv
-    from pick_validity.config import SuctionCup, SuctionGrasp
+    from pick_validity.grasps import SuctionGrasp
+    from pick_validity.grippers import SuctionCup
     scene, parts = settled
     cup = SuctionCup(cup_diameter=0.003)
     grasps = (SuctionGrasp('end', (0, 0, 1), (0, 0, 0.0055)),

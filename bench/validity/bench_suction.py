@@ -22,7 +22,9 @@ from pick_common.containers import ContainerSpec
 from pick_common.parts.spec import PartSpec
 from pick_common.specs import SceneSpec
 from pick_sim_world.world import World
-from pick_validity.config import GraspPose, PlaceSpec, Setup, SuctionCup, SuctionGrasp
+from pick_validity.config import PlaceSpec, Setup
+from pick_validity.grasps import GraspPose, SuctionGrasp
+from pick_validity.grippers import SuctionCup
 from pick_validity.naive import naive_check
 from pick_validity.results import (
     STAGE_CANDIDACY,

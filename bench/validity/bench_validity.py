@@ -16,7 +16,8 @@ import time
 from pick_common.containers import ContainerSpec
 from pick_common.specs import SceneSpec
 from pick_sim_world.world import World
-from pick_validity.config import CAPACITOR_GRASPS, Gripper, Setup
+from pick_validity.config import CAPACITOR_GRASPS, Setup
+from pick_validity.grippers import Jaws
 from pick_validity.naive import naive_check
 from pick_validity.validity import Validator
 
@@ -30,7 +31,7 @@ def main() -> None:
     args = parser.parse_args()
     os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
     print(f'pinned to core {sorted(os.sched_getaffinity(0))}; grasps '
-          f'{[g.name for g in CAPACITOR_GRASPS]}, {Gripper()}, tilts -45..45 deg by 5')
+          f'{[g.name for g in CAPACITOR_GRASPS]}, {Jaws()}, tilts -45..45 deg by 5')
     for seed in range(args.seeds):
         with World(SceneSpec(BIN, seed=seed)) as world:
             world.drop(480)

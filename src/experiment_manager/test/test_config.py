@@ -146,7 +146,7 @@ BAD = [
      r"grippers\.jaw_depth_mm\[1\]: 'x' is not a number"),
     (SWEEP + 'grippers: {jaw_width_mm: 3}}\n',
      r'grippers\.jaw_width_mm: 3 is not a known key here \(did you mean jaw_depth_mm\?\) '
-     r'\(known: body_diameter_mm'),
+     r'\(known: acceleration_m_s2, body_diameter_mm'),
     (SWEEP + 'grippers: {body_diameter_mm: [0, 8]}}\n',
      r'grippers \(body_diameter_mm 0, body_length_mm 60, .*\) \(gripper\.body_diameter\): 0'),
     (SWEEP + 'grippers: {body_diameter_mm: [5, 6, 7, 8, 9, 10, 11, 12, 13], '

@@ -5,6 +5,7 @@ import math
 
 from experiment_manager.analysis import decisions
 import numpy as np
+from pick_common.stats import binomial_bounds
 import pytest
 
 
@@ -61,7 +62,7 @@ def test_the_time_ground_decides_on_the_bound_and_says_which():
     # two runs: no fitted bound; the distribution-free one needs 29 runs all within
     two = decisions.table_time(runs[:2], 14400.0, 0.9)
     assert two.verdict == decisions.UNDECIDED and 'fewer than 3 runs' in two.reason
-    assert decisions.binomial_bounds(0, 29)[1] < 0.1 <= decisions.binomial_bounds(0, 28)[1]
+    assert binomial_bounds(0, 29)[1] < 0.1 <= binomial_bounds(0, 28)[1]
     # a run that did not empty: over the interval, the distribution-free bound alone
     stuck = runs + [{'time': math.inf, 'spilled': 0}]
     said = decisions.table_time(stuck, 14400.0, 0.9)

@@ -24,6 +24,7 @@ from feeder_controller.policy import NAMES
 import numpy as np
 from pick_common.errors import InvalidArgument
 from pick_common.states import PartStates
+from pick_common.stats import interval, stats
 from pick_sim_world.stepping import speed_limit
 from pick_validity.results import STAGE_VALID
 import pytest
@@ -163,8 +164,8 @@ def test_the_smallest_gripper_meeting_the_yield_is_chosen_by_size_then_order():
     assert summary(30.0)['smallest'] is None
     # An interval reaching below 0 does not meet even min_valid 0.
     assert not summary(0.0)['variants'][1]['meets']
-    assert metrics.interval([4.0]) == (None, None)
-    assert metrics.interval([4.0, 4.0]) == (4.0, 4.0)
+    assert interval([4.0]) == (None, None)
+    assert interval([4.0, 4.0]) == (4.0, 4.0)
 
 
 def test_runs_are_deterministic_and_independent_of_order(small, tmp_path):
@@ -503,9 +504,9 @@ def test_the_fit_finds_the_maximum_of_a_known_curve():
     # Every count weighs the same, however many iterations it had (an adaptive sweep's).
     uneven = metrics.fit_optimum([1, 1, 1, 1, 2, 3], [0, 0, 0, 4, 3, 1], 1, 3, 1)
     assert np.allclose(uneven['coefficients'], np.polyfit([1, 2, 3], [1, 3, 1], 2))
-    assert metrics.stats([1, 2, 3]) == {'n': 3, 'mean': 2.0, 'min': 1.0, 'max': 3.0,
+    assert stats([1, 2, 3]) == {'n': 3, 'mean': 2.0, 'min': 1.0, 'max': 3.0,
                                         'std': 1.0}
-    assert metrics.stats([])['mean'] is None
+    assert stats([])['mean'] is None
 
 
 def test_the_interval_of_n_star_is_the_row_fits_bootstrap_and_narrows_with_the_draws():

@@ -11,7 +11,9 @@ from pick_common.specs import SceneSpec
 from pick_common.states import rotate
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
-from pick_validity.config import GraspPose, Gripper, PlaceSpec, Setup
+from pick_validity.config import PlaceSpec, Setup
+from pick_validity.grasps import GraspPose
+from pick_validity.grippers import Jaws
 from pick_validity.validity import Validator
 import pytest
 import trimesh
@@ -138,7 +140,7 @@ CAPACITOR_GRASPS = [((1, 0, 0), (0, 1, 0)), ((-1, 0, 0), (0, 1, 0)), ((0, 1, 0),
                     ((0, -1, 0), (1, 0, 0)), ((0, 0, 1), (1, 0, 0))]
 TURN = trimesh.transformations.euler_matrix(0.7, 0.3, -1.2)[:3, :3]
 # the test case's: a 20 mm body with 3 mm deep jaws (pth0.yaml)
-TEST_CASE_GRIPPER = Gripper(body_diameter=0.02, body_length=0.06, jaw_height=0.015,
+TEST_CASE_GRIPPER = Jaws(body_diameter=0.02, body_length=0.06, jaw_height=0.015,
                             jaw_depth=0.003)
 SHIFT = np.array([0.0, 0.02, -0.01])
 

@@ -10,11 +10,11 @@ import shutil
 
 from experiment_manager import experiment_file
 from experiment_manager.analysis import decisions, pictures, report, summary, verdicts
-from experiment_manager.analysis.metrics import rate_interval
 from experiment_manager.analysis.report import Run
 from experiment_manager.analysis.report.table import feeding
 from experiment_manager.analysis.verdicts import FEASIBLE, NOT_ANALYSED, NOT_FEASIBLE, UNDECIDED
-from pick_common.containers import ContainerSpec
+from experiment_manager.experiment_file import resolved
+from pick_common.stats import binomial_bounds, rate_interval
 from pick_validity.results import STAGE_PLACEABILITY
 import pytest
 
@@ -65,16 +65,17 @@ def test_a_run_gets_its_report_files(run_dir):
             'above the pile where it stood higher, onto the feeder zone x -97.5 to -48.75 mm, '
             'y -60 to 60 mm (`feeder_zone_mm`) of the 195 x 150 mm tray with 27 mm walls '
             '(`tray_mm`), the whole shortfall to max* at once (`max_feed` would dose it). The '
-            "file sets no `hopper_lip_mm`, `feeder_zone_mm`, `tray_mm`: those are today's "
-            'defaults, which a run made by an older version may not have had') in text
-    dosed = feeding(ContainerSpec.tray(), 12)
+            'file sets no `hopper_lip_mm`, `feeder_zone_mm`, `tray_mm`: the run took their '
+            'defaults.') in text
+    tray = resolved.read(run_dir)['tray']
+    dosed = feeding(tray, 12)
     assert dosed.endswith('at most 12 parts a feed, the fill to max* going on over several '
                           'vibrations (`max_feed`).')
-    assert feeding(ContainerSpec.tray(), 0, ('hopper_lip_mm',)).endswith(
-        "The file sets no `hopper_lip_mm`: that is today's default, which a run made by an "
-        'older version may not have had (parts arrive from a height since 2026-11-28).')
+    assert feeding(tray, 0, ('hopper_lip_mm',)).endswith(
+        'The file sets no `hopper_lip_mm`: the run took its default.')
     # a header people read, and each verdict coloured by what it says
-    assert 'Part `radial_capacitor`; gripper body diameter 8 mm, jaw depth 3 mm; seed 11.' in text
+    assert ('Part `radial_capacitor`; gripper parallel jaws: body diameter 8 mm, body length '
+            '60 mm, jaw height 15 mm, jaw depth 3 mm, finger clearance 1 mm; seed 11.') in text
     for v in _verdicts(_summary(run_dir)):
         assert f'<strong class="{report.VERDICT_CLASS[v.verdict]}">{v.verdict}</strong>' in page
 
@@ -164,7 +165,7 @@ def test_the_iterations_that_would_decide_a_rate():
     # one-sided: all succeeding, 0.05^(1/n) >= 0.9 from n = 29 (28.4 solves it)
     assert decisions.iterations_to_decide(1, 1, 0.9) == 29
     assert decisions.iterations_to_decide(0, 1, 0.9) == 2     # 0 of 2: at most 0.776
-    assert decisions.binomial_bounds(2, 2)[0] > 0.1 >= decisions.binomial_bounds(1, 1)[0]
+    assert binomial_bounds(2, 2)[0] > 0.1 >= binomial_bounds(1, 1)[0]
     assert decisions.iterations_to_decide(9, 10, 0.9) is None   # the rate seen is the required
     assert decisions.iterations_to_decide(0, 0, 0.9) is None
 

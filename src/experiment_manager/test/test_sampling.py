@@ -19,6 +19,7 @@ from experiment_manager.running.local_backend import LocalBackend
 from experiment_manager.running.scheduler import Runner
 import numpy as np
 from pick_common.errors import InvalidArgument
+from pick_common.stats import difference_bound, interval, rate_interval
 import pytest
 from scipy import stats
 
@@ -117,9 +118,9 @@ def test_a_bin_leaves_the_race_on_its_difference_from_the_leader():
     file, exp = four_bins()
     rows = bin_rows(np.random.default_rng(0), [90, 85, 60, 30], 6)
     share = [[r['container_free'] / 100 for r in rows if r['group'] == g] for g in (0, 1)]
-    ahead, second = (metrics.interval(v, sampling.INTERIM_CONFIDENCE) for v in share)
+    ahead, second = (interval(v, sampling.INTERIM_CONFIDENCE) for v in share)
     assert second[1] >= ahead[0]                                # the intervals overlap
-    assert metrics.difference_bound(share[1], share[0], sampling.RACE_CONFIDENCE) < 0
+    assert difference_bound(share[1], share[0], sampling.RACE_CONFIDENCE) < 0
     assert sampling.race(exp, rows) == ([], [])
 
 
@@ -130,12 +131,12 @@ def test_the_difference_bound_is_welchs_one_sided_test():
     for _ in range(50):
         a, b = rng.normal(0.0, rng.uniform(0.5, 2.0), 6), rng.normal(1.0, 1.0, 9)
         p = stats.ttest_ind(a, b, equal_var=False, alternative='less').pvalue
-        bound = metrics.difference_bound(a, b, 0.99)
+        bound = difference_bound(a, b, 0.99)
         assert (bound < 0) == (p < 0.01)
         t = stats.ttest_ind(a, b, equal_var=False)
         assert bound == pytest.approx(a.mean() - b.mean() + stats.t.ppf(0.99, t.df)
                                       * (a.mean() - b.mean()) / t.statistic)
-    assert metrics.difference_bound([1.0, 1.0], [3.0, 3.0], 0.99) == -2.0
+    assert difference_bound([1.0, 1.0], [3.0, 3.0], 0.99) == -2.0
 
 
 def test_a_race_between_bins_that_tie_within_bin_tie_ends_in_the_tie(monkeypatch):
@@ -274,7 +275,7 @@ def test_an_adaptive_run_stops_a_feeder_study_that_settled_and_keeps_the_fixed_c
     assert rows == runs['fixed'][1][:4]
     assert 'sampling' not in runs['fixed'][0]['experiments']['feeder']
     assert verdicts(validate(summary))[1].verdict == NOT_FEASIBLE
-    assert metrics.rate_interval(0, 4)[1] < 0.9
+    assert rate_interval(0, 4)[1] < 0.9
     # The terminal and the report say how many iterations ran and why they stopped.
     assert '[adaptive: 4 of 6 iterations, settled]' in headlines(validate(summary))[0]
     assert '| `feeder` | 4 | 6 | 2 | settled |' in report.markdown(Run(validate(summary)))

@@ -138,9 +138,10 @@ RESTITUTION = r'experiments\[3\]\.inputs\.materials\.part_on_surface\.restitutio
     ('iterations: 1, of: [feeder], inputs: {materials.part_on_surface.restitution: '
      '{low: 0, high: 1, source: x}}',
      r'experiments\[3\]\.of\[0\]', 'names no earlier experiment'),
+    # the gripper's key's own limit (its kind's table), named at the input
     ('iterations: 1, of: [sweep], inputs: {gripper.jaw_depth_mm: {low: 1, high: 1200, '
-     'source: x}}', r'experiments\[3\]\.inputs \(gripper_jaw_depth_mm_high\) '
-     r'\(gripper\.jaw_depth\)', ''),
+     'source: x}}', r'experiments\[3\]\.inputs\.gripper\.jaw_depth_mm\.high',
+     'must be <= 1000'),
     ('iterations: 1, of: [sweep], inputs: {moves.amplitude_scale: {low: 1, high: 40, '
      'source: x}}', r'experiments\[3\]\.inputs \(moves_amplitude_scale_high\) \(moves\[0\]',
      ''),

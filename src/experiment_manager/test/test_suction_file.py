@@ -57,7 +57,7 @@ def test_check_prints_and_writes_each_grasp_s_seal_and_margin(tmp_path, capsys):
      'lies -0.85 mm'),
     # a jaws' key on a suction grasp, and the reverse
     ('{name: top, up_axis: [0, 0, 1],', "part.grasps[0].jaw_opening_mm (grasp 'top')",
-     "is a jaws' key, and the gripper is type: suction"),
+     'is not a key of a grasp of a suction cup (gripper.type: suction'),
     (('type: suction, cup_diameter_mm: 4', 'type: jaws'),
      "part.grasps[0].closing_axis (grasp 'top')", 'is required with parallel jaws'),
     (('cup_diameter_mm: 4', 'cup_diameter_mm: 4, jaw_depth_mm: 3'), 'gripper.jaw_depth_mm',

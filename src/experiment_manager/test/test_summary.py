@@ -1,6 +1,6 @@
 """summary.json as a typed, versioned model: the schema published in docs is the model's, a run's
 summary.json validates against it by a reader independent of the model (jsonschema), a summary
-of version 0 is read through the one migration, and a summary that breaks the model is refused
+of version 0 or 1 is read through the one migration, and a summary that breaks the model is refused
 before it is written."""
 
 import copy
@@ -67,8 +67,25 @@ def test_a_version_0_summary_is_read_through_the_migration(small, tmp_path):
     assert typed.experiments['feeder'].parts_per_hour.n == 0
     assert typed.experiments['feeder'].decision.time == summary.validate(
         _written(small)).experiments['feeder'].decision.time
-    with pytest.raises(ValueError, match='schema_version 2 is newer than this reader'):
-        summary.migrate({**old, 'schema_version': 2})
+    with pytest.raises(ValueError, match='schema_version 3 is newer than this reader'):
+        summary.migrate({**old, 'schema_version': 3})
+
+
+def test_a_version_1_summary_is_read_through_the_migration(small, tmp_path):
+    # version 1's feeder runs had no first check; the rest is today's
+    old = copy.deepcopy(_written(small))
+    old['schema_version'] = 1
+    del old['experiments']['feeder']['first_check']
+    path = tmp_path / 'summary.json'
+    path.write_text(json.dumps(old))
+    with pytest.raises(pydantic.ValidationError, match='first_check'):
+        summary.validate(old)               # as it is, version 1 is not the current model
+    typed = summary.read(str(path))
+    assert typed.schema_version == 2 == summary.SCHEMA_VERSION
+    assert typed.experiments['feeder'].first_check is None
+    now = summary.validate(_written(small))
+    assert typed.experiments['sweep'] == now.experiments['sweep']
+    assert typed.experiments['feeder'].decision == now.experiments['feeder'].decision
 
 
 def test_a_summary_that_breaks_the_model_is_never_written(small, tmp_path):

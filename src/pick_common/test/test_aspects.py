@@ -8,9 +8,9 @@ from pick_common.parts.aspects import (
     agreement,
     classify,
     OTHER,
-    share_interval,
     stable_aspects,
 )
+from pick_common.stats import wilson_interval
 import pytest
 import trimesh
 
@@ -50,10 +50,10 @@ def test_a_resting_pose_shows_the_aspect_gravity_points_through():
 
 
 def test_the_share_interval_holds_the_share_and_narrows_with_counts():
-    low, high = share_interval(38, 100)
+    low, high = wilson_interval(38, 100)
     assert low < 0.38 < high and high - low == pytest.approx(0.187, abs=0.002)
-    assert share_interval(380, 1000)[1] - share_interval(380, 1000)[0] < high - low
-    assert share_interval(0, 50)[0] == pytest.approx(0.0, abs=1e-12)
+    assert wilson_interval(380, 1000)[1] - wilson_interval(380, 1000)[0] < high - low
+    assert wilson_interval(0, 50)[0] == pytest.approx(0.0, abs=1e-12)
 
 
 def test_agreement_tells_alike_counts_from_different_ones():

@@ -37,20 +37,20 @@ class PhysicsConfig:
     time_step: s. 1/480: at pybullet's 1/240, 480 TO-220s dropped into a 300 x 300 x 26 mm bin
     lean steeper (2.6 % of them tilted past every grasp's tolerance against 1.3 to 1.7 % at
     1/480, 1/960 and 1/1920), and the bin's container-free fraction lies 2 points below the
-    finer steps' (0.908 against 0.926 / 0.930 / 0.927, 12 seeds; bench_lean.py); on a tray at
+    finer steps' (0.908 against 0.926 / 0.930 / 0.927, 12 seeds; studies/lean.py); on a tray at
     1/240 s feeder runs need a quarter more vibrations than at 1/960 s (docs/physics.md, "The
     tray at 1/240 s"). solver_iterations: per step, in a bin.
     tray_solver_iterations: per step, on a tray. 100 keep a bin's deep pile at rest: with 50,
     150 TO-220s settled in a 75 x 75 x 60 mm bin crept (5 seeds: 170 moves > 0.5 mm over three
-    further seconds against 24 at 100; bench_creep.py). Parts on a tray lie about one deep, and
+    further seconds against 24 at 100; studies/creep.py). Parts on a tray lie about one deep, and
     there 50 leave them as still as 100 (90 parts on 195 x 150 mm, 4 seeds of PTH0's and PTH1's
     parts: 3 moves against 5) for two thirds of the time per step, with every answer of the
     tray inside the finest settings' intervals (docs/physics.md, "Iterations on the tray").
     warm_starting_factor: the share of each contact's impulse of the last step the solver starts
     from. 0.85 is Bullet's own default (btContactSolverInfo); pybullet sets 0.1, at which a
-    pile's contacts are re-solved from a tenth each step and piles creep (bench_creep.py); at 1
+    pile's contacts are re-solved from a tenth each step and piles creep (studies/creep.py); at 1
     the solver throws parts: a TO-220 lying still gained 3.6 m/s and 494 rad/s in one step,
-    which the same state solved from a warm start of 0 did not; bench_throws.py counts the parts
+    which the same state solved from a warm start of 0 did not; studies/throws.py counts the parts
     thrown and off the tray per setting (600 moves: 5 off the tray at 1, none at 0.85).
     contact_breaking_threshold: how near two shapes keep a contact, as a factor of each shape's
     bounding radius (Bullet's relative threshold, engine.py: at 0.001 a 10 mm cube reports the

@@ -11,48 +11,33 @@ from dataclasses import dataclass
 
 import fcl
 import numpy as np
-from pick_common.errors import InvalidArgument
 from pick_common.parts.geometry import build_part, PartGeometry
 
-from .config import (
-    check_grasps,
-    check_gripper,
-    check_place,
-    CheckConfig,
-    Grasp,
-    Gripper,
-    is_suction,
-    Setup,
-    SuctionCup,
-    tilts,
-)
-from .geometry import (
-    contains,
-    CylinderShape,
-    gripper_shapes,
-    part_shapes,
-    rotations_about_x,
-    Shape,
-    suction_shapes,
-)
-from .grasp_fit import body_bottom, check_grasps_fit, GraspFit, round_axis
+from .config import check_place, CheckConfig, Setup, tilts
+from .geometry import part_shapes, rotations_about_x, Shape
+from .grasp_fit import GraspFit
+from .grasps import CupGrasp, Grasp
+from .grippers import check_grasps, GripperKind
 from .regrasp import Placement, placements
-from .suction import Holding, holding, Seal, seal
+from .suction import Holding, Seal
 
 
 @dataclass(frozen=True, eq=False)
 class CheckGeometry:
-    """part: the part's geometry; config: the check's settings; gripper; grasps, with
-    grasp_fits (what each one's jaws close on), finger_depths (m below its grasp point) and
-    free_axes (G, 3) (the axis of the round body a grasp closes across, about which it may
-    turn; zeros for a grasp fixed to the part); tilts (T,) rad and tilt_rotations (T, 3, 3)
-    about the gripper's x; place_axis (3,) and seat_offset, m (the placing surface in the part
-    frame); part_shapes; per grasp, the gripper's shapes (jaws, body) and their FCL objects
-    (one per shape, reused by a query that sets its transform)."""
+    """part: the part's geometry; config: the check's settings; gripper, of any kind
+    (grippers.py); grasps, checked by its kind, with grasp_fits (what each one's jaws close
+    on; a cup's: none), finger_depths (m below its grasp point) and free_axes (G, 3) (the axis
+    of the round body a grasp closes across, about which it may turn; zeros for a grasp fixed
+    to the part); tilts (T,) rad and tilt_rotations (T, 3, 3) about the gripper's x (the
+    gripper's kind decides them: a cup has one); place_axis (3,) and seat_offset, m (the
+    placing surface in the part frame); part_shapes; per grasp, the gripper's shapes and their
+    FCL objects (one per shape, reused by a query that sets its transform); usable (G,) bool:
+    the grasps the check may use (a cup's that seals and holds; every jaws' grasp), and a
+    cup's seals and holds per grasp."""
     part: PartGeometry
     config: CheckConfig
-    gripper: Gripper
-    grasps: tuple[Grasp, ...]
+    gripper: GripperKind
+    grasps: tuple[Grasp, ...] | tuple[CupGrasp, ...]
     grasp_fits: tuple[GraspFit, ...]
     tilts: np.ndarray
     tilt_rotations: np.ndarray
@@ -60,107 +45,37 @@ class CheckGeometry:
     seat_offset: float
     part_shapes: tuple[Shape, ...]
     finger_depths: tuple[float, ...]
-    gripper_shapes: tuple[tuple[Shape, Shape], ...]
+    gripper_shapes: tuple[tuple[Shape, ...], ...]
     gripper_objects: tuple[tuple[fcl.CollisionObject, ...], ...]
     free_axes: np.ndarray
-    # a suction cup's: per grasp, its seal and holding (suction.seal, suction.holding); and
-    # per grasp whether the check may use it (a suction grasp that seals and holds; every
-    # jaws' grasp)
+    usable: np.ndarray
     seals: tuple[Seal, ...] = ()
     holds: tuple[Holding, ...] = ()
-    usable: np.ndarray | None = None
     # with a regrasp station (config.regrasp_station): the placements the part rests on
     # there, and from which of them a grasp picks it and places it as required (set by the
     # Validator, which owns the stages); None without a station
     placements: tuple[Placement, ...] = ()
     station_ok: np.ndarray | None = None
 
-    @property
-    def suction(self) -> bool:
-        return is_suction(self.gripper)
-
 
 def build_geometry(setup: Setup, part: PartGeometry | None = None) -> CheckGeometry:
     """The geometry of a setup's checks. `part`: the geometry of setup.part when the caller
     has built it already (the world's); built here otherwise. Raises InvalidArgument for a bad
-    setup or a grasp whose jaws cannot close on the part (grasp_fit)."""
+    setup, or a grasp the gripper cannot use (a jaws' that cannot close on the part:
+    grasp_fit; no cup's that seals and holds)."""
     part = part if part is not None else build_part(setup.part)
-    gripper = check_gripper(setup.gripper)
-    grasps = tuple(check_grasps(list(setup.grasps), gripper))
-    if is_suction(gripper):
-        return _suction_geometry(setup, part, gripper, grasps)
-    fits = check_grasps_fit(part, setup.grasps)
-    place_axis, seat_offset = check_place(setup.place)
+    gripper = setup.gripper.check()
+    grasps = check_grasps(list(setup.grasps), gripper)
     angles = tilts(setup.config)
-    shapes = part_shapes(part)
-    depths = tuple(_finger_depth(part, gripper, g) for g in grasps)
-    jaws = tuple(gripper_shapes(gripper, g.jaw_opening, depth)
-                 for g, depth in zip(grasps, depths, strict=True))
-    return CheckGeometry(
-        placements=_placements(part, setup.config),
-        part=part, config=setup.config, gripper=gripper, grasps=grasps, grasp_fits=fits,
-        tilts=angles, tilt_rotations=rotations_about_x(angles), place_axis=place_axis,
-        seat_offset=seat_offset, part_shapes=shapes, finger_depths=depths,
-        gripper_shapes=jaws,
-        gripper_objects=tuple(tuple(s.fcl_object() for s in pair) for pair in jaws),
-        free_axes=np.stack([_free_axis(part, shapes, g) for g in grasps]))
-
-
-def _placements(part: PartGeometry, config: CheckConfig) -> tuple[Placement, ...]:
-    return placements(part, config.station_margin) if config.regrasp_station else ()
-
-
-def _finger_depth(part: PartGeometry, gripper: Gripper, grasp: Grasp) -> float:
-    """How far below the grasp point the fingertips go, m: to `finger_clearance` above the
-    bottom of the body the jaws close on (grasp_fit.body_bottom), between the grasp point
-    and V below it."""
-    bottom = body_bottom(part, grasp.point, grasp.closing, grasp.up, gripper.jaw_depth,
-                         gripper.jaw_height + gripper.finger_clearance)
-    return min(gripper.jaw_height, max(0.0, bottom - gripper.finger_clearance))
-
-
-def _free_axis(part: PartGeometry, shapes: tuple[Shape, ...], grasp: Grasp) -> np.ndarray:
-    """The axis of a cylinder of the part that holds the grasp point on its axis and that the
-    closing axis crosses at a right angle or runs along (the jaws on its ends), or zeros. A
-    built-in model's cylinders are its primitives; a mesh's are found from its surface
-    (`grasp_fit.round_axis`)."""
-    if part.spec.model == 'mesh':
-        return round_axis(part, grasp.point, grasp.closing, grasp.up)
-    for shape in shapes:
-        axis = shape.rotation[:, 2]
-        off = grasp.point - shape.center
-        along = abs(float(axis @ grasp.closing))      # across the body, or on its two ends
-        if (isinstance(shape, CylinderShape) and contains(shape, grasp.point)
-                and (along < 1e-6 or along > 1 - 1e-9)
-                and np.linalg.norm(off - (off @ axis) * axis) < 1e-9):
-            return axis.copy()
-    return np.zeros(3)
-
-
-def _suction_geometry(setup: Setup, part: PartGeometry, cup: SuctionCup,
-                      grasps: tuple[Grasp, ...]) -> CheckGeometry:
-    """A suction cup's: one approach per grasp, along minus its up axis (the cup is round, so
-    no wrist tilt: `tilts` is [0]); the cup and body as the gripper's shapes; each grasp's
-    seal and holding. Raises InvalidArgument when no grasp both seals and holds, naming
-    each grasp's reason."""
-    tilts(setup.config)                                     # the settings are checked all the same
     place_axis, seat_offset = check_place(setup.place)
-    seals = tuple(seal(part, cup, g) for g in grasps)
-    holds = tuple(holding(part, cup, g) for g in grasps)
-    usable = np.array([s.ok and h.ok for s, h in zip(seals, holds, strict=True)])
-    if not usable.any():
-        why = '; '.join(f'{g.name!r}: ' + (s.reason or f'holds with a margin of only '
-                                              f'{h.margin:.2f}')
-                        for g, s, h in zip(grasps, seals, holds, strict=True))
-        raise InvalidArgument('grasps', [g.name for g in grasps],
-                              f'hold no grasp the cup can use: {why}')
-    cups = tuple(suction_shapes(cup) for _ in grasps)
-    zero = np.zeros(1)
+    shapes = part_shapes(part)
+    grip = gripper.grip(part, tuple(setup.grasps), grasps, angles, shapes)
     return CheckGeometry(
-        placements=_placements(part, setup.config),
-        part=part, config=setup.config, gripper=cup, grasps=grasps, grasp_fits=(),
-        tilts=zero, tilt_rotations=rotations_about_x(zero), place_axis=place_axis,
-        seat_offset=seat_offset, part_shapes=part_shapes(part),
-        finger_depths=tuple(0.0 for _ in grasps), gripper_shapes=cups,
-        gripper_objects=tuple(tuple(s.fcl_object() for s in pair) for pair in cups),
-        free_axes=np.zeros((len(grasps), 3)), seals=seals, holds=holds, usable=usable)
+        placements=placements(part, setup.config.station_margin)
+        if setup.config.regrasp_station else (),
+        part=part, config=setup.config, gripper=gripper, grasps=grasps, grasp_fits=grip.fits,
+        tilts=grip.tilts, tilt_rotations=rotations_about_x(grip.tilts), place_axis=place_axis,
+        seat_offset=seat_offset, part_shapes=shapes, finger_depths=grip.finger_depths,
+        gripper_shapes=grip.shapes,
+        gripper_objects=tuple(tuple(s.fcl_object() for s in pair) for pair in grip.shapes),
+        free_axes=grip.free_axes, usable=grip.usable, seals=grip.seals, holds=grip.holds)

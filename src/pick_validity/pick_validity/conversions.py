@@ -2,6 +2,7 @@
 validity core. Container, part-model and part conversions are pick_common's, reused."""
 
 from collections.abc import Sequence
+from dataclasses import fields
 
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Point, Vector3
@@ -16,17 +17,8 @@ from pick_msgs.msg import PlaceSpec as PlaceSpecMsg
 from pick_msgs.srv import CheckParts
 from std_msgs.msg import Header
 
-from .config import (
-    CheckConfig,
-    GraspPose,
-    Gripper,
-    is_suction,
-    PlaceSpec,
-    Setup,
-    SUCTION_FIELDS,
-    SuctionCup,
-    SuctionGrasp,
-)
+from .config import CheckConfig, PlaceSpec, Setup
+from .grippers import GripperKind, KINDS
 from .results import PartResult, Report
 from .validity import Validator
 
@@ -40,8 +32,35 @@ def request_to_core(request: CheckParts.Request
     return common.container_from_msg(request.container), ids.tolist(), poses, targets
 
 
+# The message's type of each gripper kind (pick_msgs/msg/Gripper.msg).
+MSG_TYPES = {'jaws': GripperMsg.JAWS, 'suction': GripperMsg.SUCTION}
+KIND_OF_MSG = {value: KINDS[kind] for kind, value in MSG_TYPES.items()}
+
+
 def _xyz(v) -> tuple[float, float, float]:
     return float(v.x), float(v.y), float(v.z)
+
+
+def gripper_from_msg(g: GripperMsg, default: GripperKind) -> GripperKind:
+    """The message's gripper, of the kind its type names; one whose kind's fields are all 0
+    is `default` (a request that leaves the gripper empty)."""
+    kind = KIND_OF_MSG.get(g.type)
+    if kind is None:
+        kinds = ' or '.join(f'{value} ({name})' for name, value in MSG_TYPES.items())
+        raise InvalidArgument('gripper.type', g.type, f'must be {kinds}')
+    values = {key.field: getattr(g, key.field) for key in kind.KEYS}
+    return kind(**values) if any(values.values()) else default
+
+
+def gripper_to_msg(gripper: GripperKind) -> GripperMsg:
+    return GripperMsg(type=MSG_TYPES[gripper.kind], **gripper.values())
+
+
+def _written_grasp(gripper: GripperKind, m: GraspPoseMsg):
+    """A request's grasp as the gripper's kind writes it (the message's fields it has)."""
+    values = {'name': m.name, 'up_axis': _xyz(m.up_axis), 'closing_axis': _xyz(m.closing_axis),
+              'jaw_opening': m.jaw_opening, 'grasp_point': _xyz(m.grasp_point)}
+    return gripper.written(**{f.name: values[f.name] for f in fields(gripper.written)})
 
 
 def setup_from_request(request: CheckParts.Request, defaults: Setup,
@@ -50,22 +69,8 @@ def setup_from_request(request: CheckParts.Request, defaults: Setup,
     left empty (all 0 or an empty list) takes the node's default. A mesh file must lie in one
     of `mesh_dirs`. Checked by the core."""
     part = common.part_spec_from_msg(request.part_model, mesh_dirs)
-    g = request.gripper
-    gripper = defaults.gripper
-    if g.type == GripperMsg.SUCTION:
-        gripper = SuctionCup(**{name: getattr(g, name) for name in SUCTION_FIELDS})
-    elif g.type != GripperMsg.JAWS:
-        raise InvalidArgument('gripper.type', g.type, f'must be {GripperMsg.JAWS} (jaws) or '
-                              f'{GripperMsg.SUCTION} (suction)')
-    elif any((g.body_diameter, g.body_length, g.jaw_height, g.jaw_depth)):
-        gripper = Gripper(g.body_diameter, g.body_length, g.jaw_height, g.jaw_depth,
-                          g.finger_clearance)
-    if is_suction(gripper):
-        grasps = tuple(SuctionGrasp(m.name, _xyz(m.up_axis), _xyz(m.grasp_point))
-                       for m in request.grasps) or defaults.grasps
-    else:
-        grasps = tuple(GraspPose(m.name, _xyz(m.up_axis), _xyz(m.closing_axis), m.jaw_opening,
-                                 _xyz(m.grasp_point)) for m in request.grasps) or defaults.grasps
+    gripper = gripper_from_msg(request.gripper, defaults.gripper)
+    grasps = tuple(_written_grasp(gripper, m) for m in request.grasps) or defaults.grasps
     place = defaults.place
     if any(_xyz(request.place.place_axis)):
         place = PlaceSpec(_xyz(request.place.place_axis), request.place.seat_offset)
@@ -82,18 +87,8 @@ def setup_to_request(setup: Setup, request: CheckParts.Request) -> CheckParts.Re
     """Fill a request's part model, gripper, grasps, placement and settings from a Setup."""
     g, p, c = setup.gripper, setup.place, setup.config
     request.part_model = common.part_spec_to_msg(setup.part)
-    if is_suction(g):
-        request.gripper = GripperMsg(type=GripperMsg.SUCTION,
-                                     **{name: getattr(g, name) for name in SUCTION_FIELDS})
-        request.grasps = [_grasp_msg(x.name, x.up_axis, (0.0, 0.0, 0.0), 0.0, x.grasp_point)
-                          for x in setup.grasps]
-    else:
-        request.gripper = GripperMsg(type=GripperMsg.JAWS, body_diameter=g.body_diameter,
-                                     body_length=g.body_length, jaw_height=g.jaw_height,
-                                     jaw_depth=g.jaw_depth,
-                                     finger_clearance=g.finger_clearance)
-        request.grasps = [_grasp_msg(x.name, x.up_axis, x.closing_axis, x.jaw_opening,
-                                     x.grasp_point) for x in setup.grasps]
+    request.gripper = gripper_to_msg(g)
+    request.grasps = [_written_grasp_msg(x) for x in setup.grasps]
     request.place = PlaceSpecMsg(place_axis=Vector3(x=p.place_axis[0], y=p.place_axis[1],
                                                     z=p.place_axis[2]),
                                  seat_offset=p.seat_offset)
@@ -116,6 +111,14 @@ def _grasp_msg(name, up, closing, opening, point) -> GraspPoseMsg:
                                           z=float(point[2])))
 
 
+def _written_grasp_msg(grasp) -> GraspPoseMsg:
+    """A written grasp of any kind as a message; the fields its kind does not have, 0."""
+    v = {'closing_axis': (0.0, 0.0, 0.0), 'jaw_opening': 0.0,
+         **{f.name: getattr(grasp, f.name) for f in fields(grasp)}}
+    return _grasp_msg(v['name'], v['up_axis'], v['closing_axis'], v['jaw_opening'],
+                      v['grasp_point'])
+
+
 def report_to_msg(report: Report, validator: Validator, stamp: Time, frame_id: str,
                   instance: int) -> ValidityReport:
     msg = ValidityReport(header=Header(stamp=stamp, frame_id=frame_id), instance=instance,
@@ -132,8 +135,9 @@ def report_to_msg(report: Report, validator: Validator, stamp: Time, frame_id: s
                             jaw_opening=float(r.jaw_opening), valid_tilts=list(r.valid_tilts),
                             regrasp=r.regrasp)
         if r.grasp_index >= 0:
-            g = validator.grasps[r.grasp_index]
-            item.grasp = _grasp_msg(g.name, g.up, g.closing, g.jaw_opening, g.point)
+            geo = validator.geometry
+            g = geo.grasps[r.grasp_index]
+            item.grasp = _grasp_msg(g.name, g.up, g.closing, geo.gripper.width(g), g.point)
         if r.gripper_pose is not None:
             item.gripper_pose = common.pose_msg(r.gripper_pose[:3], r.gripper_pose[3:])
         msg.results.append(item)

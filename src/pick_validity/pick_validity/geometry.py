@@ -17,8 +17,6 @@ from pick_common.parts.primitives import Box, Cylinder
 from scipy.spatial import Delaunay
 import trimesh
 
-from .config import Gripper, SuctionCup
-
 
 @dataclass(frozen=True, eq=False)
 class Shape:
@@ -117,34 +115,6 @@ def part_shapes(part: PartGeometry) -> tuple[Shape, ...]:
             shapes.append(HullShape(rotation, center, _convex(p.vertices, p.faces),
                                     p.vertices))
     return tuple(shapes)
-
-
-def gripper_shapes(gripper: Gripper, opening: float, depth: float
-                   ) -> tuple[BoxShape, CylinderShape]:
-    """The jaws' workspace cuboid (U x W x V, z from -depth to V - depth: the fingertips
-    `depth` below the grasp point) and the body cylinder (diameter D, from V - depth up
-    body_length), in the gripper frame: origin at the grasp point (the point the jaws close
-    on), x along the closing direction, z up the gripper."""
-    v, length = gripper.jaw_height, gripper.body_length
-    jaws = BoxShape(np.eye(3), np.array([0.0, 0.0, v / 2 - depth]),
-                    fcl.Box(opening, gripper.jaw_depth, v),
-                    np.array([opening / 2, gripper.jaw_depth / 2, v / 2]))
-    body = CylinderShape(np.eye(3), np.array([0.0, 0.0, v - depth + length / 2]),
-                         fcl.Cylinder(gripper.body_diameter / 2, length),
-                         gripper.body_diameter / 2, length / 2)
-    return jaws, body
-
-
-def suction_shapes(cup: SuctionCup) -> tuple[CylinderShape, CylinderShape]:
-    """The cup (diameter cup_diameter, from its rim at the grasp point up cup_height) and
-    the body cylinder above it, in the gripper frame: origin at the grasp point, z up the
-    gripper (the grasp's up axis)."""
-    r, h, length = cup.cup_diameter / 2, cup.cup_height, cup.body_length
-    lip = CylinderShape(np.eye(3), np.array([0.0, 0.0, h / 2]), fcl.Cylinder(r, h), r, h / 2)
-    body = CylinderShape(np.eye(3), np.array([0.0, 0.0, h + length / 2]),
-                         fcl.Cylinder(cup.body_diameter / 2, length), cup.body_diameter / 2,
-                         length / 2)
-    return lip, body
 
 
 def contains(shape: Shape, point: np.ndarray) -> bool:

@@ -19,7 +19,7 @@ from pick_common.errors import InvalidArgument
 from pick_common.parts.geometry import PartGeometry
 from pick_common.parts.primitives import Hull
 
-from .config import GraspPose
+from .grasps import GraspPose
 
 TOLERANCE = 1e-6        # m: a grasp point this near the surface is on it
 

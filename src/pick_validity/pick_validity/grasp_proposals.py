@@ -28,8 +28,9 @@ from pick_common.parts.aspects import part_aspects
 from pick_common.parts.geometry import PartGeometry
 import trimesh
 
-from .config import check_grasps, GraspPose, SuctionCup, SuctionGrasp
 from .grasp_fit import crossings, round_axis, surface
+from .grasps import GraspPose, SuctionGrasp
+from .grippers import check_grasps, SuctionCup
 from .suction import holding, seal
 
 # 3 mm on each side of the part: the margin of every grasp of the project's test case
@@ -103,7 +104,7 @@ def propose(part: PartGeometry, margin: float = JAW_MARGIN) -> tuple[Proposal, .
     closing direction horizontal; and across each round body, one grasp that the check turns
     with the body's roll (`Validator.free_axes`), lying on its side, plus one per flat end it
     can stand on; on a round body's two ends, lying, one grasp, which turns the same way."""
-    centre = part.mass_frame[0] if part.mass_frame is not None else np.zeros(3)
+    centre = part.mass_centre
     centre = np.round(centre / ROUNDING) * ROUNDING
     faces, principal = _directions(part)
     # round bodies: an axis it is round about (the frame's axes where they are, else the
@@ -171,7 +172,7 @@ def propose_suction(part: PartGeometry, cup: SuctionCup) -> tuple[Proposal, ...]
     if found:
         return found
     for share in (0.75, 0.5, 0.25):
-        smaller = SuctionCup(**{**cup.__dict__, 'cup_diameter': share * cup.cup_diameter})
+        smaller = cup.with_values(cup_diameter=share * cup.cup_diameter)
         if _cup_grasps(part, smaller):
             fits = f'a {smaller.cup_diameter * 1000:g} mm cup would seal on it'
             break
@@ -183,7 +184,7 @@ def propose_suction(part: PartGeometry, cup: SuctionCup) -> tuple[Proposal, ...]
 
 
 def _cup_grasps(part: PartGeometry, cup: SuctionCup) -> tuple[Proposal, ...]:
-    centre = part.mass_frame[0] if part.mass_frame is not None else np.zeros(3)
+    centre = part.mass_centre
     triangles = surface(part)
     step = cup.cup_diameter / 4
     reach = int(np.ceil(part.radius / step))
@@ -231,19 +232,4 @@ def _cup_ups(part: PartGeometry) -> list[np.ndarray]:
 
 def as_yaml(proposals: tuple[Proposal, ...]) -> list[str]:
     """The proposals as the lines of `part.grasps` in an experiment file (mm)."""
-    def vector(v, digits):
-        return '[' + ', '.join(f'{x:.{digits}g}' if digits else f'{x:g}' for x in v) + ']'
-    lines = ['  grasps:']
-    for p in proposals:
-        g = p.grasp
-        if isinstance(g, SuctionGrasp):
-            point = ', '.join(f'{v * 1000:.2f}' for v in g.grasp_point)
-            lines.append(f'    - {{name: {g.name}, up_axis: {vector(g.up_axis, 4)}, '
-                         f'grasp_point_mm: [{point}]}}   # seals within '
-                         f'{p.width * 1000:.2f} mm of a plane')
-            continue
-        lines.append(f'    - {{name: {g.name}, up_axis: {vector(g.up_axis, 4)}, closing_axis: '
-                     f'{vector(g.closing_axis, 4)}, jaw_opening_mm: {g.jaw_opening * 1000:.2f}, '
-                     f'grasp_point_mm: [{", ".join(f"{v * 1000:.2f}" for v in g.grasp_point)}]}}'
-                     f'   # closes on {p.width * 1000:.2f} mm')
-    return lines
+    return ['  grasps:'] + [f'    - {p.grasp.as_yaml(p.width)}' for p in proposals]

@@ -13,7 +13,7 @@ from pick_common.containers import ContainerSpec
 from scipy.spatial.transform import Rotation
 
 from .check_geometry import CheckGeometry
-from .geometry import collide, gripper_shapes, quaternions_to_matrices, suction_shapes
+from .geometry import collide, quaternions_to_matrices
 from .results import (
     CENTRE_TOLERANCE,
     check_poses,
@@ -69,34 +69,27 @@ def naive_check(geometry: CheckGeometry, container: ContainerSpec, ids: Sequence
             turns.append(turn)
             turned.append(rotation @ Rotation.from_rotvec(turn * a).as_matrix())
         angles = [math.acos(max(-1.0, min(1.0, float((r @ g.up)[2]))))
-                  if v.usable is None or v.usable[k] else math.pi      # a cup that cannot seal
+                  if v.usable[k] else math.pi      # a cup's grasp that cannot seal or hold
                   for k, (g, r) in enumerate(zip(v.grasps, turned, strict=True))]
         g = min((k for k in range(len(angles)) if angles[k] <= min(angles) + TIE),
                 key=lambda k: (abs(turns[k]), k))
         grasp, gripped = v.grasps[g], turned[g]
         result = PartResult(ids[row], STAGE_CANDIDACY, '', g, angles[g],
-                            jaw_opening=grasp.jaw_opening)
+                            jaw_opening=v.gripper.width(grasp))
         results.append(result)
         if angles[g] > v.config.tolerance:
             result.grasp_index = -1
             continue
         closing = gripped @ grasp.closing
-        if v.suction:       # the cup along the grasp's up axis, its x the grasp's closing
-            shapes = suction_shapes(v.gripper)
-            up = gripped @ grasp.up
-            frames = [np.column_stack([closing, np.cross(up, closing), up])]
-        else:
-            shapes = gripper_shapes(v.gripper, grasp.jaw_opening, v.finger_depths[g])
-            # the vertical made perpendicular to the closing axis, turned by each tilt about it
-            axis = np.array([0.0, 0.0, 1.0]) - closing[2] * closing
-            if np.linalg.norm(axis) < 1e-9:
-                axis = gripped @ grasp.up
-            axis /= np.linalg.norm(axis)
-            side = np.cross(axis, closing)
-            frames = []
-            for tilt in v.tilts:
-                up = math.cos(tilt) * axis - math.sin(tilt) * side
-                frames.append(np.column_stack([closing, np.cross(up, closing), up]))
+        shapes = v.gripper.shapes(grasp, v.finger_depths[g])
+        # the gripper's axis as its kind takes it (the jaws': the vertical made perpendicular
+        # to the closing axis; the cup's: the grasp's up axis), turned by each tilt about x
+        axis = v.gripper.approach(closing[None], gripped[None], grasp.up[None])[0]
+        side = np.cross(axis, closing)
+        frames = []
+        for tilt in v.tilts:
+            up = math.cos(tilt) * axis - math.sin(tilt) * side
+            frames.append(np.column_stack([closing, np.cross(up, closing), up]))
         objects = [s.fcl_object() for s in shapes]
         approach = [k for k, f in enumerate(frames)
                     if f[2, 2] >= math.cos(v.config.approach_cone) - 1e-12]

@@ -20,7 +20,7 @@ import numpy as np
 from pick_common.parts.geometry import PartGeometry
 from scipy.spatial import ConvexHull, QhullError
 
-from .config import perpendicular
+from .grasps import perpendicular
 
 PLANE_TOLERANCE = 1e-7      # m: hull vertices this near a face's plane touch the station
 
@@ -40,7 +40,7 @@ def placements(part: PartGeometry, margin: float) -> tuple[Placement, ...]:
     """The hull faces the part rests on with d / h of at least `margin`, steadiest first."""
     hull = part.visual.convex_hull
     vertices = np.asarray(hull.vertices)
-    centre = part.mass_frame[0] if part.mass_frame is not None else np.zeros(3)
+    centre = part.mass_centre
     found = []
     for n in np.unique(np.round(hull.face_normals, 6), axis=0):
         n = n / np.linalg.norm(n)

@@ -29,12 +29,16 @@ Pure: no rclpy, no simulator. Units: m, kg, Pa; the part frame.
 
 from dataclasses import dataclass
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 from pick_common.parts.geometry import PartGeometry
 
-from .config import Grasp, perpendicular, SuctionCup
 from .grasp_fit import crossings, surface
+from .grasps import CupGrasp, perpendicular
+
+if TYPE_CHECKING:
+    from .grippers import SuctionCup
 
 RIM_POINTS = 32
 INNER_RINGS = (0.0, 0.3, 0.6, 0.85)     # shares of the cup's radius cast inside the rim
@@ -95,7 +99,7 @@ def _heights(triangles: np.ndarray, points: np.ndarray, up: np.ndarray, top: flo
     return out
 
 
-def seal(part: PartGeometry, cup: SuctionCup, grasp: Grasp) -> Seal:
+def seal(part: PartGeometry, cup: 'SuctionCup', grasp: CupGrasp) -> Seal:
     """Does the cup's rim seal on the part at `grasp` (module docstring)."""
     triangles = surface(part)
     up, point = grasp.up, grasp.point
@@ -147,9 +151,9 @@ def seal(part: PartGeometry, cup: SuctionCup, grasp: Grasp) -> Seal:
     return Seal('', deviation, give, rim)
 
 
-def holding(part: PartGeometry, cup: SuctionCup, grasp: Grasp) -> Holding:
+def holding(part: PartGeometry, cup: 'SuctionCup', grasp: CupGrasp) -> Holding:
     """The cup's holding force and margin at `grasp` (module docstring)."""
-    centre = part.mass_frame[0] if part.mass_frame is not None else np.zeros(3)
+    centre = part.mass_centre
     radius = cup.cup_diameter / 2
     force = cup.vacuum * math.pi * radius ** 2
     m = part.mass

@@ -68,9 +68,8 @@ class Validator:
 
     Build once and reuse: the geometry every check shares (check_geometry.CheckGeometry: part
     and gripper shapes, how deep each grasp's fingers reach, the round bodies a grasp may turn
-    about) is computed here, never per part; its fields read as the Validator's own
-    (`validator.grasps` is `validator.geometry.grasps`). Only the Validator writes a part's
-    stage and reason.
+    about) is computed here, never per part, and read as `validator.geometry`. Only the
+    Validator writes a part's stage and reason.
     """
 
     def __init__(self, setup: Setup, part: PartGeometry | None = None) -> None:
@@ -82,22 +81,15 @@ class Validator:
         if setup.config.regrasp_station:
             self.geometry = replace(self.geometry, station_ok=self._station_ok())
 
-    def __getattr__(self, name: str):
-        """The shared geometry's fields, read-only (only called for names the Validator itself
-        lacks)."""
-        if name == 'geometry':      # not built yet: no recursion through the geometry
-            raise AttributeError(name)
-        return getattr(self.geometry, name)
-
     def turned(self, rotations: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """For parts at rotations (n, 3, 3): each grasp's angle from world +Z (n, G) once
         turned about its free axis to the most vertical, and that turn (n, G), rad (0 for a
         fixed grasp). With w the world +Z in the part frame and u the up axis, a turn t about
         the unit axis a gives the up axis a height of A cos t + B sin t + C, where
         A = w.u - (a.u)(a.w), B = w.(a x u), C = (a.u)(a.w): largest at t = atan2(B, A)."""
-        ups = np.stack([g.up for g in self.grasps])                     # (G, 3)
+        ups = np.stack([g.up for g in self.geometry.grasps])                     # (G, 3)
         w = rotations[:, 2, :]                                          # (n, 3)
-        a = self.free_axes
+        a = self.geometry.free_axes
         au = np.einsum('gk,gk->g', a, ups)
         aw = w @ a.T                                                    # (n, G)
         big_a = w @ ups.T - au * aw
@@ -122,7 +114,7 @@ class Validator:
                         turn: np.ndarray) -> np.ndarray:
         """The part rotations (n, 3, 3) as the gripper takes them: turned by `turn` (n,) about
         the free axis of each part's grasp (Rodrigues)."""
-        a = self.free_axes[grasp_index]                                 # (n, 3)
+        a = self.geometry.free_axes[grasp_index]                                 # (n, 3)
         k = np.zeros((len(a), 3, 3))
         k[:, 0, 1], k[:, 0, 2], k[:, 1, 2] = -a[:, 2], a[:, 1], -a[:, 0]
         k -= np.swapaxes(k, 1, 2)
@@ -133,24 +125,18 @@ class Validator:
         """The gripper's rotations in the container frame, (n, T, 3, 3), for parts at
         rotations (n, 3, 3) held with the grasps `grasp_index` (n,), at every tilt: x along the
         part's closing axis, z the most vertical axis perpendicular to it, turned by the tilt
-        about x."""
-        closing = np.stack([g.closing for g in self.grasps])[grasp_index]
-        up = np.stack([g.up for g in self.grasps])[grasp_index]
+        about x (the gripper's kind says which is its axis: `approach`)."""
+        geo = self.geometry
+        closing = np.stack([g.closing for g in geo.grasps])[grasp_index]
+        up = np.stack([g.up for g in geo.grasps])[grasp_index]
         x = np.einsum('nij,nj->ni', rotations, closing)
-        if self.suction:        # the cup's axis is the grasp's up axis; no tilt
-            z = np.einsum('nij,nj->ni', rotations, up)
-            return np.stack([x, np.cross(z, x), z], axis=-1)[:, None] @ self.tilt_rotations[None]
-        z = np.array([0.0, 0.0, 1.0]) - x[:, 2:3] * x
-        norm = np.linalg.norm(z, axis=1)
-        flat = norm < 1e-9         # a vertical closing axis: no approach within any cone
-        z[flat] = np.einsum('nij,nj->ni', rotations[flat], up[flat])
-        z /= np.linalg.norm(z, axis=1, keepdims=True)
+        z = geo.gripper.approach(x, rotations, up)
         base = np.stack([x, np.cross(z, x), z], axis=-1)
-        return base[:, None] @ self.tilt_rotations[None]
+        return base[:, None] @ self.geometry.tilt_rotations[None]
 
     def _approachable(self, frames: np.ndarray) -> np.ndarray:
         """(n, T) bool: the gripper's axis lies within the approach cone of world +Z."""
-        return frames[..., 2, 2] >= math.cos(self.config.approach_cone) - 1e-12
+        return frames[..., 2, 2] >= math.cos(self.geometry.config.approach_cone) - 1e-12
 
     def _placeable(self, rotations: np.ndarray, frames: np.ndarray,
                    grasp_index: np.ndarray, axis: np.ndarray | None = None,
@@ -159,16 +145,16 @@ class Validator:
         as it picked it stays on the gripper's side of the seating plane. Decided in the part
         frame, where the place orientation only fixes the seating plane: `axis` . x =
         `offset` (the place's; a station placement's when given)."""
-        axis = self.place_axis if axis is None else axis
-        offset = self.seat_offset if offset is None else offset
+        axis = self.geometry.place_axis if axis is None else axis
+        offset = self.geometry.seat_offset if offset is None else offset
         n, count = frames.shape[:2]
         relative = (np.swapaxes(rotations, 1, 2)[:, None] @ frames).reshape(-1, 3, 3)
-        points = np.stack([g.point for g in self.grasps])[grasp_index]
+        points = np.stack([g.point for g in self.geometry.grasps])[grasp_index]
         origin = np.repeat(points, count, axis=0)
         clear = np.ones(n * count, dtype=bool)
         for g in np.unique(grasp_index):
             sel = np.repeat(grasp_index == g, count)
-            for shape in self.gripper_shapes[g]:
+            for shape in self.geometry.gripper_shapes[g]:
                 r, c = place(shape, relative[sel], origin[sel])
                 clear[sel] &= support(shape, r, c, axis) < offset
         return clear.reshape(n, count)
@@ -177,17 +163,16 @@ class Validator:
         """(P,) bool, per station placement (regrasp.py): the part resting on it, its
         nearest usable grasp within the tolerance picks it at a tilt within the approach cone
         that keeps the gripper clear of the station and places it as required."""
-        found = self.placements
+        found = self.geometry.placements
         if not found:
             return np.zeros(0, dtype=bool)
         down = np.array([0.0, 0.0, -1.0])
         rotations = np.stack([turn_onto(p.normal, down) for p in found])
         angles, turns = self.turned(rotations)
-        if self.usable is not None:
-            angles = np.where(self.usable, angles, math.pi)
+        angles = np.where(self.geometry.usable, angles, math.pi)
         best = nearest_grasp(angles, turns)
         frames = self.approach_frames(rotations, best, turns)
-        ok = (angles[np.arange(len(found)), best] <= self.config.tolerance)[:, None] \
+        ok = (angles[np.arange(len(found)), best] <= self.geometry.config.tolerance)[:, None] \
             & self._approachable(frames) & self._placeable(rotations, frames, best)
         for k, p in enumerate(found):
             ok[k] &= self._placeable(rotations[k:k + 1], frames[k:k + 1], best[k:k + 1],
@@ -200,7 +185,7 @@ class Validator:
         station placement it can be picked from again (station_ok) without reaching past the
         station's surface."""
         out = np.zeros(frames.shape[:2], dtype=bool)
-        for p, ok in zip(self.placements, self.station_ok, strict=True):
+        for p, ok in zip(self.geometry.placements, self.geometry.station_ok, strict=True):
             if ok:
                 out |= self._placeable(rotations, frames, grasp_index, p.normal, p.offset)
         return out
@@ -221,27 +206,27 @@ class Validator:
         queries = 0
 
         # 0. location.
-        centres = positions[rows] + rotations[rows] @ self.part.center
+        centres = positions[rows] + rotations[rows] @ self.geometry.part.center
         located = containers.inside(container, centres, CENTRE_TOLERANCE,
-                                    self.config.rim_tolerance)
+                                    self.geometry.config.rim_tolerance)
         for n in np.flatnonzero(~located):
             row = rows[n]
             results[row] = PartResult(ids[row], STAGE_OUTSIDE, _outside_reason(
-                container, centres[n], self.config.rim_tolerance))
+                container, centres[n], self.geometry.config.rim_tolerance))
         inner = [row for row, ok in zip(rows, located, strict=True) if ok]
 
         # 1. candidacy, vectorised over targets and grasps (turned on round bodies); a
         # suction grasp that does not seal or hold is never chosen.
         angles, turns = self.turned(rotations[inner])                   # (n, G)
-        if self.usable is not None:
-            unusable = angles[:, ~self.usable]
-            angles = np.where(self.usable, angles, math.pi)
+        geo = self.geometry
+        unusable = angles[:, ~geo.usable]
+        angles = np.where(geo.usable, angles, math.pi)
         best = nearest_grasp(angles, turns)
         frames = self.approach_frames(rotations[inner], best, turns)    # (n, T, 3, 3)
         approach = self._approachable(frames)
         placeable = self._placeable(rotations[inner], frames, best) & approach
         station = np.zeros_like(approach)     # only for parts no tilt places as picked
-        if self.station_ok is not None:
+        if self.geometry.station_ok is not None:
             need = np.flatnonzero(~placeable.any(axis=1) & approach.any(axis=1))
             station[need] = self._put_down(rotations[inner][need], frames[need],
                                            best[need]) & approach[need]
@@ -250,19 +235,19 @@ class Validator:
         for n, row in enumerate(inner):
             g, angle = int(best[n]), float(angles[n, best[n]])
             result = PartResult(ids[row], STAGE_CANDIDACY, '', g, angle,
-                                jaw_opening=self.grasps[g].jaw_opening)
+                                jaw_opening=geo.gripper.width(geo.grasps[g]))
             results[row] = result
-            if angle > self.config.tolerance:
+            if angle > geo.config.tolerance:
                 result.grasp_index = -1
-                result.reason = (f'no grasp pose within {_deg(self.config.tolerance)} of +Z: '
-                                 f'the nearest, {self.grasps[g].name!r}, is at {_deg(angle)}')
-                if self.usable is not None and (unusable[n] <= self.config.tolerance).any():
+                result.reason = (f'no grasp pose within {_deg(geo.config.tolerance)} of +Z: '
+                                 f'the nearest, {geo.grasps[g].name!r}, is at {_deg(angle)}')
+                if (unusable[n] <= geo.config.tolerance).any():
                     result.reason += self._unusable_near(unusable[n])
                 continue
             if not approach[n].any():
                 rise = math.asin(min(1.0, abs(float(frames[n, 0, 2, 0]))))
-                result.reason = (f'grasp {self.grasps[g].name!r}: no wrist tilt approaches '
-                                 f'within {_deg(self.config.approach_cone)} of +Z (the '
+                result.reason = (f'grasp {geo.grasps[g].name!r}: no wrist tilt approaches '
+                                 f'within {_deg(geo.config.approach_cone)} of +Z (the '
                                  f'closing axis rises {_deg(rise)})')
                 continue
             # 2. placeability of the tilts within the approach cone; with a station, the
@@ -274,7 +259,7 @@ class Validator:
                 continue
             if not placeable[n].any():
                 result.stage = STAGE_PLACEABILITY
-                result.reason = (f'grasp {self.grasps[g].name!r}: held as it lies, the part '
+                result.reason = (f'grasp {geo.grasps[g].name!r}: held as it lies, the part '
                                  f'cannot be placed: the gripper hits the placing surface at '
                                  f'each of the {int(approach[n].sum())} tilts within the '
                                  f'approach cone')
@@ -304,11 +289,12 @@ class Validator:
     def _unusable_near(self, angles: np.ndarray) -> str:
         """Why the suction grasps within the tolerance (`angles` over the unusable ones, in
         their order) were not used."""
+        geo = self.geometry
         return ''.join(
-            f'; {self.grasps[k].name!r} at {_deg(a)} does not '
-            + ('seal' if not self.seals[k].ok else 'hold')
-            for k, a in zip(np.flatnonzero(~self.usable), angles, strict=True)
-            if a <= self.config.tolerance)
+            f'; {geo.grasps[k].name!r} at {_deg(a)} does not '
+            + ('seal' if not geo.seals[k].ok else 'hold')
+            for k, a in zip(np.flatnonzero(~geo.usable), angles, strict=True)
+            if a <= geo.config.tolerance)
 
     def _close(self, pairs: Pairs, hit: np.ndarray, kept: dict[int, np.ndarray],
                results: dict[int, PartResult], stage: int, why: str,
@@ -322,7 +308,7 @@ class Validator:
             result = results[row]
             if result.stage == STAGE_CANDIDACY and not mask.any():
                 result.stage = stage
-                result.reason = why.format(name=self.grasps[result.grasp_index].name,
+                result.reason = why.format(name=self.geometry.grasps[result.grasp_index].name,
                                            n=int((pairs.row == row).sum()))
                 if touched and row in touched:
                     result.reason += f' (parts {sorted(touched[row])})'
@@ -333,12 +319,12 @@ class Validator:
         g = result.grasp_index
         valid = np.flatnonzero(mask)
         result.stage = STAGE_VALID
-        result.valid_tilts = tuple(float(self.tilts[k]) for k in valid)
-        k = valid[np.abs(self.tilts[valid]).argmin()]
-        origin = position + rotation @ self.grasps[g].point
+        result.valid_tilts = tuple(float(self.geometry.tilts[k]) for k in valid)
+        k = valid[np.abs(self.geometry.tilts[valid]).argmin()]
+        origin = position + rotation @ self.geometry.grasps[g].point
         result.gripper_pose = np.concatenate([origin, matrix_to_quaternion(frames[k])])
-        result.reason = (f'valid with grasp {self.grasps[g].name!r} at {len(valid)} of '
-                         f'{len(self.tilts)} tilts'
+        result.reason = (f'valid with grasp {self.geometry.grasps[g].name!r} at {len(valid)} of '
+                         f'{len(self.geometry.tilts)} tilts'
                          + (', placed after a regrasp on the station' if result.regrasp else ''))
 
 

@@ -12,15 +12,9 @@ from pick_msgs.srv import CheckParts
 from rclpy.node import Node
 
 from . import conversions as conv
-from .config import (
-    CAPACITOR_GRASPS,
-    CheckConfig,
-    GraspPose,
-    Gripper,
-    LIMITS,
-    PlaceSpec,
-    Setup,
-)
+from .config import CAPACITOR_GRASPS, CheckConfig, LIMITS, PlaceSpec, Setup
+from .grasps import GraspPose
+from .grippers import Jaws
 from .validity import Validator
 
 # Validators (part model x gripper, grasps, placing, settings) kept: a gripper_sweep cycles
@@ -48,18 +42,11 @@ class ValidityNode(Node):
         def get(name, default, text, limit=None):
             return declare(self, name, default, text, limit)
 
-        d = Gripper()
-        gripper = Gripper(
-            body_diameter=get('gripper.body_diameter', d.body_diameter, 'D, m',
-                              LIMITS['gripper.body_diameter']),
-            body_length=get('gripper.body_length', d.body_length, 'm',
-                            LIMITS['gripper.body_length']),
-            jaw_height=get('gripper.jaw_height', d.jaw_height, 'V, m',
-                           LIMITS['gripper.jaw_height']),
-            jaw_depth=get('gripper.jaw_depth', d.jaw_depth, 'W, m', LIMITS['gripper.jaw_depth']),
-            finger_clearance=get('gripper.finger_clearance', d.finger_clearance,
-                                 "height of the fingertips above the grasped part's bottom, m",
-                                 LIMITS['gripper.finger_clearance']))
+        # the default gripper's kind, parallel jaws, with its keys as parameters (the kind's
+        # table: grippers.Jaws.KEYS); a request may send any kind
+        d = Jaws()
+        gripper = Jaws(**{key.field: get(f'gripper.{key.field}', getattr(d, key.field),
+                                         key.text, key.limit) for key in Jaws.KEYS})
         defaults = {g.name: g for g in CAPACITOR_GRASPS}
         names = get('grasp_names', list(defaults),
                     'names of the grasp poses; each has grasps.<name>.* parameters')

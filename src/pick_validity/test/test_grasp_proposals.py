@@ -6,9 +6,9 @@ import os
 import numpy as np
 from pick_common.parts.geometry import build_part
 from pick_common.parts.spec import PartSpec
-from pick_validity.config import GraspPose
 from pick_validity.grasp_fit import check_grasps_fit
 from pick_validity.grasp_proposals import as_yaml, JAW_MARGIN, propose
+from pick_validity.grasps import GraspPose
 import pytest
 import trimesh
 import yaml
@@ -85,7 +85,7 @@ def test_a_round_body_gets_one_grasp_that_turns_with_its_roll_named_as_a_person_
     assert one.grasp.jaw_opening * 1e5 == pytest.approx(round(one.grasp.jaw_opening * 1e5))
     v = Validator(Setup(part.spec, grasps=tuple(p.grasp for p in proposals)), part)
     for p in lying:         # across the body, and on its two ends: each turns about its axis
-        assert np.allclose(np.abs(v.free_axes[proposals.index(p)]), [0, 0, 1])
+        assert np.allclose(np.abs(v.geometry.free_axes[proposals.index(p)]), [0, 0, 1])
 
 
 def test_the_printed_yaml_reads_back_as_the_same_grasps():

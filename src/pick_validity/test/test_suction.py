@@ -11,15 +11,9 @@ from pick_common.parts.geometry import build_part
 from pick_common.parts.spec import PartSpec
 from pick_common.specs import SceneSpec
 from pick_sim_world.world import World
-from pick_validity.config import (
-    check_grasps,
-    GraspPose,
-    Gripper,
-    PlaceSpec,
-    Setup,
-    SuctionCup,
-    SuctionGrasp,
-)
+from pick_validity.config import PlaceSpec, Setup
+from pick_validity.grasps import GraspPose, SuctionGrasp
+from pick_validity.grippers import check_grasps, Jaws, SuctionCup
 from pick_validity.naive import naive_check
 from pick_validity.results import STAGE_CANDIDACY, STAGE_VALID
 from pick_validity.suction import holding, OFF_SURFACE, seal
@@ -122,7 +116,7 @@ def test_the_holding_force_and_its_margin_follow_schmalz_s_load_case():
 def test_a_suction_grasp_with_jaws_and_a_jaws_grasp_with_a_cup_are_refused():
     with pytest.raises(InvalidArgument, match=r"grasps\.top: 'top' is a suction grasp, and "
                        r'the gripper is parallel jaws'):
-        check_grasps([SuctionGrasp('top', (0, 0, 1))], Gripper())
+        check_grasps([SuctionGrasp('top', (0, 0, 1))], Jaws())
     with pytest.raises(InvalidArgument, match=r"grasps\.side: 'side' is a jaws grasp, and the "
                        r'gripper is a suction cup'):
         check_grasps([GraspPose('side', (1, 0, 0), (0, 1, 0), 0.011)], CUP)
@@ -152,7 +146,7 @@ def test_the_cup_s_check_equals_the_naive_loop_on_settled_scenes(container, coun
     v = Validator(Setup(spec, gripper=CUP, grasps=DIP_GRASPS,
                         place=PlaceSpec(seat_offset=0.0015)), part)
     # the body's end is 3.3 mm high: a 4 mm cup's rim leaves it
-    assert [s.ok for s in v.seals] == [True, True, False]
+    assert [s.ok for s in v.geometry.seals] == [True, True, False]
     for neighbours in (False, True):
         fast = v.check(container, state.ids, state.poses, neighbour_check=neighbours)
         naive = naive_check(v.geometry, container, state.ids, state.poses,

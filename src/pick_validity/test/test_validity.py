@@ -10,7 +10,9 @@ from pick_common.parts.geometry import build_part
 from pick_common.parts.spec import PartSpec
 from pick_common.specs import SceneSpec
 from pick_sim_world.world import World
-from pick_validity.config import CheckConfig, GraspPose, Gripper, PlaceSpec, Setup
+from pick_validity.config import CheckConfig, PlaceSpec, Setup
+from pick_validity.grasps import GraspPose
+from pick_validity.grippers import Jaws
 from pick_validity.naive import naive_check
 from pick_validity.results import (
     STAGE_CANDIDACY,
@@ -74,7 +76,7 @@ def test_the_nearest_grasp_pose_is_chosen():
 
 
 DEEP = ContainerSpec(inner_size=(0.2, 0.2, 0.1))
-THIN = Gripper(body_diameter=0.004, jaw_depth=0.004)
+THIN = Jaws(body_diameter=0.004, jaw_depth=0.004)
 FAR = PlaceSpec(seat_offset=0.5)      # a seat no gripper reaches: placeability never decides
 
 
@@ -109,7 +111,7 @@ def test_placeability_depends_on_how_the_part_lies():
     assert 'cannot be placed' in result.reason
     assert _tilts(v, _tilted(30)) == (STAGE_VALID, tuple(range(-45, 15, 5)))
     # A huge jaw never clears the seat, however the part lies.
-    wide = Validator(Setup(gripper=Gripper(jaw_depth=0.05), grasps=(SIDE,)))
+    wide = Validator(Setup(gripper=Jaws(jaw_depth=0.05), grasps=(SIDE,)))
     assert _tilts(wide, _tilted(20))[0] == STAGE_PLACEABILITY
 
 
@@ -118,7 +120,7 @@ def test_a_regrasp_station_places_what_the_pitch_kept_from_placing(tmp_path):
     # station (lying on its side, flat) it is picked again and placed: valid after a regrasp.
     from pick_validity.regrasp import placements
     station = Validator(Setup(grasps=(SIDE,), config=CheckConfig(regrasp_station=True)))
-    assert station.placements and station.station_ok.any()
+    assert station.geometry.placements and station.geometry.station_ok.any()
     result = station.check(DEEP, [1], [_tilted(-30)], neighbour_check=False).results[0]
     assert result.stage == STAGE_VALID and result.regrasp, result.reason
     assert result.reason.endswith('placed after a regrasp on the station')
@@ -141,7 +143,7 @@ def test_the_gripper_stays_within_the_approach_cone():
     # from the vertical, and tilt a makes it acos(cos 40 cos a): within the 45 deg cone for
     # |a| <= 22.6 deg.
     v = Validator(Setup(gripper=THIN, grasps=(OFF_AXIS,), place=FAR))
-    assert not v.free_axes.any()
+    assert not v.geometry.free_axes.any()
     assert _tilts(v, _tilted(0))[1] == tuple(range(-45, 50, 5))
     assert _tilts(v, _tilted(0, roll_deg=40))[1] == tuple(range(-20, 25, 5))
     narrow = Validator(Setup(gripper=THIN, grasps=(OFF_AXIS,), place=FAR,
@@ -159,12 +161,12 @@ def test_jaws_across_a_round_body_grip_it_at_any_roll(roll):
     # A capacitor lying alone on the floor: a cell's camera cannot see its roll, and its jaws
     # close across the round body whatever it is. With the grasp fixed to the part, rolls
     # beyond 6 deg of a side grasp tilted the jaws into the floor
-    # (bench/validity/bench_roll.py). The turned grasp is the side grasp nearest in roll.
+    # (studies/roll.py). The turned grasp is the side grasp nearest in roll.
     sides = [GraspPose(f'side{k}', (math.cos(k * math.pi / 2), math.sin(k * math.pi / 2), 0.0),
                        (-math.sin(k * math.pi / 2), math.cos(k * math.pi / 2), 0.0), 0.011)
              for k in range(4)]
     v = _validator(grasps=sides)
-    assert np.allclose(v.free_axes, [[0, 0, 1.0]] * 4)
+    assert np.allclose(v.geometry.free_axes, [[0, 0, 1.0]] * 4)
     result = v.check(BIN, [1], [_lying(0, 0, roll)]).results[0]
     assert result.stage == STAGE_VALID and result.candidacy_angle < 1e-6, result.reason
     assert result.grasp_index == round(roll / 90) % 4, result.grasp_index
@@ -188,15 +190,15 @@ def test_a_round_body_is_found_in_a_mesh(tmp_path, roll):
                        (-math.sin(k * math.pi / 2), math.cos(k * math.pi / 2), 0.0), 0.011)
              for k in range(4)]
     v = Validator(Setup(part=part, grasps=tuple(sides)))
-    assert np.allclose(np.abs(v.free_axes), [[0, 0, 1.0]] * 4)
+    assert np.allclose(np.abs(v.geometry.free_axes), [[0, 0, 1.0]] * 4)
     result = v.check(BIN, [1], [_lying(0, 0, roll)]).results[0]
     assert result.stage == STAGE_VALID and result.candidacy_angle < 1e-6, result.reason
     # off the axis, or across a square section: fixed to the part
-    assert not Validator(Setup(part=part, grasps=(OFF_AXIS,))).free_axes.any()
+    assert not Validator(Setup(part=part, grasps=(OFF_AXIS,))).geometry.free_axes.any()
     trimesh.creation.box((5.0, 5.0, 11.0)).export(tmp_path / 'square.stl')
     square = PartSpec(model='mesh', mesh_path=str(tmp_path / 'square.stl'), scale=0.001,
                       mass=0.0004)
-    assert not Validator(Setup(part=square, grasps=(SIDE,))).free_axes.any()
+    assert not Validator(Setup(part=square, grasps=(SIDE,))).geometry.free_axes.any()
 
 
 def test_the_fingertips_reach_down_the_grasped_part():
@@ -204,14 +206,14 @@ def test_the_fingertips_reach_down_the_grasped_part():
     # below its axis, so the fingertips go 2.5 mm - clearance below it; from the top, the
     # body ends 5.5 mm below its centre, where only its two leads go on (a fifth of it).
     v = _validator()
-    assert v.finger_depths[0] == pytest.approx(RADIUS - 0.001, abs=1e-7)
-    assert _validator(grasps=(TOP,)).finger_depths[0] == pytest.approx(0.0055 + 0.002 - 0.001,
-                                                                       abs=1e-7)
+    assert v.geometry.finger_depths[0] == pytest.approx(RADIUS - 0.001, abs=1e-7)
+    top = _validator(grasps=(TOP,)).geometry
+    assert top.finger_depths[0] == pytest.approx(0.0055 + 0.002 - 0.001, abs=1e-7)
     # Lying 0.5 mm into the floor (as resting parts do in the physics): with no clearance the
     # fingertips, and nothing else, go through the floor at every tilt.
     sunk = _lying(0, 0)
     sunk[2] -= 0.0005
-    touching = Validator(Setup(gripper=Gripper(finger_clearance=0.0), grasps=(SIDE,)))
+    touching = Validator(Setup(gripper=Jaws(finger_clearance=0.0), grasps=(SIDE,)))
     result = touching.check(BIN, [1], [sunk], neighbour_check=False).results[0]
     assert result.stage == STAGE_CONTAINER, result.reason
     # With the default 1 mm they stop 1.5 mm below the axis, which lies 2.0 mm above the
@@ -301,7 +303,7 @@ def test_fast_check_equals_the_naive_loop_on_settled_scenes(container, model, co
         ('+', 'z', (0, 0, 1), (1, 0, 0)), ('-', 'z', (0, 0, -1), (1, 0, 0)))]
     # The default gripper stops most parts at placeability or the container; a thin one
     # lets more through to the later stages.
-    for gripper in (Gripper(), THIN):
+    for gripper in (Jaws(), THIN):
         v = Validator(Setup(PartSpec(model=model), gripper=gripper, grasps=tuple(grasps),
                             place=PlaceSpec(seat_offset=0.003)), part)
         for neighbours in (False, True):
@@ -405,8 +407,8 @@ def test_bad_check_settings_are_refused(config, rule):
 
 def test_bad_gripper_and_placement_are_refused():
     with pytest.raises(InvalidArgument, match='gripper.body_diameter: -0.02 must be > 0'):
-        Validator(Setup(gripper=Gripper(body_diameter=-0.02), grasps=(SIDE,)))
+        Validator(Setup(gripper=Jaws(body_diameter=-0.02), grasps=(SIDE,)))
     with pytest.raises(InvalidArgument, match='gripper.finger_clearance: nan must be finite'):
-        Validator(Setup(gripper=Gripper(finger_clearance=math.nan), grasps=(SIDE,)))
+        Validator(Setup(gripper=Jaws(finger_clearance=math.nan), grasps=(SIDE,)))
     with pytest.raises(InvalidArgument, match='place.place_axis: .* is a zero vector'):
-        Validator(Setup(gripper=Gripper(), grasps=(SIDE,), place=PlaceSpec(place_axis=(0, 0, 0))))
+        Validator(Setup(gripper=Jaws(), grasps=(SIDE,), place=PlaceSpec(place_axis=(0, 0, 0))))

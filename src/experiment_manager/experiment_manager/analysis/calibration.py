@@ -89,7 +89,7 @@ def noise(measured: dict[str, int], simulated: dict[str, int], seed: int = 0) ->
 
 def noise_said(sd: float | None, outside: float | None) -> str:
     """The noise in words (calibrate's noise_sd and noise_outside), '' for a summary that has
-    none (made before 2026-11-28's fourth session)."""
+    none (one of version 1: summary.migrate)."""
     if sd is None or outside is None:
         return ''
     return (f"the simulation's own noise: two points of the likeliest's shares, each from as "

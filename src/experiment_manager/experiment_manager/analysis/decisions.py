@@ -48,6 +48,7 @@ import functools
 import math
 
 import numpy as np
+from pick_common.stats import binomial_bounds
 from scipy import stats
 
 FEASIBLE, NOT_FEASIBLE, UNDECIDED = 'FEASIBLE', 'NOT FEASIBLE', 'UNDECIDED'
@@ -88,14 +89,6 @@ def feeder_runs(rows: list[dict], cell) -> list[dict]:
     return out
 
 
-def binomial_bounds(over, n, confidence: float = CONFIDENCE):
-    """One-sided exact (Clopper-Pearson) bounds of a share from `over` of `n` (ints, or int
-    arrays of one shape): (lower, upper), each at `confidence`."""
-    k, n = np.asarray(over), np.asarray(n)
-    with np.errstate(invalid='ignore', divide='ignore'):
-        low = np.where(k > 0, stats.beta.ppf(1 - confidence, k, n - k + 1), 0.0)
-        high = np.where(k < n, stats.beta.ppf(confidence, k + 1, n - k), 1.0)
-    return (float(low), float(high)) if not low.shape else (low, high)
 
 
 def iterations_to_decide(successes: int, n: int, required: float, most: int = 10_000

@@ -5,6 +5,7 @@ simulator."""
 from collections import Counter
 
 from pick_common.parts import aspects
+from pick_common.stats import wilson_interval
 
 from ..experiment_file import Experiment, ExperimentFile
 
@@ -20,13 +21,13 @@ def summary(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> dict:
     measured = dict(exp.measured)
     measured_drops = sum(measured.values())
     found = []
-    for a in aspects.spec_aspects(file.part):
+    for a in file.aspects:
         k = counts.get(a.name, 0)
         m = measured.get(a.name) if measured else None
         share = k / drops if drops else None
         m_share = m / measured_drops if m is not None and measured_drops else None
         found.append({'name': a.name, 'normal': [round(v, 6) for v in a.normal], 'count': k,
-                      'share': share, 'ci95': list(aspects.share_interval(k, drops)),
+                      'share': share, 'ci95': list(wilson_interval(k, drops)),
                       'quasi_static': a.quasi_static, 'measured': m,
                       'measured_share': m_share,
                       'difference': share - m_share if None not in (share, m_share) else None})

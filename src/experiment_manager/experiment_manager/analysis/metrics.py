@@ -12,7 +12,7 @@ interval's low end reaches the experiment's min_valid. Standard deviations are s
 """
 
 import numpy as np
-from scipy import stats as scipy_stats
+from pick_common.stats import interval, rate_interval, stats
 
 from ..experiment_file import (
     BIN_EMPTYING,
@@ -20,9 +20,8 @@ from ..experiment_file import (
     DROP_TEST,
     Experiment,
     ExperimentFile,
-    GRIPPER_KEYS,
+    FEEDER_EMPTYING,
     GRIPPER_SWEEP,
-    MM,
     TABLE_SWEEP,
 )
 from . import decisions, drop_tests
@@ -39,62 +38,12 @@ FIT_ORDER = 4
 BOOTSTRAP = 4000        # resamples of a table_sweep's iterations for the interval of n*
 
 
-def stats(values) -> dict:
-    """mean, min, max, std (sample) and n of a list of numbers; None for an empty list (so that
-    summary.json stays strict JSON)."""
-    a = np.asarray(values, dtype=float)
-    if a.size == 0:
-        return {'n': 0, 'mean': None, 'min': None, 'max': None, 'std': None}
-    return {'n': int(a.size), 'mean': float(a.mean()), 'min': float(a.min()),
-            'max': float(a.max()), 'std': float(a.std(ddof=1)) if a.size > 1 else 0.0}
 
 
-def interval(values, confidence: float = 0.95, counts: bool = False
-             ) -> tuple[float | None, float | None]:
-    """The two-sided Student-t confidence interval of the mean of `values`; (None, None) for
-    fewer than two values (one value says nothing of its spread). counts: the values are counts
-    of parts, whose spread is taken as at least a Poisson count's (variance >= mean): a few
-    scenes that happen to agree (two scenes of 4 valid parts each) do not make a mean certain."""
-    a = np.asarray(values, dtype=float)
-    if a.size < 2:
-        return None, None
-    variance = a.var(ddof=1)
-    if counts:
-        variance = max(variance, a.mean())
-    half = scipy_stats.t.ppf(0.5 + confidence / 2, a.size - 1) * np.sqrt(variance / a.size)
-    return float(a.mean() - half), float(a.mean() + half)
 
 
-def difference_bound(a, b, confidence: float) -> float:
-    """The one-sided upper confidence bound of mean(a) - mean(b) at `confidence`, Welch's (a t
-    with the Welch-Satterthwaite degrees of freedom: the two spreads need not be equal); a and
-    b each of at least two values. Two separate intervals that do not overlap are a far
-    stricter test than this one (Schenker and Gentleman, "On judging the significance of
-    differences by examining the overlap between confidence intervals", The American
-    Statistician 55(3), 2001)."""
-    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-    va, vb = a.var(ddof=1) / a.size, b.var(ddof=1) / b.size
-    difference = float(a.mean() - b.mean())
-    if va + vb == 0.0:
-        return difference
-    df = (va + vb) ** 2 / (va ** 2 / (a.size - 1) + vb ** 2 / (b.size - 1))
-    return difference + float(scipy_stats.t.ppf(confidence, df) * np.sqrt(va + vb))
 
 
-def rate_interval(successes, n, confidence: float = 0.95):
-    """The exact (Clopper-Pearson) two-sided confidence interval of a success rate from
-    `successes` of `n` trials (ints or int arrays of one shape), as (low, high); (None, None)
-    for n = 0. Exact rather than Wilson's: a verdict rests on a few iterations (the reduced
-    test case runs one), where Wilson's interval is too narrow (0 of 1: below 0.79, against
-    0.975 exact)."""
-    k, n = np.asarray(successes), np.asarray(n)
-    if not n.shape and n == 0:
-        return None, None
-    tail = (1.0 - confidence) / 2.0
-    with np.errstate(invalid='ignore', divide='ignore'):
-        low = np.where(k > 0, scipy_stats.beta.ppf(tail, k, n - k + 1), 0.0)
-        high = np.where(k < n, scipy_stats.beta.ppf(1.0 - tail, k + 1, n - k), 1.0)
-    return (float(low), float(high)) if not low.shape else (low, high)
 
 
 def _fractions(rows: list[dict]) -> dict:
@@ -297,8 +246,8 @@ def gripper_sweep(exp: Experiment, rows: list[dict], checks: list[dict]) -> dict
         low, high = interval(valid, counts=True)
         variants.append({
             'index': k, 'grasp_set': v.grasp_set, 'grasps': [g.name for g in v.grasps],
-            'gripper_mm': {key: round(getattr(v.gripper, attr) / MM, 6)
-                           for key, attr in GRIPPER_KEYS},
+            'gripper_mm': {key.file_key: round(getattr(v.gripper, key.field) / key.factor, 6)
+                           for key in v.gripper.KEYS},
             'scenes': len(mine), 'fractions': _fractions(mine), 'valid': stats(valid),
             'valid_ci95': [low, high], 'scenes_with_valid': sum(x > 0 for x in valid),
             'meets': low is not None and low >= exp.min_valid})
@@ -351,19 +300,7 @@ def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: li
     faulted = left_out(rows)
     rows = [r for r in rows if (r['group'], r['iteration']) not in faulted]
     picks = [p for p in picks if (p['group'], p['iteration']) not in faulted]
-    if exp.type == BIN_STATIC:
-        out = bin_static(exp, rows)
-    elif exp.type == BIN_EMPTYING:
-        out = bin_emptying(file, exp, rows, picks)
-    elif exp.type == TABLE_SWEEP:
-        out = table_sweep(file, exp, rows)
-    elif exp.type == GRIPPER_SWEEP:
-        out = gripper_sweep(exp, rows, checks)
-    elif exp.type == DROP_TEST:
-        out = drop_tests.summary(file, exp, rows)
-    else:
-        low_high = exp.optimal_range or (earlier or {})[exp.range_from]['optimal_range']
-        out = feeder_emptying(file, exp, rows, low_high)
+    out = SUMMARIES[exp.type](file, exp, rows, picks, earlier or {}, checks)
     if exp.gripper:
         out['gripper'] = exp.gripper
     if exp.station:
@@ -385,3 +322,19 @@ def file_summary(file: ExperimentFile, summaries: dict) -> dict:
                              'max_dimension_mm': round(r.max_dimension * 1000, 6)},
             'experiments': {k: v for k, v in summaries.items() if k not in repeats},
             **({'repeats': repeats} if repeats else {})}
+
+
+# Per kind, its metrics: (file, exp, rows, picks, the summaries before it, checks) -> its
+# summary's own keys. A sensitivity's are sensitivity.summarise's, from its repeats'.
+SUMMARIES = {
+    BIN_STATIC: lambda file, exp, rows, picks, earlier, checks: bin_static(exp, rows),
+    BIN_EMPTYING: lambda file, exp, rows, picks, earlier, checks: bin_emptying(file, exp, rows,
+                                                                               picks),
+    TABLE_SWEEP: lambda file, exp, rows, picks, earlier, checks: table_sweep(file, exp, rows),
+    FEEDER_EMPTYING: lambda file, exp, rows, picks, earlier, checks: feeder_emptying(
+        file, exp, rows, exp.optimal_range or earlier[exp.range_from]['optimal_range']),
+    GRIPPER_SWEEP: lambda file, exp, rows, picks, earlier, checks: gripper_sweep(exp, rows,
+                                                                                 checks),
+    DROP_TEST: lambda file, exp, rows, picks, earlier, checks: drop_tests.summary(file, exp,
+                                                                                  rows),
+}

@@ -23,7 +23,6 @@ from pick_common.parts.geometry import build_part
 from pick_common.parts.insets import HULL_MARGIN, hull_swelling
 from pick_common.parts.primitives import Hull
 from pick_common.parts.spec import states_units
-from pick_validity.config import VACUUM_SOURCE
 from pick_validity.geometry import (
     BoxShape,
     CylinderShape,
@@ -33,11 +32,13 @@ from pick_validity.geometry import (
     support,
     turn_onto,
 )
-from pick_validity.grasp_proposals import as_yaml, JAW_MARGIN, Proposal
+from pick_validity.grasp_proposals import as_yaml, Proposal
+from pick_validity.grippers import KINDS
 from pick_validity.validity import Validator
 import trimesh
 
 from ..experiment_file import ExperimentFile
+from ..experiment_file.kinds import kind_of
 
 MM = 1000.0
 PIECE_COLOURS = ('#4c72b0', '#dd8452', '#55a868', '#c44e52', '#8172b3', '#937860')
@@ -51,7 +52,7 @@ def validator(file: ExperimentFile) -> Validator:
 def describe(file: ExperimentFile, checks: Validator) -> list[str]:
     """What the run will use of the file's part and grasps (as `checks`, the file's
     `validator`, holds them), one fact a line."""
-    part = checks.part
+    part = checks.geometry.part
     spec = file.part
     lo, hi = part.visual.bounds * MM
     lines = []
@@ -65,7 +66,7 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
     lines.append(f'  size {" x ".join(f"{v:.2f}" for v in hi - lo)} mm; in its frame x '
                  f'{lo[0]:.2f} to {hi[0]:.2f}, y {lo[1]:.2f} to {hi[1]:.2f}, z {lo[2]:.2f} to '
                  f'{hi[2]:.2f} mm')
-    centre = part.mass_frame[0] if part.mass_frame is not None else np.zeros(3)
+    centre = part.mass_centre
     lines.append(f'  mass {part.mass * 1000:g} g, volume {part.volume * 1e9:.1f} mm^3; mass '
                  f'centre at ({", ".join(f"{v:.2f}" for v in centre * MM)}) mm in its frame'
                  + ('' if part.mass_frame is not None else ' (the frame origin: a built-in)'))
@@ -105,37 +106,22 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
     lines += [f'    {a.name}: ({", ".join(f"{v:.2f}" for v in a.normal)}), '
               f'{100 * a.quasi_static:.1f} %' for a in part_aspects(part)]
     lines += grasp_lines(file, checks)
-    if file.auto_grasps and checks.suction:
-        lines.append('  the grasps are part.grasps: auto, proposed from the geometry (per way '
-                     'the part can lie, the cup on its top where it seals and holds nearest '
-                     'the mass centre); to edit them, paste these under part: in place of '
-                     'grasps: auto')
-        used = tuple(Proposal(g, s.deviation) for g, s in zip(file.grasps, checks.seals,
-                                                              strict=True))
-        lines += ['  ' + line for line in as_yaml(used)]
-    elif file.auto_grasps:
-        lines.append('  the grasps are part.grasps: auto, proposed from the geometry (across '
-                     'opposed faces and round bodies at the mass centre, jaws '
-                     f'{JAW_MARGIN * MM:g} mm wider than the part each side); to edit them, '
-                     'paste these under part: in place of grasps: auto')
-        used = tuple(Proposal(g, fit.width) for g, fit in zip(file.grasps, checks.grasp_fits,
-                                                              strict=True))
+    if file.auto_grasps:
+        gripper = checks.geometry.gripper
+        lines.append('  the grasps are part.grasps: auto, proposed from the geometry '
+                     f'({gripper.proposal_rule}); to edit them, paste these under part: in '
+                     'place of grasps: auto')
+        used = tuple(Proposal(g, width) for g, width in zip(
+            file.grasps, gripper.proposed_widths(checks.geometry), strict=True))
         lines += ['  ' + line for line in as_yaml(used)]
     return lines
 
 
 def grasp_lines(file: ExperimentFile, checks: Validator) -> list[str]:
-    """A suction cup's line (the jaws are said in the file's keys), then a line per grasp
-    (grasp_figures)."""
-    lines = []
-    if checks.suction:
-        cup = checks.gripper
-        lines.append(f'  gripper: a suction cup {cup.cup_diameter * MM:g} mm across and '
-                     f'{cup.cup_height * MM:g} mm high on a {cup.body_diameter * MM:g} x '
-                     f'{cup.body_length * MM:g} mm body, {cup.vacuum / 1000:g} kPa, safety '
-                     f'factor {cup.safety_factor:g}, {cup.acceleration:g} m/s^2, cup friction '
-                     f'{cup.cup_friction:g} (defaults: {VACUUM_SOURCE})')
-    return lines + [_grasp_line(figures) for figures in grasp_figures(file, checks)]
+    """The gripper's own lines (its kind's account: a suction cup's sizes; the jaws are said
+    in the file's keys), then a line per grasp (grasp_figures)."""
+    return checks.geometry.gripper.account() + [_grasp_line(figures) for figures in
+                                                grasp_figures(file, checks)]
 
 
 def named_grippers(file: ExperimentFile, checks: Validator
@@ -147,42 +133,24 @@ def named_grippers(file: ExperimentFile, checks: Validator
         if exp.gripper and exp.gripper not in seen:
             seen.add(exp.gripper)
             mine = file.for_experiment(exp)
-            out.append((exp.gripper, mine, Validator(mine.setup, checks.part)))
+            out.append((exp.gripper, mine, Validator(mine.setup, checks.geometry.part)))
     return out
 
 
 def grasp_figures(file: ExperimentFile, checks: Validator) -> list[dict]:
-    """Per grasp, what the check computed of it before any scene, mm: for jaws what they
-    close on and whether they turn on a round body; for a suction cup its seal (true or
-    false, the reason), the rim's deviation from a plane against the cup's give, the force
-    margin and the distance of the grasp point from the mass centre's line."""
-    part = checks.part
-    centre = part.mass_frame[0] if part.mass_frame is not None else np.zeros(3)
+    """Per grasp, what the check computed of it before any scene, mm: where it is, and what
+    its gripper's kind computed of it (`figures`: for jaws what they close on and whether
+    they turn on a round body; for a suction cup its seal and holding)."""
+    geometry = checks.geometry
+    part = geometry.part
+    centre = part.mass_centre
     out = []
-    for k, (g, grasp) in enumerate(zip(file.grasps, checks.grasps, strict=True)):
+    for k, (g, grasp) in enumerate(zip(file.grasps, geometry.grasps, strict=True)):
         item = {'name': g.name, 'up_axis': [float(v) for v in g.up_axis],
                 'grasp_point_mm': [round(float(v) * MM, 3) for v in g.grasp_point],
                 'from_mass_centre_mm': round(float(np.linalg.norm(grasp.point - centre)) * MM,
                                              3)}
-        if checks.suction:
-            found, held = checks.seals[k], checks.holds[k]
-            item.update({
-                'gripper': 'suction', 'seal': found.ok, 'reason': found.reason,
-                'deviation_mm': None if np.isnan(found.deviation) else
-                round(found.deviation * MM, 4), 'give_mm': round(found.give * MM, 4),
-                'holding_force_n': round(held.force, 4), 'needed_n': round(held.needed, 4),
-                'force_margin': round(held.margin, 3), 'holds': held.ok,
-                'off_axis_mm': round(held.offset * MM, 3),
-                'used': bool(checks.usable[k])})
-        else:
-            fit, axis = checks.grasp_fits[k], checks.free_axes[k]
-            item.update({
-                'gripper': 'jaws', 'closing_axis': [float(v) for v in g.closing_axis],
-                'jaw_opening_mm': round(g.jaw_opening * MM, 3),
-                'problem': fit.problem(), 'closes_on_mm': round(fit.width * MM, 3),
-                'span_mm': None if fit.span is None else [round(-fit.span[0] * MM, 3),
-                                                          round(fit.span[1] * MM, 3)],
-                'round_axis': [round(float(v), 3) for v in axis] if axis.any() else None})
+        item.update(geometry.gripper.figures(geometry, k, g))
         out.append(item)
     return out
 
@@ -190,23 +158,7 @@ def grasp_figures(file: ExperimentFile, checks: Validator) -> list[dict]:
 def _grasp_line(f: dict) -> str:
     at = (f'at ({", ".join(f"{v:.2f}" for v in f["grasp_point_mm"])}) mm, '
           f'{f["from_mass_centre_mm"]:.2f} mm from the mass centre, up {f["up_axis"]}')
-    if f['gripper'] == 'suction':
-        seal = ('seals: its rim and the surface inside lie within '
-                f'{f["deviation_mm"]:.2f} mm of a plane (the cup gives {f["give_mm"]:.2f})'
-                if f['seal'] else f'does not seal: {f["reason"]}')
-        force = (f'holds {f["holding_force_n"]:.3f} N against {f["needed_n"]:.3f} N needed, '
-                 f'margin {f["force_margin"]:.2f} with the moment of the mass centre '
-                 f'{f["off_axis_mm"]:.2f} mm off the cup\'s axis'
-                 + ('' if f['holds'] else ': does not hold'))
-        used = '' if f['used'] else '; never used by the check'
-        return f'  grasp {f["name"]!r}: cup {at}: {seal}; {force}{used}'
-    what = f['problem'] or (f'closes on {f["closes_on_mm"]:.2f} mm of part '
-                            f'({f["span_mm"][0]:.2f} and {f["span_mm"][1]:.2f} mm either side '
-                            'of the grasp point)')
-    roll = (f'; round there, so it grips at any roll about {f["round_axis"]}'
-            if f['round_axis'] else '; fixed to the part (not across a round body)')
-    return (f'  grasp {f["name"]!r}: jaws open {f["jaw_opening_mm"]:.2f} mm {at}, closing '
-            f'{f["closing_axis"]}: {what}{roll}')
+    return KINDS[f['gripper']].figures_line(f, at)
 
 
 def write_check(file: ExperimentFile, checks: Validator, path: str) -> str:
@@ -260,10 +212,11 @@ def clearance(validator: Validator, g: int, relative: np.ndarray) -> float:
     """How far (m) the gripper of grasp `g`, holding the part at `relative` (its rotation in
     the part frame), stays on its side of the seating plane once the part is placed: negative
     where it reaches past it, as the placeability check decides (clear when positive)."""
-    point = validator.grasps[g].point[None]
-    return min(float(validator.seat_offset - support(shape, *place(shape, relative[None], point),
-                                                     validator.place_axis)[0])
-               for shape in validator.gripper_shapes[g])
+    geo = validator.geometry
+    point = geo.grasps[g].point[None]
+    return min(float(geo.seat_offset - support(shape, *place(shape, relative[None], point),
+                                               geo.place_axis)[0])
+               for shape in geo.gripper_shapes[g])
 
 
 def draw_place(ax, validator: Validator, g: int, relatives: list[np.ndarray],
@@ -272,22 +225,22 @@ def draw_place(ax, validator: Validator, g: int, relatives: list[np.ndarray],
     (yellow), with the gripper of grasp `g` holding it at each of `relatives` (its rotations
     in the part frame, at wrist `tilts`, rad): green where it clears the surface, red where
     it reaches past it. Returns the words per tilt ('+0 deg hits')."""
-    part = validator.part
-    visual, grasp = part.visual, validator.grasps[g]
-    view = turn_onto(validator.place_axis, np.array([0.0, 0.0, -1.0]))
+    part = validator.geometry.part
+    visual, grasp = part.visual, validator.geometry.grasps[g]
+    view = turn_onto(validator.geometry.place_axis, np.array([0.0, 0.0, -1.0]))
     _draw(ax, visual, view, '#999999', 0.7)
     points = [view @ visual.vertices.T]
     words = []
     for relative, tilt in zip(relatives, tilts, strict=True):
         clear = clearance(validator, g, relative) > 0
-        for shape in validator.gripper_shapes[g]:
+        for shape in validator.geometry.gripper_shapes[g]:
             rot, centre = place(shape, relative[None], grasp.point[None])
             mesh = _shape_mesh(shape, rot[0], centre[0])
             _draw(ax, mesh, view, '#55a868' if clear else '#c44e52', 0.15)
             points.append(view @ mesh.vertices.T)
         words.append(f'{np.degrees(tilt):+.0f} deg {"clear" if clear else "hits"}')
     pts = np.hstack(points).T
-    seat = (view @ (validator.place_axis * validator.seat_offset))[2]
+    seat = (view @ (validator.geometry.place_axis * validator.geometry.seat_offset))[2]
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     plane = np.array([[lo[0], lo[1], seat], [hi[0], lo[1], seat], [hi[0], hi[1], seat],
                       [lo[0], hi[1], seat]]) * MM
@@ -298,8 +251,8 @@ def draw_place(ax, validator: Validator, g: int, relatives: list[np.ndarray],
 
 def write(checks: Validator, path: str) -> str:
     """Draw the sheet of the file's `validator` into `path` (PNG); returns `path`."""
-    validator, part = checks, checks.part
-    grasps = validator.grasps
+    geometry = checks.geometry
+    part, grasps = geometry.part, geometry.grasps
     rows = 1 + len(grasps)
     fig = plt.figure(figsize=(8.0, 3.4 * rows))
     visual = part.visual
@@ -316,7 +269,7 @@ def write(checks: Validator, path: str) -> str:
               PIECE_COLOURS[i % len(PIECE_COLOURS)], 0.55)
     _frame(ax, visual.vertices * MM, f'what the physics and the checks collide:\n'
            f'{len(part.primitives)} convex piece(s)')
-    tilts = validator.tilts
+    tilts = geometry.tilts
     shown = sorted({0, len(tilts) - 1, int(np.abs(tilts).argmin())})
     for g, grasp in enumerate(grasps):
         # pick: the part with the grasp's up axis up and its closing axis along x
@@ -324,26 +277,22 @@ def write(checks: Validator, path: str) -> str:
         ax = fig.add_subplot(rows, 2, 3 + 2 * g, projection='3d')
         _draw(ax, visual.copy().apply_translation(-grasp.point), pick, '#999999', 0.7)
         points = [pick @ (visual.vertices - grasp.point).T]
-        for shape in validator.gripper_shapes[g]:
+        for shape in geometry.gripper_shapes[g]:
             mesh = _shape_mesh(shape, shape.rotation, shape.center)
             _draw(ax, mesh, np.eye(3), '#4c72b0', 0.25)
             points.append(mesh.vertices.T)
-        if validator.suction:       # the rim where it touches the part: green seals
-            found = validator.seals[g]
-            rim = (pick @ (found.rim - grasp.point).T).T * MM
-            ax.plot(*np.vstack([rim, rim[:1]]).T, color='#55a868' if found.ok else '#c44e52',
+        # what the gripper's kind marks at a pick (a cup's rim: green where it seals)
+        for marks, ok in geometry.gripper.pick_marks(geometry, g):
+            line = (pick @ (marks - grasp.point).T).T * MM
+            ax.plot(*np.vstack([line, line[:1]]).T, color='#55a868' if ok else '#c44e52',
                     linewidth=1.5)
-            title = (f'{grasp.name}: pick\ncup {grasp.jaw_opening * MM:g} mm, '
-                     + ('seals' if found.ok else 'no seal'))
-        else:
-            title = (f'{grasp.name}: pick\njaws {grasp.jaw_opening * MM:g} mm, fingertips '
-                     f'{validator.finger_depths[g] * MM:.1f} mm below the point')
-        _frame(ax, np.hstack(points).T * MM, title)
+        _frame(ax, np.hstack(points).T * MM,
+               f'{grasp.name}: pick\n{geometry.gripper.pick_caption(geometry, g)}')
         # place: the part turned so that place.axis points down; gripper as it picked
         ax = fig.add_subplot(rows, 2, 4 + 2 * g, projection='3d')
         relatives = [pick.T @ trimesh.transformations.rotation_matrix(tilts[k], [1, 0, 0])[:3, :3]
                      for k in shown]
-        draw_place(ax, validator, g, relatives, [tilts[k] for k in shown],
+        draw_place(ax, checks, g, relatives, [tilts[k] for k in shown],
                    f'{grasp.name}: place (yellow: the surface)\n')
     fig.tight_layout()
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
@@ -390,5 +339,5 @@ def write_account(file: ExperimentFile, run_dir: str) -> None:
     with open(os.path.join(run_dir, 'part.json'), 'w', encoding='utf-8') as f:
         json.dump(describe(file, checks), f, indent=1)
     write(checks, os.path.join(run_dir, 'part.png'))
-    if any(e.type == 'drop_test' for e in file.experiments):
-        write_aspects(checks.part, os.path.join(run_dir, 'aspects.png'))
+    if any(kind_of(e).names_aspects for e in file.experiments):
+        write_aspects(checks.geometry.part, os.path.join(run_dir, 'aspects.png'))

@@ -90,12 +90,12 @@ def _stopped_gripper(validator: Validator, row: dict) -> list[Overlay]:
     index = int(row['grasp'])
     position = np.array([float(row[k]) for k in ('x', 'y', 'z')])
     part_rotation = _rotation(row)
+    geo = validator.geometry
     frames = validator.approach_frames(part_rotation.as_matrix()[None], np.array([index]))
-    tilt = int(np.abs(validator.tilts).argmin())
+    tilt = int(np.abs(geo.tilts).argmin())
     rotation = Rotation.from_matrix(frames[0, tilt])
-    origin = position + part_rotation.apply(validator.grasps[index].point)
-    return gripper_overlays(validator.gripper_shapes[index], (*origin, *rotation.as_quat()),
-                            RED)
+    origin = position + part_rotation.apply(geo.grasps[index].point)
+    return gripper_overlays(geo.gripper_shapes[index], (*origin, *rotation.as_quat()), RED)
 
 
 def _rotation(row: dict) -> Rotation:
@@ -122,8 +122,8 @@ def stopped_in_world(world: World, validator: Validator, unit: Unit, rows: list[
         _save(os.path.join(run_dir, f'stopped_{name}.png'), image)
         captions[f'stopped_{name}.png'] = (
             f'Stopped at {name} collision: part {row["part_id"]} of `{exp_id}` iteration 1 '
-            f'(grasp {validator.grasps[int(row["grasp"])].name}), its gripper in red at the '
-            f'most vertical approach: it hits {what}.')
+            f'(grasp {validator.geometry.grasps[int(row["grasp"])].name}), its gripper in red at '
+            f'the most vertical approach: it hits {what}.')
 
 
 def placeability_picture(validator: Validator, rows: list[dict], exp_id: str,
@@ -135,10 +135,10 @@ def placeability_picture(validator: Validator, rows: list[dict], exp_id: str,
     row = _first_stopped(rows, STAGE_PLACEABILITY)
     if row is None:
         return None
-    g = int(row['grasp'])
+    g, geo = int(row['grasp']), validator.geometry
     rotation = _rotation(row).as_matrix()
     frames = validator.approach_frames(rotation[None], np.array([g]))[0]
-    within = np.flatnonzero(frames[:, 2, 2] >= np.cos(validator.config.approach_cone) - 1e-12)
+    within = np.flatnonzero(frames[:, 2, 2] >= np.cos(geo.config.approach_cone) - 1e-12)
     relatives = {k: rotation.T @ frames[k] for k in within}
     reach = {k: part_sheet.clearance(validator, g, r) for k, r in relatives.items()}
     if not reach:
@@ -146,15 +146,15 @@ def placeability_picture(validator: Validator, rows: list[dict], exp_id: str,
     best = max(reach, key=reach.get)
     fig = plt.figure(figsize=(5.0, 4.2))
     ax = fig.add_subplot(1, 1, 1, projection='3d')
-    part_sheet.draw_place(ax, validator, g, [relatives[best]], [validator.tilts[best]],
-                          f'part {row["part_id"]}, grasp {validator.grasps[g].name}\n')
+    part_sheet.draw_place(ax, validator, g, [relatives[best]], [geo.tilts[best]],
+                          f'part {row["part_id"]}, grasp {geo.grasps[g].name}\n')
     fig.tight_layout()
     fig.savefig(os.path.join(run_dir, 'stopped_placeability.png'), dpi=90)
     plt.close(fig)
     return (f'Stopped at placeability: part {row["part_id"]} of `{exp_id}` iteration 1 (grasp '
-            f'{validator.grasps[g].name}), turned to its place orientation, the gripper holding '
+            f'{geo.grasps[g].name}), turned to its place orientation, the gripper holding '
             f'it as it would pick it as it lies, at its best tilt '
-            f'({np.degrees(validator.tilts[best]):+.0f} deg of {len(within)} within the '
+            f'({np.degrees(geo.tilts[best]):+.0f} deg of {len(within)} within the '
             f'approach cone): it reaches {-reach[best] * 1000:.1f} mm past the placing surface '
             '(yellow).')
 
@@ -163,7 +163,7 @@ def bin_picture(file: ExperimentFile, summary: dict, run_dir: str,
                 captions: dict[str, str]) -> str | None:
     """bin.png with a valid and a rejected grasp, and the parts its bin's stages stopped
     (`stopped_in_world`, into `captions`); returns its caption (None: nothing to draw)."""
-    exp = next((e for e in file.experiments if e.type == BIN_EMPTYING), None)
+    exp = file.first_of(BIN_EMPTYING)
     if exp is None or exp.id not in summary['experiments'] or (
             exp.bin_from and exp.bin_from not in summary['experiments']):
         return None
@@ -173,14 +173,14 @@ def bin_picture(file: ExperimentFile, summary: dict, run_dir: str,
         return None
     with _settle(file, unit) as world:
         validator = Validator(file.for_experiment(exp).setup, world.part)
-        grasps = validator.grasps
+        grasps = validator.geometry.grasps
         same = _same_as_recorded(world, parts, 0)
         overlays, notes = [], []
         if picks:
             p = picks[0]
             pose = [float(p[k]) for k in ('gripper_x', 'gripper_y', 'gripper_z', 'gripper_qx',
                                           'gripper_qy', 'gripper_qz', 'gripper_qw')]
-            overlays += gripper_overlays(validator.gripper_shapes[int(p['grasp'])], pose,
+            overlays += gripper_overlays(validator.geometry.gripper_shapes[int(p['grasp'])], pose,
                                          GREEN)
             notes.append(f'green: the first pick, part {p["part_id"]} (grasp '
                          f'{grasps[int(p["grasp"])].name}), found after {p["searches"]} '
@@ -206,7 +206,7 @@ def tray_picture(file: ExperimentFile, summary: dict, run_dir: str,
                  captions: dict[str, str]) -> str | None:
     """tray.png at the count nearest n*, and the parts its stages stopped that the bin did not
     show (`stopped_in_world`); returns its caption (None: nothing to draw)."""
-    exp = next((e for e in file.experiments if e.type == TABLE_SWEEP), None)
+    exp = file.first_of(TABLE_SWEEP)
     if exp is None or summary['experiments'].get(exp.id, {}).get('n_star') is None:
         return None
     n_star = summary['experiments'][exp.id]['n_star']

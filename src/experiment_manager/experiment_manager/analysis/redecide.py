@@ -1,14 +1,16 @@
-"""A finished run decided again with today's rules: every experiment's summary computed anew
+"""An experiment's summary from its rows (`summarise`: the one step the scheduler takes when an
+experiment's last iteration is written, and `redecide` for each experiment of a finished run),
+and a finished run decided again with today's rules: every experiment's summary computed anew
 from the run's own result files (iterations.csv, picks.csv, checks.csv) and the experiment file
-it kept, in the file's order, as the scheduler computes it when an experiment's last iteration
-is written. What a rule cannot recompute is kept from the run's summary.json: an adaptive
-experiment's sampling (the batches it took are the run's history). Results written before a
-rule changed (the table's bound, the bins' race) are then read as today's. No rclpy."""
+it kept, in the file's order. What a rule cannot recompute is kept from the run's
+summary.json: an adaptive experiment's sampling (the batches it took are the run's history).
+Results written before a rule changed (the table's bound, the bins' race) are then read as
+today's. No rclpy."""
 
 import os
 
 from .. import experiment_file
-from ..experiment_file import SENSITIVITY
+from ..experiment_file.kinds import kind_of
 from . import metrics, sensitivity
 from . import summary as summary_model
 from .results import read_csv
@@ -28,20 +30,27 @@ def redecide(run_dir: str, recorded: summary_model.Summary | None = None) -> dic
     sampled = _sampling(recorded) if recorded is not None else {}
     summaries: dict[str, dict] = {}
     for exp in file.experiments:
-        if exp.type == SENSITIVITY:
-            if all(source in summaries for source in exp.sources):
-                summaries[exp.id] = sensitivity.summarise(file, exp, summaries)
-            continue
         mine = [r for r in rows if r['experiment'] == exp.id]
-        if not mine:            # an interrupted run: not reached
+        reached = (all(s in summaries for s in exp.sources) if kind_of(exp).repeats_others
+                   else bool(mine))
+        if not reached:         # an interrupted run stopped before it
             continue
-        summaries[exp.id] = metrics.summarise(
-            file.for_experiment(exp), exp, mine,
-            [p for p in picks if p['experiment'] == exp.id], summaries,
-            [c for c in checks if c['experiment'] == exp.id])
+        summaries[exp.id] = summarise(
+            file, exp, mine, [p for p in picks if p['experiment'] == exp.id],
+            [c for c in checks if c['experiment'] == exp.id], summaries)
         if exp.id in sampled:
             summaries[exp.id]['sampling'] = sampled[exp.id]
     return metrics.file_summary(file, summaries)
+
+
+def summarise(file: experiment_file.ExperimentFile, exp: experiment_file.Experiment,
+              rows: list[dict], picks: list[dict], checks: list[dict], earlier: dict) -> dict:
+    """An experiment's summary from its rows of iterations.csv, picks.csv and checks.csv, and
+    the summaries of the experiments before it (`earlier`): a sensitivity's from its repeats'
+    (sensitivity.summarise), every other kind's from its rows (metrics.summarise)."""
+    if kind_of(exp).repeats_others:
+        return sensitivity.summarise(file, exp, earlier)
+    return metrics.summarise(file.for_experiment(exp), exp, rows, picks, earlier, checks)
 
 
 def _sampling(recorded: summary_model.Summary) -> dict[str, dict]:

@@ -150,8 +150,8 @@ class FeederEmptying(_Experiment):
     parts_per_hour_ci95: list[float | None]
     cell: Cell
     decision: TableGrounds
-    first_check: Fractions | None = Field(None, description="each run's first check, the "
-                                          'tray loaded')
+    first_check: Fractions | None = Field(description="each run's first check, the tray "
+                                          'loaded; null in a summary of version 1')
     regrasps: Stats | None = Field(None, description='with a station: picks placed only '
                                    'after a regrasp, per run')
 
@@ -251,8 +251,8 @@ class Calibration(_Record):
     keys: list[str]
     # the simulation's noise: SD of a log likelihood difference between two points of one true
     # shares, and how often it alone puts such a point outside the interval
-    noise_sd: float | None = None
-    noise_outside: float | None = None
+    noise_sd: float | None = Field(description='null in a summary of version 1')
+    noise_outside: float | None = Field(description='null in a summary of version 1')
 
 
 class Sensitivity(_Experiment):
@@ -316,7 +316,7 @@ class Summary(_Record):
     """summary.json: the file's experiments by id, in the file's order, and a sensitivity
     experiment's repeats of them (`<experiment>@<scenario>`) apart."""
     model_config = ConfigDict(title=f'pick_sim run summary, version {SCHEMA_VERSION}')
-    schema_version: Literal[1] = SCHEMA_VERSION
+    schema_version: Literal[2] = SCHEMA_VERSION
     id: str
     seed: int
     requirements: Requirements

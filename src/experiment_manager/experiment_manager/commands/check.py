@@ -14,7 +14,8 @@ from pick_common.specs import CENTRE, FIXED, MOVES, RANDOM, Vibration
 
 from .. import experiment_file
 from ..analysis import part_sheet
-from ..experiment_file.model import ExperimentFile, FEEDER_EMPTYING, SENSITIVITY
+from ..experiment_file.kinds import kind_of
+from ..experiment_file.model import ExperimentFile
 from ..experiment_file.plan import count_iterations, experiment_iterations
 
 
@@ -64,7 +65,7 @@ def describe_plan(file: ExperimentFile) -> list[str]:
              + (' (sampling adaptive: each stops once its decision is settled)' if adaptive
                 else '')]
     for exp in own:
-        if exp.type != SENSITIVITY:
+        if not kind_of(exp).repeats_others:
             lines.append(f'  {exp.id} ({exp.type}): {at_most}{experiment_iterations(exp)} '
                          'iterations')
             continue
@@ -76,7 +77,7 @@ def describe_plan(file: ExperimentFile) -> list[str]:
         for s in exp.scenarios:
             values = ', '.join(f'{name} {value:g}' for name, value in s.values)
             lines.append(f'    {s.name}: {values}')
-    if any(e.type == FEEDER_EMPTYING for e in own):
+    if any(kind_of(e).feeds for e in own):
         lines.append('feeder cycle, one vibration: ' + ', '.join(describe_move(m)
                                                                 for m in file.moves))
     return lines

@@ -31,11 +31,10 @@ from .model import (
     TABLE_SWEEP,
     TYPES,
 )
-from .schema import GRIPPER_KEYS
 
 __all__ = [
     'ADAPTIVE', 'BIN_EMPTYING', 'BIN_STATIC', 'Cell', 'DROP_TEST', 'Experiment', 'ExperimentFile',
-    'FEEDER_EMPTYING', 'FIXED', 'GRIPPER_KEYS', 'GRIPPER_SWEEP', 'GripperVariant', 'InvalidFile',
+    'FEEDER_EMPTYING', 'FIXED', 'GRIPPER_SWEEP', 'GripperVariant', 'InvalidFile',
     'load', 'MAX_ITERATIONS', 'MM', 'parse', 'reduced', 'Requirements', 'Sampling', 'SEARCH_ORDERS',
     'SENSITIVITY', 'TABLE_SWEEP', 'TYPES',
 ]

@@ -11,7 +11,8 @@ from pick_common.parts.geometry import PartGeometry
 
 from . import experiment_keys
 from .errors import checked
-from .model import DROP_PLATE, DROP_TEST, MM
+from .kinds.base import KINDS
+from .model import DROP_PLATE, MM
 from .scenarios import DROP_HEIGHT
 
 
@@ -44,7 +45,7 @@ def drop_test_height(of: tuple[str, ...], where: str, earlier: dict) -> float:
     heights = set()
     for exp_id in of:
         source = earlier[exp_id]
-        if source.type != DROP_TEST:
+        if not KINDS[source.type].names_aspects:
             raise InvalidArgument(where, DROP_HEIGHT, "varies a drop test's "
                                   f'height; {exp_id} is a {source.type}: name drop tests only')
         heights.add(round(source.bin.drop_height / MM, 9))

@@ -6,23 +6,16 @@ from functools import partial
 from typing import Annotated, Any
 
 from pick_common.specs import MAX_PARTS_PER_INSTANCE
-from pydantic import BeforeValidator, ConfigDict, model_validator
+from pydantic import BeforeValidator, create_model, model_validator
 
 from .model import (
-    BIN_EMPTYING,
-    BIN_STATIC,
-    DROP_TEST,
-    FEEDER_EMPTYING,
-    GRIPPER_SWEEP,
     MAX_BINS,
     MAX_EXPERIMENTS,
     MAX_ITERATIONS,
     MAX_VARIANTS,
-    SENSITIVITY,
-    TABLE_SWEEP,
     TYPES,
 )
-from .schema import Section
+from .schema import GRIPPER_FILE_KEYS, Section
 from .values import (
     fail,
     Identifier,
@@ -137,15 +130,11 @@ class FeederEmptyingKeys(OnGripper):
     max_feed: Int(1, MAX_PARTS_PER_INSTANCE) | None = None    # a feed's dose; None: no limit
 
 
-class GripperGrid(Section):
-    """gripper_sweep's grid: each gripper key a number or a list of numbers, mm; a key left
-    out is the file's gripper's."""
-
-    body_diameter_mm: GridValues = None
-    body_length_mm: GridValues = None
-    jaw_height_mm: GridValues = None
-    jaw_depth_mm: GridValues = None
-    finger_clearance_mm: GridValues = None
+# gripper_sweep's grid: each key of the file's gripper's kind a number or a list of numbers,
+# in the key's unit; a key left out is the file's gripper's (every kind's keys are read here;
+# a key of another kind than the file's gripper is refused by grippers.variants).
+GripperGrid = create_model('GripperGrid', __base__=Section, __module__=__name__,
+                           **{key: (GridValues, None) for key in GRIPPER_FILE_KEYS})
 
 
 class GripperSweepKeys(ExperimentKeys):
@@ -198,22 +187,3 @@ class SensitivityKeys(ExperimentKeys):
     inputs: Annotated[dict[str, InputRange], BeforeValidator(_inputs)]
     joint: Int(0, 64) = 0
     grid: Int(0, 9) = 0
-
-
-EXPERIMENTS: dict[str, type[ExperimentKeys]] = {
-    BIN_STATIC: BinStaticKeys, BIN_EMPTYING: BinEmptyingKeys, TABLE_SWEEP: TableSweepKeys,
-    FEEDER_EMPTYING: FeederEmptyingKeys, GRIPPER_SWEEP: GripperSweepKeys,
-    DROP_TEST: DropTestKeys, SENSITIVITY: SensitivityKeys}
-
-
-def experiment_model(item: Any) -> type[Section]:
-    """The model an experiment is read with: its type's, or (for an unknown or missing type)
-    one that names the type's error and its id's and iterations' but no key as unknown."""
-    kind = item.get('type') if isinstance(item, Mapping) else None
-    if isinstance(kind, str) and kind in EXPERIMENTS:
-        return EXPERIMENTS[kind]
-    return _AnyExperiment
-
-
-class _AnyExperiment(ExperimentKeys):
-    model_config = ConfigDict(extra='ignore', frozen=True, validate_default=True)

@@ -1,50 +1,44 @@
 """The grippers of a file besides its own: `grippers`, each named, with its grasps, for the
 experiments that name it (`named`); and a gripper_sweep's grippers, every combination of the
-jaws' sizes it gives and of its grasp sets (`variants`); each checked by the core's rules
-under the file's keys."""
+sizes it gives the file's gripper and of its grasp sets (`variants`); each checked by the
+core's rules under the file's keys."""
 
+from dataclasses import replace
 import itertools
 import math
 
 from pick_common.errors import check_number, InvalidArgument
 from pick_common.parts.geometry import PartGeometry
-from pick_validity.config import (
-    CAPACITOR_GRASPS,
-    check_grasps,
-    check_gripper,
-    GraspPose,
-    Gripper,
-    is_suction,
-    Setup,
-    SuctionCup,
-)
+from pick_validity.config import Setup
+from pick_validity.grippers import GripperKind
 
 from . import experiment_keys, schema, sections
 from . import part as part_section
 from .errors import checked as checked_as
 from .errors import read as read_keys
-from .model import GripperVariant, MAX_VARIANTS, MM
-from .schema import GRIPPER_KEYS
+from .model import GripperVariant, MAX_VARIANTS
 from .values import short
 
 
-def variants(e: experiment_keys.GripperSweepKeys, where: str, gripper: Gripper | SuctionCup,
-             grasps: tuple[GraspPose, ...]) -> tuple[GripperVariant, ...]:
-    """gripper_sweep's grid: every combination of its grippers (the file's gripper standing in
-    for keys not given) and grasp sets (default: every grasp, named 'all'), in the order
-    given, body diameter varying slowest. The jaws' sizes only: a suction cup is refused.
-    `gripper` and `grasps`: the file's."""
-    if is_suction(gripper):
-        raise InvalidArgument(where, 'gripper_sweep', "varies the parallel jaws' sizes, and "
-                              'the gripper is a suction cup (gripper.type: suction): compare a '
-                              "cup's sizes with a sensitivity of gripper.body_diameter_mm or "
-                              'files of their own')
+def variants(e: experiment_keys.GripperSweepKeys, where: str, gripper: GripperKind,
+             grasps: tuple) -> tuple[GripperVariant, ...]:
+    """gripper_sweep's grid: every combination of its grippers (the file's gripper's kind,
+    the file's gripper standing in for keys not given) and grasp sets (default: every grasp,
+    named 'all'), in the order given, the kind's first key varying slowest. `gripper` and
+    `grasps`: the file's."""
+    for key in e.grippers.model_fields_set:
+        if getattr(e.grippers, key) is not None and key not in \
+                {k.file_key for k in gripper.KEYS}:
+            raise InvalidArgument(f'{where}.grippers.{key}', getattr(e.grippers, key),
+                                  f"is not a key of the file's gripper, {gripper.description} "
+                                  f'(gripper.type: {gripper.kind})')
     axes = []
-    for key, attr in GRIPPER_KEYS:
-        given = getattr(e.grippers, key)
+    for key in gripper.KEYS:
+        given = getattr(e.grippers, key.file_key)
         values = given if given is not None else (check_number(
-            f'{where}.grippers.{key}', getattr(gripper, attr) / MM, low=0.0),)
-        axes.append([(attr, v * MM) for v in values])
+            f'{where}.grippers.{key.file_key}', getattr(gripper, key.field) / key.factor,
+            low=0.0),)
+        axes.append([(key.field, v * key.factor) for v in values])
     names = [g.name for g in grasps]
     sets = []
     for name, members in (e.grasp_sets or {'all': names}).items():
@@ -65,9 +59,9 @@ def variants(e: experiment_keys.GripperSweepKeys, where: str, gripper: Gripper |
                               f'limit of {MAX_VARIANTS} combinations per experiment')
     out = []
     for combination in itertools.product(*axes):
-        g = Gripper(**dict(combination))
-        checked_as(check_gripper, g, f'{where}.grippers (' + ', '.join(
-            f'{key} {getattr(g, attr) / MM:g}' for key, attr in GRIPPER_KEYS) + ')')
+        g = gripper.with_values(**dict(combination))
+        checked_as(lambda x: x.check(), g, f'{where}.grippers (' + ', '.join(
+            f'{key.file_key} {getattr(g, key.field) / key.factor:g}' for key in g.KEYS) + ')')
         out += [GripperVariant(g, name, members) for name, members in sets]
     return tuple(out)
 
@@ -90,31 +84,12 @@ def named(value, setup: Setup, geometry: PartGeometry) -> dict[str, Setup]:
         keys, errors = read_keys(schema.NamedGripper, entry, where)
         if errors:
             raise errors[0]
-        gripper = sections.gripper(keys)
-        checked_as(check_gripper, gripper, where)
-        suction = is_suction(gripper)
+        gripper = checked_as(lambda g: g.check(), sections.gripper(keys), where)
         try:
-            if keys.grasps == part_section.AUTO:
-                grasps = part_section.proposed(geometry, gripper)
-            elif keys.grasps is None:
-                if suction:
-                    raise InvalidArgument('part.grasps', None, "is required with a suction "
-                                          "cup: give each grasp's up_axis and grasp_point_mm, "
-                                          'or auto')
-                grasps = CAPACITOR_GRASPS
-            else:
-                grasps = tuple(part_section.grasp_entry(g, i, suction)
-                               for i, g in enumerate(keys.grasps))
-            check_grasps(grasps, gripper)
-            mine = Setup(setup.part, gripper, grasps, setup.place, setup.config)
-            if suction:
-                part_section.check_cup(geometry, mine)
-            else:
-                part_section.check_fits(geometry, grasps)
-        except InvalidArgument as exc:       # the part's keys, under this gripper's
-            field = exc.field.replace('part.grasps', f'{where}.grasps', 1)
-            if not field.startswith(where):
-                field = f'{where}.{field}'
+            grasps = part_section.grasps_for(keys.grasps, gripper, geometry, setup,
+                                             f'{where}.grasps')
+        except InvalidArgument as exc:       # a core field, under this gripper's
+            field = exc.field if exc.field.startswith(where) else f'{where}.{exc.field}'
             raise InvalidArgument(field, exc.value, exc.rule) from None
-        out[name] = mine
+        out[name] = replace(setup, gripper=gripper, grasps=grasps)
     return out

@@ -15,45 +15,27 @@ from dataclasses import replace
 import os
 from typing import Any
 
-from feeder_controller.policy import check_feeder, FeederConfig
-from pick_common.containers import check_container, check_fits, ContainerSpec
 from pick_common.errors import check_int, InvalidArgument
-from pick_common.parts.geometry import PartGeometry
-from pick_common.specs import Vibration
-from pick_validity.config import (
-    check_grasps,
-    check_gripper,
-    check_place,
-    is_suction,
-    Setup,
-    tilts,
-)
+from pick_common.parts.aspects import part_aspects
+from pick_validity.config import check_place, Setup, tilts
 import yaml
 
 from . import experiment_keys, grippers, schema, sections
 from . import part as part_section
-from . import scenarios as scenario_inputs
-from .drop_test import drop_test, drop_test_height
 from .errors import checked as checked_as
 from .errors import read as read_keys
+from .kinds import Context, keys_model, KINDS
+from .kinds.context import earlier
 from .model import (
     ADAPTIVE,
-    BIN_EMPTYING,
-    BIN_STATIC,
     Cell,
-    DROP_TEST,
     Experiment,
     ExperimentFile,
-    FEEDER_EMPTYING,
-    GRIPPER_SWEEP,
-    Input,
     MAX_EXPERIMENTS,
     MAX_FILE_BYTES,
     MAX_ITERATIONS,
     MM,
     Sampling,
-    SENSITIVITY,
-    TABLE_SWEEP,
 )
 from .values import short
 
@@ -71,135 +53,14 @@ class InvalidFile(InvalidArgument):
 
 
 # -------------------------------------------------------------------------- experiments
-class _Context:
-    """What an experiment's checks relate to: the part's geometry, the tray, the bins' wall
-    and size limit, the setup (part, gripper, grasps) and table moves, the file's seed, and
-    the experiments read before it."""
-
-    def __init__(self, geometry: PartGeometry, tray: ContainerSpec, bin_wall: float,
-                 bin_drop: float, max_dimension: float, setup: Setup,
-                 moves: tuple[Vibration, ...], seed: int) -> None:
-        self.geometry, self.tray, self.bin_wall = geometry, tray, bin_wall
-        self.bin_drop = bin_drop
-        self.max_dimension, self.setup, self.moves, self.seed = max_dimension, setup, moves, seed
-        self.gripper, self.grasps = setup.gripper, setup.grasps
-        self.earlier: dict[str, Experiment] = {}
-        self.named: dict[str, Setup] = {}           # the file's `grippers`
-
-
-def _bin(size_mm: tuple[float, ...], where: str, c: _Context) -> ContainerSpec:
-    size = tuple(MM * s for s in size_mm)
-    for i, s in enumerate(size):
-        if s > c.max_dimension + 1e-12:
-            raise InvalidArgument(f'{where}[{i}]', round(s / MM, 6),
-                                  f'mm is over the size limit requirements.max_dimension_mm '
-                                  f'= {c.max_dimension / MM:g}')
-    spec = ContainerSpec(inner_size=size, wall_thickness=c.bin_wall, drop_height=c.bin_drop)
-    checked_as(check_container, spec, where)
-    return spec
-
-
-def _earlier(where: str, exp_id: str, c: _Context, kind: str, alternative: str) -> Experiment:
-    """The earlier experiment of type `kind` named by id at `where`."""
-    source = c.earlier.get(exp_id)
-    if source is None or source.type != kind:
-        raise InvalidArgument(where, exp_id, f'names no earlier {kind} experiment (give its '
-                              f'id, or {alternative})')
-    return source
-
-
-def _bin_or_source(value: Any, parts: int, where: str, c: _Context) -> dict:
-    """An experiment's `bin`: a bin in mm ({'bin': spec}) or the id of an earlier bin_static
-    experiment whose best bin is used ({'bin_from': id}); {} when there is none. `parts` must
-    fit in it (in every bin of the source)."""
-    volume = c.geometry.volume
-    if value is None:
-        return {}
-    if isinstance(value, str):
-        source = _earlier(f'{where}.bin', value, c, BIN_STATIC, 'a bin [x, y, z] in mm')
-        for i, b in enumerate(source.bins):
-            check_fits(f'{where}.parts ({value}.bins_mm[{i}])', parts, volume, b)
-        return {'bin_from': value}
-    spec = _bin(value, f'{where}.bin', c)
-    check_fits(f'{where}.parts', parts, volume, spec)
-    return {'bin': spec}
-
-
-def _sensitivity(e: experiment_keys.SensitivityKeys, where: str, c: _Context) -> list[Experiment]:
-    """A sensitivity experiment and, before it, its repeats of the experiments it names, one
-    per scenario (scenarios.py); a repeat takes its bin or range from the same scenario's
-    repeat of its source when that is repeated too, else from the source itself."""
-    for i, exp_id in enumerate(e.of):
-        if c.earlier.get(exp_id) is None or c.earlier[exp_id].type == SENSITIVITY:
-            raise InvalidArgument(f'{where}.of[{i}]', exp_id, 'names no earlier experiment '
-                                  '(of a type other than sensitivity)')
-    if len(set(e.of)) != len(e.of):
-        raise InvalidArgument(f'{where}.of', list(e.of), 'names an experiment twice')
-    for i, exp_id in enumerate(e.of):
-        if c.earlier[exp_id].gripper or c.earlier[exp_id].station:
-            raise InvalidArgument(f'{where}.of[{i}]', exp_id, 'runs with a gripper of the '
-                                  "file's grippers or a regrasp station; a sensitivity varies "
-                                  "the file's own cell")
-    inputs = []
-    for name, r in e.inputs.items():
-        at = f'{where}.inputs.{name}'
-        moved = name.removeprefix('part.')
-        if name.startswith('part.') and moved in schema.MOVED_KEYS:
-            raise InvalidArgument(at, name, f'has moved: vary materials.part_on_surface.{moved} '
-                                  f'(the part on the bin or tray) or materials.part_on_part.'
-                                  f'{moved} (on another part)')
-        if name not in scenario_inputs.INPUTS:
-            raise InvalidArgument(at, name, 'is not an input a sensitivity experiment varies ('
-                                  + ', '.join(scenario_inputs.INPUTS) + ')')
-        sweeps = [x for x in e.of if c.earlier[x].type == GRIPPER_SWEEP]
-        if name.startswith('gripper.') and sweeps:
-            raise InvalidArgument(at, name, f'cannot reach the gripper_sweep {sweeps[0]}, whose '
-                                  'grippers are its own: vary the gripper there, or leave it '
-                                  'out of `of`')
-        low = scenario_inputs.check_input(name, r.low, f'{at}.low')
-        high = scenario_inputs.check_input(name, r.high, f'{at}.high')
-        if name == scenario_inputs.DROP_HEIGHT:
-            base = drop_test_height(e.of, at, c.earlier)
-        else:
-            base = scenario_inputs.base_value(name, c.setup, c.geometry.mass, at)
-        inputs.append(Input(name, round(base, 9), low, high, r.source.strip()))
-    inputs = tuple(inputs)
-    repeats = (2 * len(inputs) + e.joint + (e.grid ** len(inputs) if e.grid else 0)) * len(e.of)
-    if repeats > scenario_inputs.MAX_REPEATS:
-        raise InvalidArgument(f'{where}.inputs', repeats, f'scenarios x experiments repeated '
-                              f'is over the limit of {scenario_inputs.MAX_REPEATS} (2 '
-                              'scenarios per input, plus joint, plus grid ** inputs, times the '
-                              'experiments of `of`)')
-    found = scenario_inputs.scenarios(inputs, e.joint, c.setup, c.moves, c.seed, e.id, where,
-                                      e.grid)
-    repeats = []
-    for scenario in found:
-        for exp_id in e.of:
-            source = c.earlier[exp_id]
-            renamed = {key: f'{value}@{scenario.name}' if value in e.of else value
-                       for key in ('bin_from', 'range_from')
-                       if (value := getattr(source, key))}
-            if (height := scenario_inputs.drop_height(scenario)) is not None:
-                renamed['bin'] = replace(source.bin, drop_height=height)
-            repeats.append(replace(source, id=f'{exp_id}@{scenario.name}',
-                                   iterations=min(source.iterations, e.iterations),
-                                   scenario=scenario, **renamed))
-    return repeats + [Experiment(id=e.id, type=SENSITIVITY, iterations=e.iterations,
-                                 of=tuple(e.of), inputs=inputs, scenarios=found,
-                                 grid=e.grid)]
-
-
-def _experiment(e: experiment_keys.ExperimentKeys, where: str, c: _Context) -> list[Experiment]:
-    """The experiment read at `where` (with, for a sensitivity experiment, its repeats)."""
+def _experiment(e: experiment_keys.ExperimentKeys, where: str, c: Context) -> list[Experiment]:
+    """The experiment read at `where` (with, for a sensitivity experiment, its repeats): what
+    every kind reads (its id, and of an experiment of the cell's picking its parts, gripper,
+    scenes and station), then its kind's own keys (kinds.ExperimentKind.read)."""
     if e.id in c.earlier:
         raise InvalidArgument(f'{where}.id', e.id, 'is the id of an earlier experiment')
-    if e.type == SENSITIVITY:
-        return _sensitivity(e, where, c)
-    volume, tray = c.geometry.volume, c.tray
     out: dict[str, Any] = {'id': e.id, 'type': e.type, 'iterations': e.iterations}
-    if e.type == DROP_TEST:
-        return [Experiment(**out, **drop_test(e, where, c.geometry, c.bin_wall))]
-    if e.type != TABLE_SWEEP:
+    if 'parts' in type(e).model_fields:
         out['parts'] = e.parts
     if getattr(e, 'gripper', None) is not None:
         if e.gripper not in c.named:
@@ -207,45 +68,13 @@ def _experiment(e: experiment_keys.ExperimentKeys, where: str, c: _Context) -> l
                                   f"file's grippers ({', '.join(c.named) or 'none'})")
         out['gripper'], out['setup'] = e.gripper, c.named[e.gripper]
     if getattr(e, 'scenes_of', None) is not None:
-        _earlier(f'{where}.scenes_of', e.scenes_of, c, e.type, 'leave scenes_of out')
+        earlier(f'{where}.scenes_of', e.scenes_of, c, e.type, 'leave scenes_of out')
         out['seeded_by'] = c.earlier[e.scenes_of].seeded_by or e.scenes_of
     if getattr(e, 'regrasp_station', False):
         mine = out.get('setup', c.setup)
         out['station'] = True
         out['setup'] = replace(mine, config=replace(mine.config, regrasp_station=True))
-    if e.type == BIN_STATIC:
-        out['bins'] = tuple(_bin(v, f'{where}.bins_mm[{i}]', c) for i, v in enumerate(e.bins_mm))
-        for i, b in enumerate(out['bins']):
-            check_fits(f'{where}.parts (bins_mm[{i}])', e.parts, volume, b)
-    elif e.type == BIN_EMPTYING:
-        out.update(_bin_or_source(e.bin, e.parts, where, c))
-    elif e.type == TABLE_SWEEP:
-        out['counts'] = tuple(range(e.counts.first, e.counts.last + 1, e.counts.step))
-        check_fits(f'{where}.counts.last', out['counts'][-1], volume, tray)
-        out['margin'] = e.margin
-        out['extend'] = e.extend
-    elif e.type == GRIPPER_SWEEP:
-        scene = _bin_or_source(e.bin, e.parts, where, c)
-        if not scene:       # no bin: the parts lie on the tray, as in a table_sweep
-            check_fits(f'{where}.parts (tray_mm)', e.parts, volume, tray)
-        out.update(scene)
-        out['variants'] = grippers.variants(e, where, c.gripper, c.grasps)
-        out['min_valid'] = e.min_valid
-    elif e.type == FEEDER_EMPTYING:
-        if isinstance(e.optimal_range, str):
-            source = _earlier(f'{where}.optimal_range', e.optimal_range, c, TABLE_SWEEP,
-                              '[min, max]')
-            out['range_from'] = e.optimal_range
-            high = source.counts[-1] + source.margin
-        else:
-            out['optimal_range'] = e.optimal_range
-            high = e.optimal_range[1]
-            checked_as(check_feeder, FeederConfig(e.parts, *e.optimal_range, e.max_vibrations,
-                                                  e.max_feed or 0), where)
-        out['max_vibrations'] = e.max_vibrations
-        out['max_feed'] = e.max_feed or 0
-        check_fits(f'{where}.optimal_range (max)', high, volume, tray)
-    return [Experiment(**out)]
+    return KINDS[e.type].read(e, where, c, out)
 
 
 # ------------------------------------------------------------------------------- the file
@@ -280,39 +109,31 @@ def parse(text: str, path: str = '') -> ExperimentFile:
     top = read(schema.FileKeys, data, '')
     s = {key: read(model, data.get(key, {}), key) for key, model in schema.SECTIONS.items()}
     gripper = sections.gripper(s['gripper']) if s['gripper'] else None
-    suction = is_suction(gripper)
-    read_part = checked(lambda: part_section.read_part(s['part'], s['materials'], base_dir,
-                                                       suction)
+    read_part = checked(lambda: part_section.read_part(s['part'], s['materials'], base_dir)
                         ) if s['part'] and s['materials'] else None
-    part, grasps, place = read_part or (None, None, None)
+    part, place = read_part or (None, None)
     check = sections.check(s['check']) if s['check'] else None
     requirements = sections.requirements(s['requirements']) if s['requirements'] else None
     tray = checked(lambda: sections.tray(top)) if top else None
     moves = checked(lambda: sections.moves(top)) if top else None
     # The cores' own checks, under the file's names.
     if gripper is not None:
-        checked(lambda: checked_as(check_gripper, gripper, 'gripper'))
-    auto_grasps = grasps == part_section.AUTO
-    if part is not None:
-        checked(lambda: checked_as(check_place, place, 'part.place'))
-    if check is not None:
-        checked(lambda: checked_as(tilts, check, 'check'))
+        gripper = checked(lambda: checked_as(lambda g: g.check(), gripper, 'gripper'))
+    auto_grasps = s['part'] is not None and s['part'].grasps == part_section.AUTO
+    if part is not None and checked(lambda: checked_as(check_place, place, 'part.place')) is None:
+        place = None
+    if check is not None and checked(lambda: checked_as(tilts, check, 'check')) is None:
+        check = None
     geometry = checked(lambda: part_section.geometry(part)) if part is not None else None
-    if auto_grasps:
-        grasps = checked(lambda: part_section.proposed(geometry, gripper)) \
-            if geometry is not None else None
-    if grasps is not None:
-        checked(lambda: checked_as(check_grasps, list(grasps), 'part.grasps'))
-    if None not in (geometry, grasps, gripper, check) and suction:
-        checked(lambda: part_section.check_cup(geometry, Setup(part, gripper, grasps, place,
-                                                                check)))
-    elif geometry is not None and grasps is not None:
-        checked(lambda: part_section.check_fits(geometry, grasps))
+    grasps = None
+    if None not in (geometry, gripper, place, check):
+        grasps = checked(lambda: part_section.grasps_for(
+            s['part'].grasps, gripper, geometry, Setup(part, gripper, (), place, check)))
     if None not in (top, geometry, tray) and top.feeder_zone_mm is not None:
         checked(lambda: sections.zone_holds(top.feeder_zone_mm.size, geometry))
     context = None
     if None not in (top, geometry, tray, moves, requirements, gripper, grasps, check):
-        context = _Context(geometry, tray, MM * top.bin_wall_mm, MM * top.bin_drop_mm,
+        context = Context(geometry, tray, MM * top.bin_wall_mm, MM * top.bin_drop_mm,
                            requirements.max_dimension,
                            Setup(part, gripper, grasps, place, check), moves, top.seed)
         context.named = checked(lambda: grippers.named(top.grippers, context.setup,
@@ -321,7 +142,7 @@ def parse(text: str, path: str = '') -> ExperimentFile:
     for i, item in enumerate(raw if isinstance(raw, list) and len(raw) <= MAX_EXPERIMENTS
                              else []):
         where = f'experiments[{i}]'
-        keys = read(experiment_keys.experiment_model(item), item, where)
+        keys = read(keys_model(item), item, where)
         if keys is not None and context is not None:
             read_here = checked(lambda keys=keys, where=where: _experiment(keys, where,
                                                                             context))
@@ -341,7 +162,7 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         cell=Cell(pick_time=s['cell'].pick_s, image_time=s['cell'].image_s,
                   regrasp_time=s['cell'].regrasp_s),
         path=os.path.abspath(path) if path else '', text=text, auto_grasps=auto_grasps,
-        part_volume=geometry.volume,
+        part_volume=geometry.volume, aspects=part_aspects(geometry),
         material_account=part_section.material_account(s['materials']))
 
 

@@ -7,7 +7,8 @@ import math
 from pick_common.containers import ContainerSpec
 from pick_common.parts.spec import PartSpec
 from pick_common.specs import Vibration
-from pick_validity.config import CheckConfig, GraspPose, Gripper, PlaceSpec, Setup
+from pick_validity.config import CheckConfig, PlaceSpec, Setup
+from pick_validity.grippers import GripperKind
 
 BIN_STATIC, BIN_EMPTYING, TABLE_SWEEP, FEEDER_EMPTYING, GRIPPER_SWEEP, SENSITIVITY = (
     'bin_static', 'bin_emptying', 'table_sweep', 'feeder_emptying', 'gripper_sweep',
@@ -84,16 +85,14 @@ class GripperVariant:
     """One gripper and grasp set of a gripper_sweep: the gripper, the name of the grasp set
     (a key of the experiment's `grasp_sets`) and its grasps, in part.grasps order."""
 
-    gripper: Gripper
+    gripper: GripperKind
     grasp_set: str
-    grasps: tuple[GraspPose, ...]
+    grasps: tuple
 
     @property
-    def size(self) -> tuple[float, float, float, float]:
-        """What "smaller" means when grippers are compared: the body's diameter first (what
-        must fit between neighbours), then the jaws' depth and height, then the body's length."""
-        g = self.gripper
-        return g.body_diameter, g.jaw_depth, g.jaw_height, g.body_length
+    def size(self) -> tuple[float, ...]:
+        """What "smaller" means when grippers are compared: its kind's (grippers.py)."""
+        return self.gripper.size
 
 
 @dataclass(frozen=True)
@@ -192,20 +191,27 @@ class ExperimentFile:
     part_volume: float = 0.0    # m^3, the part's (the packing rule of a sweep's extra counts)
     # per contact pair, how each value was got and where they come from (part.material_account)
     material_account: tuple[tuple[str, tuple[tuple[str, str], ...], str], ...] = ()
+    # the aspects the part can rest on (pick_common.parts.aspects), from the geometry the
+    # file was checked with: what a drop test classifies by and counts
+    aspects: tuple = field(default=(), compare=False, repr=False)
 
     def experiment(self, experiment_id: str) -> Experiment:
         return next(e for e in self.experiments if e.id == experiment_id)
+
+    def first_of(self, kind: str) -> Experiment | None:
+        """The file's first experiment of this type (the one a picture shows), or None."""
+        return next((e for e in self.experiments if e.type == kind), None)
 
     @property
     def part(self) -> PartSpec:
         return self.setup.part
 
     @property
-    def gripper(self) -> Gripper:
+    def gripper(self) -> GripperKind:
         return self.setup.gripper
 
     @property
-    def grasps(self) -> tuple[GraspPose, ...]:
+    def grasps(self) -> tuple:
         return self.setup.grasps
 
     @property

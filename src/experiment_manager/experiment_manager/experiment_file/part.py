@@ -2,6 +2,7 @@
 material, its grasps and how it is placed, in SI units; and its geometry, with the check that
 each grasp's jaws close on it, every error named by the file's keys."""
 
+from dataclasses import fields, MISSING, replace
 import os
 from typing import Any
 
@@ -10,22 +11,11 @@ from pick_common.parts.geometry import build_part, PartGeometry
 from pick_common.parts.materials import body_values, Contact, DEFAULT_BASIS, SOURCE
 from pick_common.parts.spec import PartSpec, states_units, UNITS
 from pick_validity.check_geometry import build_geometry
-from pick_validity.config import (
-    CAPACITOR_GRASPS,
-    check_grasps,
-    GraspPose,
-    Gripper,
-    is_suction,
-    PlaceSpec,
-    Setup,
-    SuctionCup,
-    SuctionGrasp,
-)
-from pick_validity.grasp_fit import check_grasps_fit
-from pick_validity.grasp_proposals import propose, propose_suction
-from pick_validity.suction import OFF_SURFACE, seal
+from pick_validity.config import PlaceSpec, Setup
+from pick_validity.grippers import check_grasps, GripperKind, KINDS
 
 from . import schema
+from .errors import checked as checked_as
 from .model import G, MM
 
 AUTO = 'auto'       # part.grasps: proposed from the geometry
@@ -89,12 +79,10 @@ def material_account(m: schema.MaterialsSection
     return tuple(out)
 
 
-def read_part(p: schema.Part, m: schema.MaterialsSection, base_dir: str, suction: bool = False
-              ) -> tuple[PartSpec, tuple[GraspPose, ...] | tuple[SuctionGrasp, ...] | str,
-                         PlaceSpec]:
-    """The part's spec (its contact materials from `m`), its grasps (AUTO when the file
-    leaves them to `proposed`; a suction cup's when `suction`) and its placing, in SI
-    units."""
+def read_part(p: schema.Part, m: schema.MaterialsSection, base_dir: str
+              ) -> tuple[PartSpec, PlaceSpec]:
+    """The part's spec (its contact materials from `m`) and its placing, in SI units (its
+    grasps: `grasps_for`, once the gripper is known)."""
     mesh, scale, mass = '', 1.0, G * p.mass_g
     if p.model == 'mesh':
         if mass == 0.0:
@@ -128,79 +116,106 @@ def read_part(p: schema.Part, m: schema.MaterialsSection, base_dir: str, suction
         mesh_path=mesh, scale=scale)
     body_values(spec.part_on_surface, spec.part_on_part)     # a pair Bullet cannot apply
     place = PlaceSpec(place_axis=p.place.axis, seat_offset=MM * p.place.seat_offset_mm)
-    if p.grasps is None:
-        if suction:
-            raise InvalidArgument('part.grasps', None, 'is required with a suction cup (the '
-                                  "default grasps are jaws' for a capacitor): give each "
-                                  "grasp's up_axis and grasp_point_mm, or auto")
-        return spec, CAPACITOR_GRASPS, place
-    if p.grasps == AUTO:
-        return spec, AUTO, place
-    grasps = tuple(grasp_entry(g, i, suction) for i, g in enumerate(p.grasps))
-    names = [g.name for g in grasps]
-    if len(set(names)) != len(names):
-        raise InvalidArgument('part.grasps', names, 'has a grasp name twice')
-    return spec, grasps, place
+    return spec, place
 
 
-def grasp_entry(g: schema.GraspEntry, i: int, suction: bool) -> GraspPose | SuctionGrasp:
-    """One entry of part.grasps as the gripper's type reads it: a suction grasp gives no
-    closing_axis and no jaw_opening_mm, a jaws' grasp both."""
-    name = g.name if g.name is not None else f'grasp_{i}'
-    point = tuple(MM * v for v in g.grasp_point_mm)
-    jaws_keys = [k for k in ('closing_axis', 'jaw_opening_mm') if getattr(g, k) is not None]
-    if suction:
-        if jaws_keys:
-            raise InvalidArgument(f'part.grasps[{i}].{jaws_keys[0]} (grasp {name!r})',
-                                  getattr(g, jaws_keys[0]), "is a jaws' key, and the "
-                                  'gripper is type: suction (a suction grasp is up_axis and '
-                                  "grasp_point_mm: where the cup's centre touches)")
-        return SuctionGrasp(name=name, up_axis=g.up_axis, grasp_point=point)
-    missing = [k for k in ('closing_axis', 'jaw_opening_mm') if getattr(g, k) is None]
-    if missing:
-        raise InvalidArgument(f'part.grasps[{i}].{missing[0]} (grasp {name!r})', None,
-                              'is required with parallel jaws (gripper.type: jaws); a grasp '
-                              "without it is a suction cup's: set gripper.type: suction")
-    return GraspPose(name=name, up_axis=g.up_axis, closing_axis=g.closing_axis,
-                     jaw_opening=MM * g.jaw_opening_mm, grasp_point=point)
+# A grasp's keys in the file: per field of a written grasp (pick_validity.grasps), its key and
+# the factor from the file's unit to SI.
+GRASP_KEYS = {'up_axis': ('up_axis', 1.0), 'closing_axis': ('closing_axis', 1.0),
+              'jaw_opening': ('jaw_opening_mm', MM), 'grasp_point': ('grasp_point_mm', MM)}
 
 
-def check_cup(geometry: PartGeometry, setup: Setup) -> None:
-    """A suction cup's grasps: each one's point lies on the part's surface, named by its
-    place in the file; at least one seals and holds (build_geometry names each one's
-    reason). The seals are the check geometry's, computed once; only when it refuses the
-    setup are they computed here, so that a point off the surface is the error said."""
-    cup, grasps = setup.gripper, setup.grasps
-    try:
-        seals = build_geometry(setup, geometry).seals
-        refused = None
-    except InvalidArgument as exc:
-        seals = tuple(seal(geometry, cup, c) for c in check_grasps(grasps, cup))
-        refused = InvalidArgument(f'part.{exc.field}', exc.value, exc.rule)
-    for i, (g, found) in enumerate(zip(grasps, seals, strict=True)):
-        if found.reason.startswith(OFF_SURFACE):
-            raise InvalidArgument(f'part.grasps[{i}].grasp_point_mm (grasp {g.name!r})',
-                                  [round(v / MM, 3) for v in g.grasp_point], found.reason)
-    if refused is not None:
-        raise refused
-
-
-def proposed(geometry: PartGeometry, gripper: Gripper | SuctionCup | None = None
-             ) -> tuple[GraspPose, ...] | tuple[SuctionGrasp, ...]:
-    """`part.grasps: auto`: the grasps proposed from the part's geometry for the gripper's
-    type (a suction cup's: grasp_proposals.propose_suction)."""
-    if gripper is not None and is_suction(gripper):
-        try:
-            return tuple(p.grasp for p in propose_suction(geometry, gripper))
-        except InvalidArgument as exc:      # the core's field, in the file's mm
-            raise InvalidArgument(f'{exc.field}_mm', exc.value,
-                                  exc.rule.removeprefix('(mm) ')) from None
-    grasps = tuple(p.grasp for p in propose(geometry))
-    if not grasps:
-        raise InvalidArgument('part.grasps', AUTO, 'found no grasp: the part has no opposed '
-                              'faces and no round body across its mass centre; write its '
-                              'grasps')
+def grasps_for(value, gripper: GripperKind, geometry: PartGeometry, setup: Setup,
+               where: str = 'part.grasps') -> tuple:
+    """The grasps a gripper picks the part with, as the file gives them at `where` (`value`:
+    a list of schema.GraspEntry, AUTO, or None for the kind's defaults), each read as the
+    gripper's kind reads a grasp, checked, and holding the part as the kind requires
+    (`check_held`). `setup`: the rest of the setup they are checked in. The one resolution of
+    the file's own grasps and of each named gripper's."""
+    if value == AUTO:
+        grasps = proposed(geometry, gripper, where)
+    elif value is None:
+        grasps = gripper.default_grasps
+        if not grasps:
+            raise InvalidArgument(where, None, f'is required with {gripper.description} (the '
+                                  "default grasps are the jaws' for a capacitor): give each "
+                                  f"grasp's {_keys(gripper)}, or auto")
+    else:
+        grasps = tuple(grasp_entry(g, i, gripper, where) for i, g in enumerate(value))
+        names = [g.name for g in grasps]
+        if len(set(names)) != len(names):
+            raise InvalidArgument(where, names, 'has a grasp name twice')
+    checked_as(lambda g: check_grasps(g, gripper), list(grasps), where)
+    check_held(geometry, replace(setup, gripper=gripper, grasps=grasps), where)
     return grasps
+
+
+def _keys(gripper: GripperKind) -> str:
+    return ' and '.join(GRASP_KEYS[f.name][0] for f in fields(gripper.written)
+                        if f.name in GRASP_KEYS)
+
+
+def grasp_entry(g: schema.GraspEntry, i: int, gripper: GripperKind,
+                where: str = 'part.grasps'):
+    """One entry of part.grasps as the gripper's kind reads it (its written grasp's fields:
+    a suction grasp gives no closing_axis and no jaw_opening_mm, a jaws' grasp both)."""
+    name = g.name if g.name is not None else f'grasp_{i}'
+    wanted = {f.name: f.default is MISSING for f in fields(gripper.written) if f.name != 'name'}
+    values = {}
+    for field, (key, factor) in GRASP_KEYS.items():
+        given = getattr(g, key)
+        if field not in wanted:
+            if given is not None:
+                raise InvalidArgument(
+                    f'{where}[{i}].{key} (grasp {name!r})', given,
+                    f'is not a key of a grasp of {gripper.description} (gripper.type: '
+                    f'{gripper.kind}; its grasps give {_keys(gripper)})')
+            continue
+        if given is None:
+            if wanted[field]:
+                others = [k for k in KINDS.values()
+                          if field not in {f.name for f in fields(k.written)}]
+                raise InvalidArgument(f'{where}[{i}].{key} (grasp {name!r})', None,
+                                      f'is required with {gripper.description} (gripper.type: '
+                                      f'{gripper.kind})' + ''.join(
+                                          f"; a grasp without it is {k.description}'s: set "
+                                          f'gripper.type: {k.kind}' for k in others))
+            continue
+        values[field] = tuple(factor * v for v in given) if field == 'grasp_point' else \
+            given if factor == 1.0 else factor * given
+    return gripper.written(name=name, **values)
+
+
+def check_held(geometry: PartGeometry, setup: Setup, where: str = 'part.grasps') -> None:
+    """The setup's grasps hold the part as its gripper's kind requires (check_geometry.
+    build_geometry: a jaws' grasp closes on the part, a cup's grasp point lies on its surface,
+    some cup's grasp seals and holds), a grasp named by its place in the file at `where`."""
+    try:
+        build_geometry(setup, geometry)
+    except InvalidArgument as exc:
+        parts = exc.field.split('.')
+        if len(parts) == 3 and parts[0] == 'grasps':        # grasps.<name>.grasp_point
+            index = next(i for i, g in enumerate(setup.grasps) if g.name == parts[1])
+            raise InvalidArgument(f'{where}[{index}].grasp_point_mm (grasp {parts[1]!r})',
+                                  exc.value, exc.rule.removeprefix('(mm) ')) from None
+        raise InvalidArgument(exc.field.replace('grasps', where, 1), exc.value,
+                              exc.rule) from None
+
+
+def proposed(geometry: PartGeometry, gripper: GripperKind, where: str = 'part.grasps'
+             ) -> tuple:
+    """`part.grasps: auto`: the grasps the gripper's kind proposes from the part's geometry;
+    a core field is named with the file's key (gripper.cup_diameter_mm)."""
+    try:
+        return tuple(p.grasp for p in gripper.propose(geometry))
+    except InvalidArgument as exc:
+        field = exc.field
+        if field == 'grasps':
+            field = where
+        elif field.startswith('gripper.'):
+            key = next(k for k in gripper.KEYS if f'gripper.{k.field}' == field)
+            field = f'gripper.{key.file_key}'
+        raise InvalidArgument(field, exc.value, exc.rule.removeprefix('(mm) ')) from None
 
 
 # The core's names of a mesh part's fields, and the file's keys for them; the core's other
@@ -218,14 +233,3 @@ def geometry(part: PartSpec) -> PartGeometry:
         return build_part(part)
     except InvalidArgument as exc:
         raise InvalidArgument(_file_key(exc.field), exc.value, exc.rule) from None
-
-
-def check_fits(geometry: PartGeometry, grasps: tuple[GraspPose, ...]) -> None:
-    """Every grasp closes on the part (grasp_fit), named by its place in the file."""
-    try:
-        check_grasps_fit(geometry, grasps)
-    except InvalidArgument as exc:
-        name = exc.field.split('.')[1]
-        index = next(i for i, g in enumerate(grasps) if g.name == name)
-        raise InvalidArgument(f'part.grasps[{index}].grasp_point_mm (grasp {name!r})',
-                              exc.value, exc.rule.removeprefix('(mm) ')) from None

@@ -14,16 +14,8 @@ import numpy as np
 from pick_common.containers import ContainerSpec, PACKING_LIMIT
 from pick_common.specs import MAX_PARTS_PER_INSTANCE, MAX_SEED
 
-from .model import (
-    BIN_EMPTYING,
-    BIN_STATIC,
-    DROP_TEST,
-    Experiment,
-    ExperimentFile,
-    GRIPPER_SWEEP,
-    SENSITIVITY,
-    TABLE_SWEEP,
-)
+from .kinds import kind_of
+from .model import Experiment, ExperimentFile
 
 
 def iteration_seed(seed: int, experiment_id: str, key: tuple[int, ...]) -> int:
@@ -54,14 +46,8 @@ class Unit:
 
     @property
     def label(self) -> str:
-        """The iteration as a progress line says it."""
-        kind = self.experiment.type
-        if kind == BIN_STATIC:
-            return (f'bin {self.group + 1}/{len(self.experiment.bins)}, '
-                    f'iteration {self.iteration + 1}')
-        if kind == TABLE_SWEEP:
-            return f'{self.group} parts, iteration {self.iteration + 1}'
-        return f'iteration {self.iteration + 1}/{self.experiment.iterations}'
+        """The iteration as a progress line says it (its kind's label)."""
+        return kind_of(self.experiment).label(self.experiment, self.group, self.iteration)
 
 
 EXTEND_STEPS = 3    # counts a table_sweep adds at a time while its fit still rises at its last
@@ -72,7 +58,7 @@ def extended(file: ExperimentFile, exp: Experiment, summary: dict) -> Experiment
     EXTEND_STEPS more counts at its step, as many as fit the tray with the sweep's margin
     (containers' packing rule) and the per-instance limit; None when n* lies inside its counts,
     no part was valid, no more fit, or the sweep says `extend: false`."""
-    if (exp.type != TABLE_SWEEP or not exp.extend or summary.get('no_valid')
+    if (not kind_of(exp).extends or not exp.extend or summary.get('no_valid')
             or summary.get('n_star') is None):
         return None
     last = exp.counts[-1]
@@ -88,15 +74,10 @@ def extended(file: ExperimentFile, exp: Experiment, summary: dict) -> Experiment
 
 
 def groups(exp: Experiment) -> list[int]:
-    """The groups of `exp`'s iterations (Unit.group): its bins' indexes, its counts, or 0;
-    none for a sensitivity experiment (its repeats are experiments of their own)."""
-    if exp.type == SENSITIVITY:
-        return []
-    if exp.type == BIN_STATIC:
-        return list(range(len(exp.bins)))
-    if exp.type == TABLE_SWEEP:
-        return list(exp.counts)
-    return [0]
+    """The groups of `exp`'s iterations (Unit.group), its kind's: its bins' indexes, its
+    counts, or 0; none for a sensitivity experiment (its repeats are experiments of their
+    own)."""
+    return kind_of(exp).groups(exp)
 
 
 def experiment_iterations(exp: Experiment) -> int:
@@ -111,32 +92,8 @@ def count_iterations(file: ExperimentFile) -> int:
 def plan(file: ExperimentFile, exp: Experiment, summary: dict) -> list[Unit]:
     """The iterations of `exp`, given the metrics of the experiments before it. A sensitivity
     scenario's repeat runs on the seeds of the experiment it repeats (scenarios.py)."""
-    units = []
     seeded_by = exp.seeded_by or exp.id.partition('@')[0]
-
-    def unit(group: int, i: int, container: ContainerSpec, parts: int, **kw) -> Unit:
-        return Unit(exp, group, i, iteration_seed(file.seed, seeded_by, (group, i)),
-                    container, parts, **kw)
-
-    if exp.type == SENSITIVITY:
-        return []
-    if exp.type == BIN_STATIC:
-        for b, container in enumerate(exp.bins):
-            units += [unit(b, i, container, exp.parts) for i in range(exp.iterations)]
-    elif exp.type in (BIN_EMPTYING, GRIPPER_SWEEP, DROP_TEST):
-        container = exp.bin
-        if exp.bin_from:
-            best = summary[exp.bin_from]['best_bin']
-            container = file.experiment(exp.bin_from).bins[best]
-        elif container is None:     # a gripper_sweep without a bin: the tray
-            container = file.tray
-        units = [unit(0, i, container, exp.parts) for i in range(exp.iterations)]
-    elif exp.type == TABLE_SWEEP:
-        for n in exp.counts:
-            units += [unit(n, i, file.tray, n) for i in range(exp.iterations)]
-    else:
-        low, high = exp.optimal_range or summary[exp.range_from]['optimal_range']
-        feeder = FeederConfig(exp.parts, low, high, exp.max_vibrations, exp.max_feed)
-        units = [unit(0, i, file.tray, exp.parts, feeder=feeder)
-                 for i in range(exp.iterations)]
-    return units
+    return [Unit(exp, group, i, iteration_seed(file.seed, seeded_by, (group, i)), container,
+                 parts, feeder)
+            for group, container, parts, feeder in kind_of(exp).scenes(file, exp, summary)
+            for i in range(exp.iterations)]

@@ -33,7 +33,8 @@ import numpy as np
 from pick_common.errors import check_number, InvalidArgument
 from pick_common.parts.materials import body_values
 from pick_common.specs import check_vibration, Vibration
-from pick_validity.config import check_gripper, is_suction, Setup
+from pick_validity.config import Setup
+from pick_validity.grippers import KINDS
 
 from .errors import checked
 from .model import G, Input, MM, Scenario
@@ -47,14 +48,10 @@ INPUTS = {
                                      ('spinning_friction_mm', 'spinning_friction', MM, 100.0),
                                      ('restitution', 'restitution', 1.0, 1.0))},
     'part.mass_g': ('part', 'mass', G, 0.0, 10_000.0, True),
-    'gripper.body_diameter_mm': ('gripper', 'body_diameter', MM, 0.0, None, True),
-    'gripper.body_length_mm': ('gripper', 'body_length', MM, 0.0, None, True),
-    'gripper.jaw_height_mm': ('gripper', 'jaw_height', MM, 0.0, None, True),
-    'gripper.jaw_depth_mm': ('gripper', 'jaw_depth', MM, 0.0, None, True),
-    'gripper.finger_clearance_mm': ('gripper', 'finger_clearance', MM, 0.0, None, False),
-    'gripper.cup_diameter_mm': ('gripper', 'cup_diameter', MM, 0.0, None, True),
-    'gripper.cup_height_mm': ('gripper', 'cup_height', MM, 0.0, None, True),
-    'gripper.vacuum_kpa': ('gripper', 'vacuum', 1000.0, 0.0, 101.325, True),
+    # every gripper kind's keys, with their kind's limits (pick_validity.grippers: KEYS)
+    **{f'gripper.{key.file_key}': ('gripper', key.field, key.factor, key.limit.low / key.factor,
+                                   key.limit.high / key.factor, key.limit.low_open)
+       for kind in KINDS.values() for key in kind.KEYS},
     'moves.amplitude_scale': ('moves', 'amplitude', 1.0, 0.0, None, True),
     'moves.frequency_scale': ('moves', 'frequency', 1.0, 0.0, None, True),
     'moves.duration_scale': ('moves', 'duration', 1.0, 0.0, None, True),
@@ -75,10 +72,9 @@ def base_value(name: str, setup: Setup, mass: float, where: str = '') -> float:
     which the file may leave to the model); InvalidArgument named `where` for a key of the
     other kind of gripper."""
     section, attr, unit = INPUTS[name][:3]
-    if section == 'gripper' and not hasattr(setup.gripper, attr):
-        kind = 'a suction cup' if is_suction(setup.gripper) else 'parallel jaws'
+    if section == 'gripper' and attr not in setup.gripper.values():
         raise InvalidArgument(where or name, name, f"is not a key of the file's gripper, "
-                              f'{kind} (gripper.type)')
+                              f'{setup.gripper.description} (gripper.type)')
     if section == 'moves':
         return 1.0
     if attr == 'mass':
@@ -116,7 +112,7 @@ def apply(values: dict[str, float], setup: Setup, moves: tuple[Vibration, ...], 
     if any(pairs.values()):
         new_part = replace(setup.part, **part)
         checked(lambda p: body_values(p.part_on_surface, p.part_on_part), new_part, where)
-    new_gripper = checked(check_gripper, replace(setup.gripper, **gripper), where)
+    new_gripper = checked(lambda g: g.check(), setup.gripper.with_values(**gripper), where)
     new_moves = [checked(check_vibration, Vibration(
         tuple(a * scale.get('amplitude', 1.0) for a in m.amplitude),
         m.frequency * scale.get('frequency', 1.0), m.duration * scale.get('duration', 1.0),

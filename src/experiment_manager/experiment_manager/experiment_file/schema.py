@@ -22,8 +22,17 @@ from pick_common.specs import (
     MAX_SEED,
     MOVES,
 )
-from pick_validity.config import CheckConfig, Gripper, SuctionCup
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator, WrapValidator
+from pick_validity.config import CheckConfig
+from pick_validity.grippers import kind_of_key, KINDS
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    create_model,
+    Field,
+    model_validator,
+    WrapValidator,
+)
 
 from .model import (
     ADAPTIVE,
@@ -156,48 +165,33 @@ class MaterialsSection(Section):
 
 
 # ------------------------------------------------------------------ gripper and check
-# The gripper's keys in the file and the Gripper fields they set.
-GRIPPER_KEYS = (('body_diameter_mm', 'body_diameter'), ('body_length_mm', 'body_length'),
-                ('jaw_height_mm', 'jaw_height'), ('jaw_depth_mm', 'jaw_depth'),
-                ('finger_clearance_mm', 'finger_clearance'))
+# Every kind's keys, once each, in KINDS' order (a key two kinds share, such as
+# body_diameter_mm, is each one's, with each one's default).
+GRIPPER_FILE_KEYS = tuple(dict.fromkeys(key.file_key for kind in KINDS.values()
+                                        for key in kind.KEYS))
 
 
-# A suction cup's keys and the SuctionCup fields they set, with the factor from the file's
-# unit to SI.
-SUCTION_KEYS = (('cup_diameter_mm', 'cup_diameter', MM), ('cup_height_mm', 'cup_height', MM),
-                ('body_diameter_mm', 'body_diameter', MM),
-                ('body_length_mm', 'body_length', MM), ('vacuum_kpa', 'vacuum', 1000.0),
-                ('safety_factor', 'safety_factor', 1.0),
-                ('acceleration_m_s2', 'acceleration', 1.0), ('cup_friction', 'cup_friction', 1.0))
-JAWS_ONLY = ('jaw_height_mm', 'jaw_depth_mm', 'finger_clearance_mm')
-SUCTION_ONLY = tuple(k for k, _, _ in SUCTION_KEYS if not k.startswith('body_'))
+class _Gripper(Section):
+    """The simplified gripper, in the file's units: parallel jaws (`type: jaws`, the default)
+    or a suction cup (`type: suction`). Its keys, their units, limits and defaults are its
+    kind's (pick_validity.grippers: KEYS), one table for the file, the node and the message;
+    a key left out takes its kind's default."""
 
-
-class GripperSection(Section):
-    """The simplified gripper, mm (its rules are the core's: pick_validity.config): parallel
-    jaws (`type: jaws`, the default) or a suction cup (`type: suction`)."""
-
-    type: Text('jaws', 'suction') = 'jaws'
-    body_diameter_mm: Number() | None = None           # the type's default
-    body_length_mm: Number() | None = None
-    jaw_height_mm: Number() = Gripper.jaw_height / MM
-    jaw_depth_mm: Number() = Gripper.jaw_depth / MM
-    finger_clearance_mm: Number() = Gripper.finger_clearance / MM
-    cup_diameter_mm: Number() = SuctionCup.cup_diameter / MM
-    cup_height_mm: Number() = SuctionCup.cup_height / MM
-    vacuum_kpa: Number() = SuctionCup.vacuum / 1000.0
-    safety_factor: Number() = SuctionCup.safety_factor
-    acceleration_m_s2: Number() = SuctionCup.acceleration
-    cup_friction: Number() = SuctionCup.cup_friction
+    type: Text(*KINDS) = 'jaws'
 
     @model_validator(mode='after')
-    def _keys_of_its_type(self) -> 'GripperSection':
-        foreign = JAWS_ONLY if self.type == 'suction' else SUCTION_ONLY
-        for key in foreign:
-            if key in self.model_fields_set:
-                fail(f'is a key of {"parallel jaws" if self.type == "suction" else "a suction cup"}'
-                     f', and the gripper is type: {self.type}', getattr(self, key), f'.{key}')
+    def _keys_of_its_type(self) -> '_Gripper':
+        own = {key.file_key for key in KINDS[self.type].KEYS}
+        for key in GRIPPER_FILE_KEYS:
+            if key in self.model_fields_set and key not in own:
+                fail(f'is a key of {kind_of_key(key).description}, and the gripper is type: '
+                     f'{self.type}', getattr(self, key), f'.{key}')
         return self
+
+
+GripperSection = create_model(
+    'GripperSection', __base__=_Gripper, __module__=__name__,
+    **{key: (Number() | None, None) for key in GRIPPER_FILE_KEYS})
 
 
 class CheckSection(Section):

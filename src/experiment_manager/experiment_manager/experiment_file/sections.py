@@ -9,23 +9,20 @@ from pick_common.containers import check_container, ContainerSpec
 from pick_common.errors import InvalidArgument
 from pick_common.parts.geometry import PartGeometry
 from pick_common.specs import check_vibration, MOVES, Vibration
-from pick_validity.config import CheckConfig, Gripper, SuctionCup
+from pick_validity.config import CheckConfig
+from pick_validity.grippers import GripperKind, KINDS
 
 from . import schema
 from .errors import checked as checked_as
 from .model import DEG, MM, Requirements
-from .schema import GRIPPER_KEYS
 
 
-def gripper(g: schema.GripperSection) -> Gripper | SuctionCup:
-    """The section's parallel jaws or suction cup, SI units; a key left out, its type's
-    default."""
-    if g.type == 'suction':
-        return SuctionCup(**{attr: factor * getattr(g, key)
-                             for key, attr, factor in schema.SUCTION_KEYS
-                             if getattr(g, key) is not None})
-    return Gripper(**{attr: MM * getattr(g, key) for key, attr in GRIPPER_KEYS
-                      if getattr(g, key) is not None})
+def gripper(g: schema.GripperSection) -> GripperKind:
+    """The section's gripper, of the kind its type names, in SI units; a key left out, its
+    kind's default."""
+    kind = KINDS[g.type]
+    return kind(**{key.field: key.factor * getattr(g, key.file_key) for key in kind.KEYS
+                   if getattr(g, key.file_key) is not None})
 
 
 def check(c: schema.CheckSection) -> CheckConfig:

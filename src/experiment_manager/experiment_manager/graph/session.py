@@ -16,7 +16,7 @@ from pick_common.errors import check_inside, InvalidArgument
 
 from ..analysis import part_sheet, report
 from ..analysis.results import keep_part_file, ResultsWriter
-from ..experiment_file import ExperimentFile, load
+from ..experiment_file import ExperimentFile, load, resolved
 from ..running.backend import Backend
 from ..running.scheduler import Progress, Runner
 from .recording import Recorder
@@ -72,6 +72,8 @@ class RunSession:
         self.writer = ResultsWriter(run_dir, file.text, resume)
         if not resume:
             keep_part_file(file.part.mesh_path, file.path, run_dir)
+        if not os.path.exists(os.path.join(run_dir, resolved.NAME)):   # what it runs with, once
+            resolved.write(file, run_dir)
         self.recorder = self._open_recording(run_dir, resume)
 
     @property

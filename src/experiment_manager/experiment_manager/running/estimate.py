@@ -15,8 +15,6 @@ feeder run weighed at 200 sweep parts a part (a file whose feeder vibrated to it
 
 from collections.abc import Iterable
 
-import numpy as np
-
 from ..experiment_file import (
     BIN_EMPTYING,
     BIN_STATIC,
@@ -26,6 +24,7 @@ from ..experiment_file import (
     GRIPPER_SWEEP,
     TABLE_SWEEP,
 )
+from ..experiment_file.kinds import kind_of
 
 # Seconds per cost unit of each type, measured: the reduced test case (pth0/1/2.yaml with one
 # iteration each, 2 workers on the project's 2-core machine; docs/benchmarks.md),
@@ -39,12 +38,12 @@ PRIOR = {TABLE_SWEEP: 0.0098, BIN_STATIC: 0.031, BIN_EMPTYING: 0.035, FEEDER_EMP
 def units(exp: Experiment, parts: float) -> float:
     """The cost units of one iteration of `exp` with `parts` parts: its parts, times its
     grippers x grasp sets for a gripper_sweep (each checks the scene once)."""
-    return parts * (len(exp.variants) if exp.type == GRIPPER_SWEEP else 1)
+    return kind_of(exp).cost_units(exp, parts)
 
 
 def mean_units(exp: Experiment) -> float:
     """The cost units of an average iteration of `exp` (a table_sweep's over its counts)."""
-    return units(exp, float(np.mean(exp.counts)) if exp.type == TABLE_SWEEP else exp.parts)
+    return units(exp, kind_of(exp).parts(exp))
 
 
 class Costs:

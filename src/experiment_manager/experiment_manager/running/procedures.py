@@ -12,7 +12,7 @@ from feeder_controller.policy import NAMES as DECISION_NAMES
 from feeder_controller.policy import PICK, STOP_EMPTY, STOP_VIBRATION_LIMIT
 import numpy as np
 from pick_common.errors import PhysicsFault
-from pick_common.parts.aspects import classify, spec_aspects
+from pick_common.parts.aspects import classify
 from pick_common.states import PartStates, SettleReport
 from pick_validity.results import Report, STAGE_NONE
 
@@ -28,6 +28,7 @@ from ..experiment_file import (
     GripperVariant,
     TABLE_SWEEP,
 )
+from ..experiment_file.kinds import kind_of
 from ..experiment_file.plan import Unit
 from .backend import Backend
 
@@ -66,11 +67,8 @@ def run_unit(file: ExperimentFile, u: Unit, backend: Backend) -> Record:
     start = time.monotonic()
     backend.reset(u.container, u.seed)
     iteration = Iteration(file, u, backend)
-    run = {BIN_STATIC: iteration.static, TABLE_SWEEP: iteration.static,
-           BIN_EMPTYING: iteration.emptying, FEEDER_EMPTYING: iteration.feeder,
-           GRIPPER_SWEEP: iteration.grippers, DROP_TEST: iteration.drop_test}
     try:
-        row = run[u.experiment.type]()
+        row = PROCEDURES[u.experiment.type](iteration)
     except PhysicsFault as exc:    # its seed would fault again: marked, not run again
         row = {**iteration.health(), 'emptied': False, 'vibrations': 0, 'feeds': 0,
                'stop': f'{metrics.PHYSICS_FAULT}: {exc}'}
@@ -172,7 +170,7 @@ class Iteration:
         """bin_static (stages 1-3) and table_sweep (all four stages): drop, settle, check."""
         states, settle = self.backend.drop(self.u.parts, 'container')
         self.reports.append(settle)
-        self.check(states, neighbours=self.u.experiment.type == TABLE_SWEEP)
+        self.check(states, neighbours=kind_of(self.u.experiment).checks_neighbours)
         return {**self.health(), 'emptied': False, 'vibrations': 0, 'feeds': 0, 'stop': ''}
 
     def drop_test(self) -> dict:
@@ -182,7 +180,7 @@ class Iteration:
         self.reports.append(settle)
         self.check(states, neighbours=False)
         inside = states.poses[states.inside]
-        aspect = classify(spec_aspects(self.file.part), inside[:, 3:])[0] if len(inside) else ''
+        aspect = classify(self.file.aspects, inside[:, 3:])[0] if len(inside) else ''
         return {**self.health(), 'emptied': False, 'vibrations': 0, 'feeds': 0, 'stop': '',
                 'aspect': aspect}
 
@@ -242,3 +240,10 @@ class Iteration:
         return {**self.health(), 'emptied': step.decision == STOP_EMPTY,
                 'vibrations': step.vibrations, 'feeds': step.feeds,
                 'stop': DECISION_NAMES[step.decision]}
+
+
+# Per kind, what one of its iterations does (a sensitivity has none: its repeats run as the
+# experiments they repeat).
+PROCEDURES = {BIN_STATIC: Iteration.static, TABLE_SWEEP: Iteration.static,
+              BIN_EMPTYING: Iteration.emptying, FEEDER_EMPTYING: Iteration.feeder,
+              GRIPPER_SWEEP: Iteration.grippers, DROP_TEST: Iteration.drop_test}

@@ -58,6 +58,7 @@ L x 0.1 %.
 """
 
 import numpy as np
+from pick_common.stats import difference_bound, interval
 
 from ..analysis import decisions, metrics
 from ..experiment_file import (
@@ -70,6 +71,7 @@ from ..experiment_file import (
     GRIPPER_SWEEP,
     TABLE_SWEEP,
 )
+from ..experiment_file.kinds import kind_of
 from ..experiment_file.plan import groups
 
 INTERIM_CONFIDENCE = 0.999
@@ -92,23 +94,34 @@ def ended(file: ExperimentFile, exp: Experiment, rows: list[dict],
     """(unsettled's groups, the bins of a tie that settled a bin_static race: race)."""
     rows = sorted(rows, key=lambda r: (r['group'], r['iteration']))
     out = metrics.left_out(rows)
-    if out and exp.type in (BIN_EMPTYING, FEEDER_EMPTYING):
+    if out and kind_of(exp).left_out_settles:
         return [], []       # a left-out iteration makes the option NOT FEASIBLE: settled
     kept = [r for r in rows if (r['group'], r['iteration']) not in out]
-    if exp.type == DROP_TEST:
-        return groups(exp), []      # no decision: every drop asked for is made
-    if exp.type == BIN_STATIC:
-        return race(exp, kept)
-    if exp.type == TABLE_SWEEP:
-        return _sweep_unsettled(file, exp, kept), []
-    if exp.type == GRIPPER_SWEEP:
+    if kind_of(exp).uses_checks:
         kept_keys = {(r['group'], r['iteration']) for r in kept}
-        return ([] if _smallest_settled(exp, [c for c in checks if (c['group'], c['iteration'])
-                                              in kept_keys]) else groups(exp)), []
-    if exp.type == BIN_EMPTYING:
-        successes = sum(bool(r['emptied']) for r in kept)
-        return ([] if rate_settled(successes, len(kept), file.requirements.success_rate)
-                else groups(exp)), []
+        checks = [c for c in checks if (c['group'], c['iteration']) in kept_keys]
+    return DECISIONS[exp.type](file, exp, kept, checks)
+
+
+def _drops_unsettled(file: ExperimentFile, exp: Experiment, kept: list[dict],
+                     checks: list[dict]) -> tuple[list[int], list[int]]:
+    return groups(exp), []      # no decision: every drop asked for is made
+
+
+def _gripper_unsettled(file: ExperimentFile, exp: Experiment, kept: list[dict],
+                       checks: list[dict]) -> tuple[list[int], list[int]]:
+    return ([] if _smallest_settled(exp, checks) else groups(exp)), []
+
+
+def _emptying_unsettled(file: ExperimentFile, exp: Experiment, kept: list[dict],
+                        checks: list[dict]) -> tuple[list[int], list[int]]:
+    successes = sum(bool(r['emptied']) for r in kept)
+    return ([] if rate_settled(successes, len(kept), file.requirements.success_rate)
+            else groups(exp)), []
+
+
+def _feeder_unsettled(file: ExperimentFile, exp: Experiment, kept: list[dict],
+                      checks: list[dict]) -> tuple[list[int], list[int]]:
     grounds = metrics.table_grounds(file, kept, INTERIM_CONFIDENCE)
     return ([] if decisions.combined([g.verdict for g in grounds.values()])
             != decisions.UNDECIDED else groups(exp)), []
@@ -138,11 +151,11 @@ def race(exp: Experiment, rows: list[dict]) -> tuple[list[int], list[int]]:
     leader = max(groups(exp), key=lambda g: (np.mean(fractions[g]), -g))
     ahead = fractions[leader]
     racing = [g for g in groups(exp) if g == leader
-              or metrics.difference_bound(fractions[g], ahead, RACE_CONFIDENCE) >= 0.0]
+              or difference_bound(fractions[g], ahead, RACE_CONFIDENCE) >= 0.0]
     if len(racing) == 1:
         return [], []
-    floor = metrics.interval(ahead, INTERIM_CONFIDENCE)[0]
-    if all(metrics.difference_bound(ahead, fractions[g], RACE_CONFIDENCE) <= BIN_TIE * floor
+    floor = interval(ahead, INTERIM_CONFIDENCE)[0]
+    if all(difference_bound(ahead, fractions[g], RACE_CONFIDENCE) <= BIN_TIE * floor
            for g in racing if g != leader):
         return [], [leader] + [g for g in racing if g != leader]
     return racing, []
@@ -237,7 +250,7 @@ def _smallest_settled(exp: Experiment, checks: list[dict]) -> bool:
     """In size order: every gripper known not to meet min_valid up to one known to meet it,
     or all known not to."""
     for k in sorted(range(len(exp.variants)), key=lambda k: (exp.variants[k].size, k)):
-        low, high = metrics.interval([c['valid'] for c in checks if c['check'] == k],
+        low, high = interval([c['valid'] for c in checks if c['check'] == k],
                                      INTERIM_CONFIDENCE, counts=True)
         if low is None:
             return False
@@ -246,3 +259,16 @@ def _smallest_settled(exp: Experiment, checks: list[dict]) -> bool:
         if high >= exp.min_valid:
             return False
     return True
+
+
+# Per kind, whether its decision is settled: (file, exp, its kept rows, its kept checks) ->
+# (unsettled groups, the bins of a tie that settled a race). A sensitivity has none: its
+# repeats are sampled as the experiments they repeat.
+DECISIONS = {
+    BIN_STATIC: lambda file, exp, kept, checks: race(exp, kept),
+    BIN_EMPTYING: _emptying_unsettled,
+    TABLE_SWEEP: lambda file, exp, kept, checks: (_sweep_unsettled(file, exp, kept), []),
+    FEEDER_EMPTYING: _feeder_unsettled,
+    GRIPPER_SWEEP: _gripper_unsettled,
+    DROP_TEST: _drops_unsettled,
+}

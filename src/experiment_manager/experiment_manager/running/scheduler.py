@@ -20,9 +20,12 @@ import threading
 import time
 from typing import Protocol
 
-from ..analysis import metrics, sensitivity
+from ..analysis import metrics
+from ..analysis.records import Sampling
+from ..analysis.redecide import summarise
 from ..analysis.rows import Record
-from ..experiment_file import BIN_STATIC, Experiment, ExperimentFile, GRIPPER_SWEEP, SENSITIVITY
+from ..experiment_file import Experiment, ExperimentFile
+from ..experiment_file.kinds import kind_of
 from ..experiment_file.plan import count_iterations, experiment_iterations, extended, plan, Unit
 from . import sampling
 from .backend import Backend, WorkerLost
@@ -208,7 +211,7 @@ class Runner:
         rows = [r for r in self.sink.iterations(exp.id)
                 if (r['group'], r['iteration']) in released]
         checks = ([c for c in self.sink.checks(exp.id) if (c['group'], c['iteration']) in released]
-                  if exp.type == GRIPPER_SWEEP else [])
+                  if kind_of(exp).uses_checks else [])
         return [g for g in sampling.unsettled(self.file, exp, rows, checks)
                 if self._unreleased[exp.id].get(g)]
 
@@ -217,32 +220,32 @@ class Runner:
         experiments waiting for it (under the lock)."""
         self.sink.reorder(self._rank)
         rows, checks = self.sink.iterations(exp.id), self.sink.checks(exp.id)
-        if exp.type == SENSITIVITY:
-            self._summary[exp.id] = sensitivity.summarise(self.file, exp, self._summary)
-        else:
-            self._summary[exp.id] = metrics.summarise(
-                self.file.for_experiment(exp), exp, rows, self.sink.picks(exp.id),
-                self._summary, checks)
-            wider = extended(self.file, exp, self._summary[exp.id])
-            if wider is not None:       # a sweep still rising at its last count goes on
-                del self._summary[exp.id]
-                self._extend(exp, wider)
-                return
-        if self.file.sampling.adaptive and exp.type != SENSITIVITY:
-            left, tie = sampling.ended(self.file, exp, rows, checks)
-            self._summary[exp.id]['sampling'] = {
-                'mode': self.file.sampling.mode, 'batch': self.file.sampling.batch,
-                'batches': self._looks[exp.id], 'iterations_run': len(rows),
-                'most': experiment_iterations(exp), 'settled': not left}
-            if left and exp.type == BIN_STATIC:     # the bins that could not be told apart
-                self._summary[exp.id]['sampling'].update(
-                    tied_bins=left, race_confidence=sampling.RACE_CONFIDENCE)
-            elif tie:                               # bins known to tie within BIN_TIE
-                self._summary[exp.id]['sampling'].update(
-                    tie=tie, tie_within=sampling.BIN_TIE,
-                    race_confidence=sampling.RACE_CONFIDENCE)
+        self._summary[exp.id] = summarise(self.file, exp, rows, self.sink.picks(exp.id),
+                                          checks, self._summary)
+        wider = extended(self.file, exp, self._summary[exp.id])
+        if wider is not None:       # a sweep still rising at its last count goes on
+            del self._summary[exp.id]
+            self._extend(exp, wider)
+            return
+        if self.file.sampling.adaptive and not kind_of(exp).repeats_others:
+            self._summary[exp.id]['sampling'] = self._sampling(exp, rows, checks).model_dump(
+                exclude_none=True)
         self.sink.write_summary(metrics.file_summary(self.file, self._ordered_summary()))
         self._release()
+
+    def _sampling(self, exp: Experiment, rows: list[dict], checks: list[dict]) -> Sampling:
+        """How an adaptive experiment was sampled: its batches, iterations, whether its
+        decision settled, and the bins left tied or known to tie (sampling.ended)."""
+        left, tie = sampling.ended(self.file, exp, rows, checks)
+        race = {}
+        if left and kind_of(exp).groups_are_bins:       # the bins that could not be told apart
+            race = {'tied_bins': left, 'race_confidence': sampling.RACE_CONFIDENCE}
+        elif tie:                                       # bins known to tie within BIN_TIE
+            race = {'tie': tie, 'tie_within': sampling.BIN_TIE,
+                    'race_confidence': sampling.RACE_CONFIDENCE}
+        return Sampling(mode=self.file.sampling.mode, batch=self.file.sampling.batch,
+                        batches=self._looks[exp.id], iterations_run=len(rows),
+                        most=experiment_iterations(exp), settled=not left, **race)
 
     def _extend(self, exp: Experiment, wider: Experiment) -> None:
         """Run a table_sweep on at more counts (plan.extended): the file holds `wider` from

@@ -234,7 +234,7 @@ def part_aspects(part: PartGeometry) -> tuple[Aspect, ...]:
     (the file's check, the part's account and the summary ask for the same part's)."""
     key = geometry_key(part.spec)
     if key not in _BY_GEOMETRY:
-        centre = part.mass_frame[0] if part.mass_frame is not None else np.zeros(3)
+        centre = part.mass_centre
         _BY_GEOMETRY[key] = tuple(stable_aspects(part.visual, centre))
     return _BY_GEOMETRY[key]
 
@@ -272,15 +272,6 @@ def classify(aspects: Sequence[Aspect], orientations: np.ndarray) -> list[str]:
     return out
 
 
-def share_interval(count: int, total: int) -> tuple[float, float]:
-    """The 95 % Wilson interval of a share count / total."""
-    if total <= 0:
-        return 0.0, 1.0
-    z = 1.959963984540054
-    p = count / total
-    centre = (p + z * z / (2 * total)) / (1 + z * z / total)
-    half = z * math.sqrt(p * (1 - p) / total + z * z / (4 * total * total)) / (1 + z * z / total)
-    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 def agreement(simulated: Mapping[str, int], measured: Mapping[str, int]) -> float:

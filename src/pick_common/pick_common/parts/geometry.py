@@ -59,6 +59,13 @@ class PartGeometry:
     moments: np.ndarray | None = None
     collision_note: str = ''
 
+    @property
+    def mass_centre(self) -> np.ndarray:
+        """The physics' mass centre (3,), m in the part frame: a mesh part's from its solids
+        (mass_frame), a built-in's at its frame origin. The one answer every check, proposal
+        and sheet takes."""
+        return np.zeros(3) if self.mass_frame is None else self.mass_frame[0]
+
 
 MM = 1e-3       # m
 

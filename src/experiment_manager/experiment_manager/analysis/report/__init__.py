@@ -1,7 +1,7 @@
 """The report of a run: the decision the engineer came for, with the figures behind it.
 
-From a run directory (`summary.json`, read by summary.read; `experiment.yaml`, for the part and
-gripper the file gave; `pictures.json`, the pictures of analysis/pictures.py when they were
+From a run directory (`summary.json`, read by summary.read; `resolved.json`, what the run ran
+with: experiment_file.resolved; `pictures.json`, the pictures of analysis/pictures.py when they were
 rendered; `part.json`, the part's account of part_sheet.py; `checks.csv`) it writes `report.md`
 and `report.html` (the same content) and the figures of `plots`. The report is its sections
 (SECTIONS, one module each on `base.Section`), in order; tables follow the paper's Tables 2
@@ -12,13 +12,7 @@ decisions themselves are verdicts.py's; this package renders them. No rclpy.
 import json
 import os
 
-from pick_common.errors import InvalidArgument
-from pydantic import ValidationError
-import yaml
-
-from ...experiment_file import sections
-from ...experiment_file.schema import FileKeys
-from ...experiment_file.schema import Part as PartKeys
+from ...experiment_file import resolved
 from .. import stages
 from .. import summary as summary_model
 from ..results import read_csv
@@ -59,24 +53,20 @@ def _json(path: str):
 
 
 def read(run_dir: str) -> Run:
-    """A run directory as the report reads it (base.Run), its figures not yet drawn."""
-    with open(os.path.join(run_dir, 'experiment.yaml'), encoding='utf-8') as f:
-        spec = yaml.safe_load(f) or {}
-    part = PartKeys.model_validate(spec.get('part') or {})
+    """A run directory as the report reads it (base.Run), its figures not yet drawn: what the
+    run ran with from its resolved.json (experiment_file.resolved.read: for a run directory
+    made before runs wrote one, its experiment.yaml resolved by today's rules)."""
+    ran = resolved.read(run_dir)
     checks = os.path.join(run_dir, 'checks.csv')
-    try:        # a run of an older version may hold keys this one no longer reads
-        tray = sections.tray(FileKeys.model_validate(spec))
-    except (ValidationError, InvalidArgument):
-        tray = None
-    max_feed = {e.get('id'): e.get('max_feed') or 0 for e in spec.get('experiments') or []
-                if isinstance(e, dict) and e.get('type') == 'feeder_emptying'}
+    gripper = dict(ran['gripper'])
     return Run(summary=summary_model.read(os.path.join(run_dir, 'summary.json')),
-               part_model=part.model, part_dimensions_mm=dict(part.dimensions_mm),
-               gripper=spec.get('gripper') or {},
+               part_model=ran['part']['model'], part_dimensions_mm=ran['part']['dimensions_mm'],
+               gripper_type=gripper.pop('type'), gripper=gripper,
                pictures=_json(os.path.join(run_dir, 'pictures.json')),
                account=_json(os.path.join(run_dir, 'part.json')),
                stops=stages.turned_down(read_csv(checks)) if os.path.exists(checks) else None,
-               tray=tray, unset=tuple(k for k in FEEDING if k not in spec), max_feed=max_feed)
+               tray=ran['tray'], unset=tuple(k for k in FEEDING if k in ran['defaulted']),
+               max_feed=ran['doses'])
 
 
 def write(run_dir: str) -> str:

@@ -5,8 +5,6 @@ has nothing for it."""
 from dataclasses import dataclass, field
 from functools import cached_property
 
-from pick_common.containers import ContainerSpec
-
 from ...experiment_file.schema import Part as PartKeys
 from ..summary import Summary
 from ..verdicts import PAPER, Verdict, verdicts
@@ -14,24 +12,26 @@ from ..verdicts import PAPER, Verdict, verdicts
 
 @dataclass
 class Run:
-    """A finished run as the report reads it. summary: summary.json; part_model and
-    part_dimensions_mm: the file's part section as written (`schema.Part`: the model's name,
-    the dimensions it gave); gripper: the gripper keys the file gave (mm); figures: which plots
-    were drawn, by name (plots.py); pictures: {image file: caption} (pictures.py); account:
-    the part's account (part_sheet.describe), with its sheet `part.png`; stops: why parts were
-    turned down, per experiment (stages.turned_down); tray: the tray the file gave (its walls,
-    feeder zone and hopper lip), None when the file cannot say; unset: those of its keys the
-    file does not set (`tray`'s values for them are today's defaults); max_feed: each feeder
-    run's dose, by experiment id (0: the whole shortfall at once)."""
+    """A finished run as the report reads it, what it ran with from its resolved.json
+    (experiment_file.resolved). summary: summary.json; part_model and part_dimensions_mm: the
+    part's model and the dimensions it was built with (mm); gripper_type and gripper: the
+    gripper's kind and every key of it, in the file's units; figures: which plots were drawn,
+    by name (plots.py); pictures: {image file: caption} (pictures.py); account: the part's
+    account (part_sheet.describe), with its sheet `part.png`; stops: why parts were turned
+    down, per experiment (stages.turned_down); tray: the tray it ran on (resolved.json's
+    `tray`: its size, walls, feeder zone and hopper lip, mm), None when unknown; unset: those
+    of the tray's keys the file left to their defaults; max_feed: each feeder run's dose, by
+    experiment id (0: the whole shortfall at once)."""
     summary: Summary
     part_model: str = PartKeys.model_fields['model'].default
     part_dimensions_mm: dict[str, float] = field(default_factory=dict)
+    gripper_type: str = 'jaws'
     gripper: dict[str, float] = field(default_factory=dict)
     figures: dict[str, bool] = field(default_factory=dict)
     pictures: dict[str, str] | None = None
     account: list[str] | None = None
     stops: dict[str, dict[str, int]] | None = None
-    tray: ContainerSpec | None = None
+    tray: dict | None = None
     unset: tuple[str, ...] = ()
     max_feed: dict[str, int] = field(default_factory=dict)
 

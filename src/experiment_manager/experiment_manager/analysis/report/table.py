@@ -2,7 +2,6 @@
 its optimal range, with warnings where the range is not pinned down) and the feeder emptying
 (its Table 3, and the parts per hour the cell would pick)."""
 
-from pick_common.containers import ContainerSpec, drop_height
 
 from ..wording import count, fmt, table
 from .base import Run, Section
@@ -92,23 +91,18 @@ class Feeder(Section):
 FEEDING = ('hopper_lip_mm', 'feeder_zone_mm', 'tray_mm')
 
 
-def feeding(tray: ContainerSpec, dose: int, unset: tuple[str, ...] = ()) -> str:
-    """How the parts reached the tray, in words, from the file's keys; `unset`, those of
-    FEEDING the file does not set, are said to be today's defaults (a run of an older version
-    may have had others: parts arrive from a height since 2026-11-28)."""
-    (cx, cy), (sx, sy) = tray.feeder_zone_center, tray.feeder_zone_size
-    x, y, z = (1000 * v for v in tray.inner_size)
-    return (f'The hopper fed the parts from {fmt(1000 * drop_height(tray))} mm over the plate '
+def feeding(tray: dict, dose: int, unset: tuple[str, ...] = ()) -> str:
+    """How the parts reached the tray, in words, from what the run ran with (resolved.json's
+    `tray`, mm); `unset`: those of FEEDING the file left to their defaults."""
+    (cx, cy), (sx, sy) = tray['feeder_zone_mm']['center'], tray['feeder_zone_mm']['size']
+    x, y, z = tray['tray_mm']
+    return (f'The hopper fed the parts from {fmt(tray["hopper_lip_mm"])} mm over the plate '
             f'(`hopper_lip_mm`), or from just above the pile where it stood higher, onto the '
-            f'feeder zone x {fmt(1000 * (cx - sx / 2), 4)} to {fmt(1000 * (cx + sx / 2), 4)} mm, '
-            f'y {fmt(1000 * (cy - sy / 2), 4)} to {fmt(1000 * (cy + sy / 2), 4)} mm '
-            '(`feeder_zone_mm`) '
+            f'feeder zone x {fmt(cx - sx / 2, 4)} to {fmt(cx + sx / 2, 4)} mm, '
+            f'y {fmt(cy - sy / 2, 4)} to {fmt(cy + sy / 2, 4)} mm (`feeder_zone_mm`) '
             f'of the {fmt(x)} x {fmt(y)} mm tray with {fmt(z)} mm walls (`tray_mm`), '
             + (f'at most {dose} parts a feed, the fill to max* going on over several '
                'vibrations (`max_feed`).' if dose else
                'the whole shortfall to max* at once (`max_feed` would dose it).')
-            + (f' The file sets no {", ".join(f"`{k}`" for k in unset)}: '
-               + ("that is today's default" if len(unset) == 1 else
-                  "those are today's defaults")
-               + ', which a run made by an older version may not have had (parts arrive '
-               'from a height since 2026-11-28).' if unset else ''))
+            + (f' The file sets no {", ".join(f"`{k}`" for k in unset)}: the run took '
+               + ('its default.' if len(unset) == 1 else 'their defaults.') if unset else ''))

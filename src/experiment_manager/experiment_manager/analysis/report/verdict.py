@@ -1,8 +1,19 @@
 """The report's head: the part, the gripper and the requirement, then the verdict per option
 with its reasons, and the grounds each verdict rests on (the bound it was decided on)."""
 
+from pick_validity.grippers import KINDS
+
 from ..wording import fmt, pct, table
 from .base import Run, Section
+
+
+def _gripper(kind: str, values: dict) -> str:
+    """The gripper a run ran with, as people read it ('parallel jaws: body diameter 8 mm,
+    ...'), its keys' names and units its kind's (pick_validity.grippers)."""
+    keys = {k.file_key: k for k in KINDS[kind].KEYS}
+    return f'{KINDS[kind].description}: ' + ', '.join(
+        f'{keys[key].field.replace("_", " ")} {fmt(value)}'
+        + (f' {keys[key].unit}' if keys[key].unit else '') for key, value in values.items())
 
 
 def _sizes(given: dict | None, lead: str) -> str:
@@ -33,8 +44,8 @@ class Head(Section):
         s = run.summary
         r = s.requirements
         lines = [f'# Picking feasibility: {s.id}', '',
-                 f'Part `{run.part_model}`{_sizes(run.part_dimensions_mm, ", ")}; gripper'
-                 f'{_sizes(run.gripper, " ") or " as the defaults"}; seed {s.seed}.', '',
+                 f'Part `{run.part_model}`{_sizes(run.part_dimensions_mm, ", ")}; gripper '
+                 f'{_gripper(run.gripper_type, run.gripper)}; seed {s.seed}.', '',
                  f'Requirement: {fmt(r.parts_per_hour)} parts per hour, a refill every '
                  f'{fmt(r.refill_interval_h)} h (capacity {r.capacity} parts), no bin longer '
                  f'than {fmt(r.max_dimension_mm)} mm in any dimension (every bin analysed '

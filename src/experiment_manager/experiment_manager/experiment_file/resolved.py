@@ -1,0 +1,106 @@
+"""What a run ran with, every default applied: `resolved.json` in its run directory, written
+once when the run starts (graph/session.py) and read by the report instead of the raw
+experiment.yaml, so that a default changed later never changes what an old run's report says.
+
+It holds the part (its model, dimensions, mesh, mass, placing, and the aspects it can rest on
+with their normals), its materials with the basis of each value, the gripper (its kind and
+every key in the file's units), the grasps, the tray (size, walls, feeder zone, the hopper's
+lip), each feeder run's dose, the table's moves, the requirements and the cell's times, and
+`defaulted`: the file's top keys it left to their defaults. In the file's units (mm, g, deg),
+as the file would say them. Pure: no rclpy, no simulator.
+"""
+
+from dataclasses import fields
+import json
+import os
+
+import yaml
+
+from .kinds import kind_of
+from .loading import load
+from .model import ExperimentFile, MM
+from .part import GRASP_KEYS
+
+NAME = 'resolved.json'
+# the top keys of the file the report speaks of when the file leaves them out
+TOP_KEYS = ('tray_mm', 'feeder_zone_mm', 'hopper_lip_mm', 'bin_wall_mm', 'bin_drop_mm',
+            'moves')
+
+
+def _mm(values) -> list[float]:
+    return [round(v / MM, 6) for v in values]
+
+
+def resolved(file: ExperimentFile, given: set[str] | None = None) -> dict:
+    """The record of `file` as a run uses it; `given`: the file's top keys as written (None:
+    read from its text)."""
+    if given is None:       # which top keys the file's text sets
+        given = set(yaml.safe_load(file.text) or {}) if file.text else set()
+    part, gripper, tray, r = file.part, file.gripper, file.tray, file.requirements
+    (cx, cy), (sx, sy) = tray.feeder_zone_center, tray.feeder_zone_size
+    return {
+        'id': file.id, 'seed': file.seed,
+        'part': {'model': part.model,
+                 'dimensions_mm': {k: (v if k == 'pins_per_row' else round(v / MM, 6))
+                                   for k, v in part.dimensions.items()},
+                 'mesh': os.path.basename(part.mesh_path) if part.mesh_path else '',
+                 'mass_g': None if part.mass is None else round(part.mass / 1e-3, 6),
+                 'place': {'axis': list(file.place.place_axis),
+                           'seat_offset_mm': round(file.place.seat_offset / MM, 6)},
+                 'aspects': [{'name': a.name, 'normal': [round(v, 6) for v in a.normal],
+                              'quasi_static': round(a.quasi_static, 6)}
+                             for a in file.aspects]},
+        'materials': [{'pair': pair, 'basis': dict(bases), 'source': said}
+                      for pair, bases, said in file.material_account],
+        'gripper': {'type': gripper.kind,
+                    **{k.file_key: round(getattr(gripper, k.field) / k.factor, 6)
+                       for k in gripper.KEYS}},
+        'grasps': [_grasp(g) for g in file.grasps],
+        'auto_grasps': file.auto_grasps,
+        'tray': {'tray_mm': _mm(tray.inner_size), 'wall_mm': round(tray.wall_thickness / MM, 6),
+                 'feeder_zone_mm': {'center': _mm((cx, cy)), 'size': _mm((sx, sy))},
+                 'hopper_lip_mm': round(tray.drop_height / MM, 6)},
+        'bin_wall_mm': round(file.bin_wall / MM, 6),
+        'doses': {e.id: e.max_feed for e in file.experiments if kind_of(e).feeds},
+        'moves': [{'amplitude_mm': _mm(m.amplitude), 'frequency_hz': m.frequency,
+                   'duration_s': m.duration, 'direction': m.direction} for m in file.moves],
+        'requirements': {'parts_per_hour': r.parts_per_hour,
+                         'refill_interval_h': r.refill_interval / 3600.0,
+                         'max_dimension_mm': round(r.max_dimension / MM, 6),
+                         'max_spilled_parts': r.max_spilled, 'success_rate': r.success_rate},
+        'cell': {'pick_s': file.cell.pick_time, 'image_s': file.cell.image_time,
+                 'regrasp_s': file.cell.regrasp_time},
+        'defaulted': [k for k in TOP_KEYS if k not in given],
+    }
+
+
+def _grasp(g) -> dict:
+    """A written grasp in the file's keys and units."""
+    out = {'name': g.name}
+    for f in fields(g):
+        if f.name in GRASP_KEYS:
+            key, factor = GRASP_KEYS[f.name]
+            value = getattr(g, f.name)
+            out[key] = ([round(v / factor, 6) for v in value] if isinstance(value, tuple)
+                        else round(value / factor, 6))
+    return out
+
+
+def write(file: ExperimentFile, run_dir: str) -> str:
+    """resolved.json of `file` in `run_dir`; returns its path."""
+    path = os.path.join(run_dir, NAME)
+    with open(path, 'w', encoding='utf-8') as f:
+        json.dump(resolved(file), f, indent=1)
+        f.write('\n')
+    return path
+
+
+def read(run_dir: str) -> dict:
+    """What the run in `run_dir` ran with: its resolved.json, or, for a run directory made
+    before runs wrote one, its experiment.yaml resolved by today's rules (the defaults it left
+    out are today's: said by `defaulted`)."""
+    path = os.path.join(run_dir, NAME)
+    if os.path.exists(path):
+        with open(path, encoding='utf-8') as f:
+            return json.load(f)
+    return json.loads(json.dumps(resolved(load(os.path.join(run_dir, 'experiment.yaml')))))
