@@ -28,7 +28,7 @@ help:
 	@echo "make run    - the paper's PTH0 decided through the graph (RUN_ARGS=\"file.yaml\")"
 	@echo 'make test   - lint and run every test (installs and builds on first use)'
 	@echo 'make test-loaded - make test three times with every CPU kept busy by other loops'
-	@echo 'make bench  - world, validity and vibration benchmarks (figures in the READMEs)'
+	@echo 'make bench  - world and validity timings, each against a baseline of the same run'
 	@echo 'make clean  - remove build/, install/, log/ (keeps the venv)'
 
 $(DEPS_STAMP): requirements.txt constraints.txt tools/fix_cmake_paths.py
@@ -70,9 +70,8 @@ test-loaded: $(BUILD_STAMP)
 	$(PYTHON) tools/loaded.py --rounds 3 -- $(MAKE) test
 
 bench: $(BUILD_STAMP)
-	$(WS) python bench/world/bench_world.py
-	$(WS) python bench/validity/bench_validity.py
-	$(WS) python bench/world/bench_vibration.py
+	$(WS) python -m bench.world.bench_world
+	$(WS) python -m bench.validity.bench_validity
 
 lock: $(DEPS_STAMP)
 	$(VENV)/bin/python -m pip freeze --exclude-editable | sort > constraints.txt.new

@@ -7,8 +7,10 @@ run (never timed assertions in tests). Run from the top of the workspace, by are
     tools/ws python -m bench.graph.bench_calls          # graph/: what DDS and rclpy add
 
 Each script's docstring says what it measures and how to call it; `paper_case` holds what
-several share (the paper's test-case files, a variant of one, a run on the cores, a worker's
-nodes). Benchmarks call public names only. Their figures are in docs/benchmarks.md. Studies of
-finished runs (decisions on few runs, replays, run comparisons) are in studies/, with a test
-each; re-deciding a finished run is the `decide` command.
+several share (a worker's nodes, a full run's working time; the test case's files and a run on
+the cores are studies.cases'). `make bench` runs bench_world and bench_validity, each timing
+against a baseline measured in the same run. Benchmarks call public names only. Their figures
+are in docs/benchmarks.md. What answers a question (the physics studies, decisions on few runs,
+replays, run comparisons) is in studies/, with a test each; re-deciding a finished run is the
+`decide` command.
 """

@@ -1,64 +1,21 @@
-"""The paper's test case files, a variant of one run on the cores in this process, a worker's
-nodes to call through the graph, and the working time of a full run from its run directories,
-for the benchmarks (run them as `tools/ws python bench/NAME.py`: this directory is on the
-path)."""
+"""A worker's nodes to call through the graph, and the working time of a full run from its run
+directories, for the benchmarks; the test case's files and a run of a variant of one on the
+cores are studies.cases', which the benchmarks share (`TEST_CASE`, `variant`, `run_on_cores`
+are imported here from it)."""
 
 from collections.abc import Iterator, Sequence
 import contextlib
 import os
 import re
 import tempfile
-import time
 
-from experiment_manager import experiment_file
-from experiment_manager.analysis.results import read_csv, ResultsWriter
+from experiment_manager.analysis.results import read_csv
 from experiment_manager.commands.launcher import NodeProcess, WORKER_NODES
 from experiment_manager.graph.recording import CompleteRecords
-from experiment_manager.running.local_backend import LocalBackend
-from experiment_manager.running.scheduler import Runner
 from mcap.exceptions import McapError
 from mcap.reader import make_reader
 from mcap.records import Message
-from pick_sim_world.config import PhysicsConfig
-import yaml
-
-TEST_CASE = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src',
-                         'experiment_manager', 'config', 'test_case')
-
-
-def variant(part_file: str, experiments: list[dict], part: dict | None = None,
-            **sections) -> experiment_file.ExperimentFile:
-    """TEST_CASE/`part_file` with its experiments replaced by `experiments`, its top-level
-    `sections` (e.g. vibration, gripper) by the ones given, and the keys of its part section
-    in `part` changed, parsed."""
-    path = os.path.join(TEST_CASE, part_file)
-    with open(path, encoding='utf-8') as f:
-        data = yaml.safe_load(f)
-    data.update(sections, experiments=experiments)
-    data['part'].update(part or {})
-    return experiment_file.parse(yaml.safe_dump(data), path)
-
-
-def run_on_cores(part_file: str, experiments: list[dict], physics: PhysicsConfig | None = None,
-                 **sections) -> tuple[list[dict], float]:
-    """Run variant(part_file, experiments, **sections) on the cores with `physics` (the
-    world's defaults when None); the rows of iterations.csv and the wall time of the run, s."""
-    rows, _, wall = summarise_on_cores(part_file, experiments, physics, **sections)
-    return rows, wall
-
-
-def summarise_on_cores(part_file: str, experiments: list[dict],
-                       physics: PhysicsConfig | None = None,
-                       **sections) -> tuple[list[dict], dict, float]:
-    """run_on_cores with the run's summary too (summary.json's, per experiment id): the rows,
-    the summary and the wall time, s."""
-    file = variant(part_file, experiments, **sections)
-    with tempfile.TemporaryDirectory() as out:
-        start = time.perf_counter()
-        with LocalBackend(physics) as backend, ResultsWriter(out, file.text) as writer:
-            summary = Runner(file, [backend], writer).run()
-        wall = time.perf_counter() - start
-        return read_csv(os.path.join(out, 'iterations.csv')), summary, wall
+from studies.cases import run_on_cores, summarise_on_cores, TEST_CASE, variant  # noqa: F401
 
 
 @contextlib.contextmanager

@@ -1,7 +1,7 @@
 """Do the answers a run reports hold at finer steps? The test case's own files (their gripper,
 their parts' loads) run on the cores at the default step, half and a quarter of it, on the same
 seeds, and the answers read from the run's summary as summary.json reports them
-(bench_convergence.py checks the physics' own figures with a smaller gripper and loads):
+(studies/convergence.py checks the physics' own figures with a smaller gripper and loads):
 
 - pth0-sweep: PTH0 on the tray at 40 to 100 parts (step 10, around the full sweep's n* of
   71-72): n* and its 95 % bootstrap interval, the fit's valid parts at n*, valid per check at
@@ -19,7 +19,7 @@ A setting's mean is marked '*' when it lies outside the finest setting's 95 % in
 n* when its interval misses the finest one's. Jobs (a setting and a workload) run dearest
 first over a process per CPU.
 
-    tools/ws python -m bench.world.bench_answers [--workloads pth0-sweep,...]
+    tools/ws python -m studies.answers [--workloads pth0-sweep,...]
         [--settings default,dt/2,dt/4] [--seeds N]
 
 What it found: docs/physics.md, "The answers as reported".
@@ -31,10 +31,10 @@ import os
 import statistics
 import time
 
-from experiment_manager.analysis import metrics
+from pick_common.stats import interval
 
-from bench.paper_case import summarise_on_cores
-from bench.world.bench_convergence import SETTINGS
+from studies.cases import parse_args, summarise_on_cores
+from studies.convergence import SETTINGS
 
 
 def _feeder(part_file: str, parts: int, optimal_range: list[int], seeds: int) -> tuple:
@@ -73,7 +73,7 @@ def job(args: tuple[str, str, int]) -> tuple[str, str, list[dict], dict, float]:
 
 def mean_interval(values: list[float]) -> tuple[float, float, float]:
     """Mean and its 95 % interval (metrics.interval; the mean itself for one value)."""
-    low, high = metrics.interval(values)
+    low, high = interval(values)
     m = statistics.fmean(values)
     return m, m if low is None else low, m if high is None else high
 
@@ -102,7 +102,8 @@ def sweep_table(results: dict, settings: list[str], finest: str) -> list[str]:
                                       if int(r['group']) == n])
             cells.append(cell([float(r['valid']) for r in rows if int(r['group']) == n],
                               finest_n))
-        out.append(f'| {s} | {sw["n_star"]} ({ci[0]}-{ci[1]})' + (' *' if apart else '')
+        interval_text = f' ({ci[0]}-{ci[1]})' if ci else ''      # none from one seed
+        out.append(f'| {s} | {sw["n_star"]}{interval_text}' + (' *' if apart else '')
                    + f' | {sw["fit_max"]:.1f} | ' + ' | '.join(cells) + f' | {wall:.0f} |')
     return out
 
@@ -152,13 +153,18 @@ def bins_table(results: dict, settings: list[str], finest: str) -> list[str]:
     return out
 
 
+# the size of its smoke test (tests/test_studies.py): `--small`
+SMALL = ['--workloads', 'pth0-sweep', '--settings', 'default', '--finest', 'default',
+         '--seeds', '1']
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--workloads', default=','.join(WORKLOADS))
     parser.add_argument('--settings', default='default,dt/2,dt/4')
     parser.add_argument('--finest', default='dt/4')
     parser.add_argument('--seeds', type=int, help="seeds per group (default: each workload's)")
-    args = parser.parse_args()
+    args = parse_args(parser, SMALL)
     workloads = args.workloads.split(',')
     settings = args.settings.split(',')
     unknown = (set(workloads) - set(WORKLOADS)) | (set(settings + [args.finest]) - set(SETTINGS))

@@ -23,7 +23,7 @@ error and the wall time per iteration. An interval is mean +- t(0.975, n-1) s / 
 setting's mean is marked '*' when it lies outside the finest setting's interval (--finest,
 default a quarter of the step).
 
-    tools/ws python -m bench.world.bench_convergence [--seeds 8] [--workloads sweep,feeder,bins,...]
+    tools/ws python -m studies.convergence [--seeds 8] [--workloads sweep,feeder,bins,...]
         [--settings default,100-it,...] [--finest dt/4]
 
 Runs are spread over a process per CPU. What it costs: docs/physics.md, "Convergence".
@@ -37,17 +37,17 @@ import os
 import statistics
 import time
 
-from experiment_manager.analysis import metrics
+from pick_common.stats import interval as mean_interval
 from pick_sim_world.config import PhysicsConfig
 
-from bench.paper_case import run_on_cores
+from studies.cases import parse_args, run_on_cores
 
 DEFAULT = PhysicsConfig()
 # The finer settings solve a tray with a bin's iterations too (100, not the tray's 50).
 FINER = replace(DEFAULT, tray_solver_iterations=DEFAULT.solver_iterations)
 SETTINGS = {
     'default': DEFAULT,         # 1/480 s, 100 iterations (50 on a tray), warm start 0.85
-    '1/240': replace(DEFAULT, time_step=1 / 240),   # pybullet's step, the default until 11-25
+    '1/240': replace(DEFAULT, time_step=1 / 240),   # pybullet's step, an earlier default
     'dt/2': replace(FINER, time_step=DEFAULT.time_step / 2),
     'dt/4': replace(FINER, time_step=DEFAULT.time_step / 4),
     'dt/8': replace(FINER, time_step=DEFAULT.time_step / 8),
@@ -132,7 +132,7 @@ WORKLOADS = {
 # docs/paper-test-case.md, "Which gripper"). Chosen when, with the test case's 20 mm one (and
 # the earlier validity check), every PTH0 feeder run stopped at its vibration limit; since round
 # bodies are gripped at any roll they empty (PTH0: 50 of 50, 33 vibrations on average), so that
-# reason no longer holds: bench_answers.py checks the answers as reported with the test case's
+# reason no longer holds: studies/answers.py checks the answers as reported with the test case's
 # own gripper and loads.
 GRIPPER = {'body_diameter_mm': 8, 'body_length_mm': 60, 'jaw_height_mm': 15, 'jaw_depth_mm': 3}
 
@@ -161,8 +161,12 @@ def interval(values: list[float]) -> tuple[float, float] | None:
     value); None for no value."""
     if not values:
         return None
-    low, high = metrics.interval(values)
+    low, high = mean_interval(values)
     return statistics.fmean(values), 0.0 if low is None else (high - low) / 2
+
+
+# the size of its smoke test (tests/test_studies.py): `--small`
+SMALL = ['--workloads', 'sweep', '--settings', 'default', '--finest', 'default', '--seeds', '1']
 
 
 def main() -> None:
@@ -175,7 +179,7 @@ def main() -> None:
     parser.add_argument('--rows', default='',
                         help="a JSON file the runs' rows are written to, or read from when it "
                              'exists (the tables again without running)')
-    args = parser.parse_args()
+    args = parse_args(parser, SMALL)
     workloads = args.workloads.split(',')
     unknown = set(args.settings.split(',') + [args.finest]) - set(SETTINGS)
     if unknown:

@@ -5,7 +5,7 @@ creep (most of them on the former defaults, where the creep was found; the 'form
 keep that day's 1 mm rolling and spinning friction arms, the others take today's, 0.1 mm,
 unless they change them: ARMS).
 
-    tools/ws python -m bench.world.bench_creep [--parts 150] [--bin 75x75x60] [--seed 0] [--cap 5]
+    tools/ws python -m studies.creep [--parts 150] [--bin 75x75x60] [--seed 0] [--cap 5]
         [--part pth1] [--settings default,former,...] [--seconds 1]
 
 Prints per setting: settled or not (and when), wall time, parts still moving at the end, the
@@ -26,15 +26,14 @@ from pick_common.specs import SceneSpec
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
 
-from bench.paper_case import TEST_CASE
+from studies.cases import parse_args, TEST_CASE
 
 # The defaults before the convergence study: 30 iterations, pybullet's warm start 0.1
 # and step of 1/240 s. The probes for the cause of the creep ran on them first (world README,
 # "Piles that rest"); the probes that set Bullet's engine parameters, part dynamics or gravity
 # directly (ERP, split impulse, CFM, cone friction, SAT, friction anchors, damping, a scene
 # scaled x 10) needed the world's private client and were dropped from this script when
-# benchmarks took to public names only; their figures in the world README were measured with
-# it as of commit 10416e4.
+# benchmarks took to public names only; their figures in docs/studies.md were measured with it.
 FORMER = {'solver_iterations': 30, 'warm_starting_factor': 0.1, 'time_step': 1 / 240}
 # name: PhysicsConfig fields
 SETTINGS = {
@@ -110,6 +109,10 @@ def creep(name: str, parts: int, size: tuple[float, float, float], seed: int, ca
             + (f' | moved > 0.5 mm in each of {seconds} seconds: '
                f'{", ".join(map(str, per_second))}' if seconds > 1 else ''))
 
+# the size of its smoke test (tests/test_studies.py): `--small`
+SMALL = ['--parts', '20', '--settings', 'default', '--cap', '1', '--seconds', '1']
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--parts', type=int, default=150)
@@ -121,7 +124,7 @@ def main() -> None:
     parser.add_argument('--settings', default=','.join(SETTINGS))
     parser.add_argument('--seconds', type=int, default=1,
                         help='further seconds, each counted apart (median and max: over all)')
-    args = parser.parse_args()
+    args = parse_args(parser, SMALL)
     size = tuple(float(x) / 1000 for x in args.bin.split('x'))
     print(f'{args.parts} parts of {args.part} into a {args.bin} mm bin, seed {args.seed}',
           flush=True)

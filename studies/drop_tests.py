@@ -37,6 +37,7 @@ from pick_common.parts.geometry import build_part
 from pick_common.parts.materials import Contact, PART_ON_SURFACE
 from pick_common.parts.spec import PartSpec
 from pick_common.specs import SceneSpec
+from pick_common.stats import wilson_interval
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
 import trimesh
@@ -152,10 +153,10 @@ def compare(name: str, data: DataSet, contact: Contact, height: float, drops: in
     for o in data.outcomes:
         measured = (data.counts[o] / measured_total if data.counts else data.shares[o])
         rows.append({'outcome': o, 'measured': measured,
-                     'measured_ci': aspects_of.share_interval(data.counts[o], measured_total)
+                     'measured_ci': wilson_interval(data.counts[o], measured_total)
                      if data.counts else None,
                      'simulated': simulated[o] / total,
-                     'simulated_ci': aspects_of.share_interval(simulated[o], total),
+                     'simulated_ci': wilson_interval(simulated[o], total),
                      'quasi_static': quasi[o]})
     p = aspects_of.agreement(simulated, data.counts) if data.counts else None
     return {'name': name, 'rows': rows, 'other': counts.get(aspects_of.OTHER, 0),

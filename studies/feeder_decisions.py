@@ -46,13 +46,15 @@ import argparse
 import os
 import sys
 
-from bench.paper_case import TEST_CASE
 from experiment_manager import experiment_file
-from experiment_manager.analysis import decisions, metrics
+from experiment_manager.analysis import decisions
 from experiment_manager.analysis.results import read_csv
 from experiment_manager.running import sampling
 import numpy as np
+from pick_common.stats import rate_interval
 import yaml
+
+from studies.cases import TEST_CASE
 
 # the full-count sweeps' n* (docs/paper-test-case.md, "In short") and the files' margin
 N_STAR = {'pth0': 72, 'pth1': 45, 'pth2': 54}
@@ -174,7 +176,7 @@ def cost(run_dirs: list[str]) -> None:
         minutes = np.cumsum([r['wall_time'] for r in rows]) / 60.0
         batch = file.sampling.batch
         before = next((k for k in range(batch, len(rows) + 1, batch)
-                       if metrics.rate_interval(sum(r['emptied'] for r in rows[:k]), k,
+                       if rate_interval(sum(r['emptied'] for r in rows[:k]), k,
                                                 sampling.INTERIM_CONFIDENCE)[0] >= 0.9),
                       len(rows))
         now = next((k for k in range(batch, len(rows) + 1, batch)

@@ -22,13 +22,14 @@ import argparse
 import os
 import tempfile
 
-from bench.paper_case import variant
 from experiment_manager.analysis.results import read_csv, ResultsWriter
 from experiment_manager.running.local_backend import LocalBackend
 from experiment_manager.running.scheduler import Runner
 import numpy as np
 from pick_common.states import PartStates
 import trimesh
+
+from studies.cases import variant
 
 OVER_WALL = 0.004   # m: a part this close to a wall's inner face, or past it, leans on it
 

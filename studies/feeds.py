@@ -4,7 +4,7 @@ its biggest), at the world's default physics; counts the parts that ended in or 
 floor or a wall (tunnelled), over a wall (spilled), the deepest penetration and the lowest
 part origin above the floor's top.
 
-    tools/ws python -m bench.world.bench_feeds [--feeds 50] [--loads pth0=90,pth1=55,pth2=54]
+    tools/ws python -m studies.feeds [--feeds 50] [--loads pth0=90,pth1=55,pth2=54]
 
 The default loads are the upper ends of the optimal ranges the reduced test case found with
 the earlier physics (n* 85, 50, 49, margin 5: docs/paper-test-case.md). Feeds are
@@ -21,7 +21,7 @@ from pick_common.specs import SceneSpec
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
 
-from bench.paper_case import TEST_CASE
+from studies.cases import parse_args, TEST_CASE
 
 
 def feed(args: tuple[str, int, int]) -> tuple[str, int, int, int, float, float, float]:
@@ -35,12 +35,16 @@ def feed(args: tuple[str, int, int]) -> tuple[str, int, int, int, float, float, 
             1000.0 * report.max_penetration, 1000.0 * lowest, time.perf_counter() - start)
 
 
+# the size of its smoke test (tests/test_studies.py): `--small`
+SMALL = ['--feeds', '1', '--loads', 'pth0=10']
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--feeds', type=int, default=50, help='seeded feeds per part')
     parser.add_argument('--loads', default='pth0=90,pth1=55,pth2=54',
                         help='part file = parts per feed, comma-separated')
-    args = parser.parse_args()
+    args = parse_args(parser, SMALL)
     loads = {k: int(v) for k, v in (item.split('=') for item in args.loads.split(','))}
     jobs = [(name, n, seed) for name, n in loads.items() for seed in range(args.feeds)]
     start = time.perf_counter()

@@ -4,7 +4,7 @@ from the file's in body diameter, jaw depth and finger clearance. Prints the val
 scene and the parts stopped at each stage (1 candidacy, 2 placeability, 3 container,
 4 neighbours, 5 valid).
 
-    tools/ws python -m bench.validity.bench_grippers [--file pth0.yaml] [--parts 50] [--seeds 3]
+    tools/ws python -m studies.gripper_stages [--file pth0.yaml] [--parts 50] [--seeds 3]
 """
 
 import argparse
@@ -18,7 +18,10 @@ from pick_common.specs import SceneSpec
 from pick_sim_world.world import World
 from pick_validity.validity import Validator
 
-from bench.paper_case import TEST_CASE
+from studies.cases import parse_args, TEST_CASE
+
+# the size of its smoke test (tests/test_studies.py): `--small`
+SMALL = ['--parts', '10', '--seeds', '1']
 
 
 def main() -> None:
@@ -26,7 +29,7 @@ def main() -> None:
     parser.add_argument('--file', default='pth0.yaml')
     parser.add_argument('--parts', type=int, default=50)
     parser.add_argument('--seeds', type=int, default=3)
-    args = parser.parse_args()
+    args = parse_args(parser, SMALL)
     f = load(os.path.join(TEST_CASE, args.file))
     scenes = []
     for seed in range(args.seeds):

@@ -3,7 +3,7 @@ the tray's +x wall, 30 mm apart, lying on their sides, then one move (pick_commo
 and a settle; the scene of test_world.py's
 test_centring_carries_parts_off_centre_toward_the_middle_where_a_flip_does_not.
 
-    tools/ws python -m bench.world.bench_moves [--moves centre,flip,backward,spread]
+    tools/ws python -m studies.moves [--moves centre,flip,backward,spread]
         [--offset-mm 50]
 
 Prints per move: the parts' centroid (x, y, mm) before and after, how far it moved toward the
@@ -19,6 +19,8 @@ from pick_common.parts.spec import PartSpec
 from pick_common.specs import MOVES, SceneSpec
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
+
+from studies.cases import parse_args
 
 LYING = (0.0, 0.7071068, 0.0, 0.7071068)     # the capacitor's axis along x
 
@@ -38,11 +40,15 @@ def carry(move: str, offset: float) -> tuple[np.ndarray, np.ndarray, float, floa
         return before, world.snapshot().poses[:, :2].mean(axis=0), report.sim_time, error
 
 
+# the size of its smoke test (tests/test_studies.py): `--small`
+SMALL = ['--moves', 'centre']
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     ap.add_argument('--moves', default='centre,flip,backward,spread')
     ap.add_argument('--offset-mm', type=float, default=50.0)
-    args = ap.parse_args()
+    args = parse_args(ap, SMALL)
     print(f'{"move":<10} {"before x, y mm":>16} {"after x, y mm":>16} {"toward centre mm":>17} '
           f'{"sim s":>6} {"tray error":>10}')
     for move in args.moves.split(','):

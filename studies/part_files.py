@@ -21,7 +21,6 @@ import os
 import tempfile
 import time
 
-from experiment_manager.analysis.metrics import interval
 from experiment_manager.experiment_file.drop_test import plate
 import numpy as np
 from pick_common.containers import ContainerSpec
@@ -30,9 +29,12 @@ from pick_common.parts.geometry import build_part
 from pick_common.parts.spec import PartSpec
 from pick_common.specs import SceneSpec
 from pick_common.states import rotate
+from pick_common.stats import interval, rate_interval
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
-from pick_validity.config import GraspPose, Gripper, PlaceSpec, Setup
+from pick_validity.config import PlaceSpec, Setup
+from pick_validity.grasps import GraspPose
+from pick_validity.grippers import Jaws
 from pick_validity.results import (
     STAGE_CANDIDACY,
     STAGE_CONTAINER,
@@ -42,8 +44,9 @@ from pick_validity.results import (
     STAGE_VALID,
 )
 from pick_validity.validity import Validator
-from scipy import stats
 import trimesh
+
+from studies.cases import parse_args
 
 STEP = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src',
                     'experiment_manager', 'config', 'parts', 'CP_Radial_D5.0mm_P2.00mm.step')
@@ -51,7 +54,7 @@ MASS = 0.0004                   # kg: cp_radial_kicad.yaml's
 POINT = np.array([0.001, 0.0, 0.0025])      # m, KiCad's frame: the body's middle
 GRASPS = [((1, 0, 0), (0, 1, 0)), ((-1, 0, 0), (0, 1, 0)), ((0, 1, 0), (1, 0, 0)),
           ((0, -1, 0), (1, 0, 0)), ((0, 0, 1), (1, 0, 0))]
-GRIPPER = Gripper(body_diameter=0.02, body_length=0.06, jaw_height=0.015, jaw_depth=0.003)
+GRIPPER = Jaws(body_diameter=0.02, body_length=0.06, jaw_height=0.015, jaw_depth=0.003)
 TURN = trimesh.transformations.euler_matrix(0.7, 0.3, -1.2)[:3, :3]
 STAGES = {STAGE_CANDIDACY: 'candidacy', STAGE_PLACEABILITY: 'placeability',
           STAGE_CONTAINER: 'container', STAGE_NEIGHBOUR: 'neighbours', STAGE_VALID: 'valid',
@@ -78,8 +81,7 @@ def files(directory: str) -> dict[str, tuple[PartSpec, np.ndarray, np.ndarray]]:
 
 
 def share(k: int, n: int) -> str:
-    low = stats.beta.ppf(0.025, k, n - k + 1) if k else 0.0
-    high = stats.beta.ppf(0.975, k + 1, n - k) if k < n else 1.0
+    low, high = rate_interval(k, n)
     return f'{100 * k / n:5.1f} % [{100 * low:4.1f}, {100 * high:4.1f}]'
 
 
@@ -88,13 +90,17 @@ def kicad_z(poses: np.ndarray, turn: np.ndarray) -> np.ndarray:
     return rotate(poses[:, 3:], turn @ np.array([0.0, 0.0, 1.0]))[:, 2]
 
 
+# the size of its smoke test (tests/test_studies.py): `--small`
+SMALL = ['--drops', '4', '--parts', '6', '--seeds', '2']
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     ap.add_argument('--drops', type=int, default=300)
     ap.add_argument('--parts', type=int, default=60)
     ap.add_argument('--seeds', type=int, default=4)
     ap.add_argument('--length-unit', type=float, default=PhysicsConfig().length_unit)
-    args = ap.parse_args()
+    args = parse_args(ap, SMALL)
     physics = PhysicsConfig(length_unit=args.length_unit) if args.length_unit != 1.0 else \
         PhysicsConfig(length_unit=1.0, contact_breaking_threshold=0.001)
     with tempfile.TemporaryDirectory() as tmp:

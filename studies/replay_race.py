@@ -15,11 +15,11 @@ import argparse
 import os
 
 from experiment_manager import experiment_file
-from experiment_manager.analysis import metrics
 from experiment_manager.analysis.results import read_csv
 from experiment_manager.experiment_file.plan import groups
 from experiment_manager.running import sampling
 import numpy as np
+from pick_common.stats import interval
 
 from . import replay_decisions
 
@@ -31,7 +31,7 @@ def overlap_race(exp, rows: list[dict]) -> tuple[list[int], list[int]]:
         return [], []
     fractions = {g: [r['container_free'] / r['checked'] for r in rows
                      if r['group'] == g and r['checked']] for g in groups(exp)}
-    intervals = {g: metrics.interval(v, sampling.INTERIM_CONFIDENCE)
+    intervals = {g: interval(v, sampling.INTERIM_CONFIDENCE)
                  for g, v in fractions.items()}
     if any(low is None for low, _ in intervals.values()):
         return groups(exp), []

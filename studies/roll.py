@@ -2,7 +2,7 @@
 body axis: the test case's side grasps are four poses 90 degrees apart about that axis, and a
 part that rests at a roll between them is approached tilted by the difference.
 
-    tools/ws python -m bench.validity.bench_roll [--files pth0 pth2] [--step 3]
+    tools/ws python -m studies.roll [--files pth0 pth2] [--step 3]
 
 For each test-case file: the part lies on its side (body axis along +X of the tray, its body on
 the floor) in the middle of the empty tray, rolled by 0..45 degrees about its body axis, and is
@@ -25,7 +25,7 @@ from pick_validity.results import STAGE_VALID
 from pick_validity.validity import Validator
 from scipy.spatial.transform import Rotation
 
-from bench.paper_case import TEST_CASE
+from studies.cases import parse_args, TEST_CASE
 
 
 def stages_by_roll(name: str, rolls: np.ndarray) -> list[int]:
@@ -43,11 +43,15 @@ def stages_by_roll(name: str, rolls: np.ndarray) -> list[int]:
     return out
 
 
+# the size of its smoke test (tests/test_studies.py): `--small`
+SMALL = ['--files', 'pth0', '--step', '15']
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     parser.add_argument('--files', nargs='+', default=['pth0', 'pth2'])
     parser.add_argument('--step', type=float, default=3.0, help='degrees between rolls')
-    args = parser.parse_args()
+    args = parse_args(parser, SMALL)
     rolls = np.arange(0.0, 45.0 + 1e-9, args.step)
     for name in args.files:
         stages = stages_by_roll(name, rolls)

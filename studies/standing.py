@@ -4,7 +4,7 @@ parts lie: on their side, standing on the body's top with the leads up (no grasp
 so candidacy rejects it), standing on the leads, or leaning. Per solver setting on the same
 seeds, to tell the physics from the step.
 
-    tools/ws python -m bench.world.bench_standing [--file pth2] [--parts 100] [--moves 50]
+    tools/ws python -m studies.standing [--file pth2] [--parts 100] [--moves 50]
         [--every 10] [--seeds 0,1] [--settings default,dt/2]
 
 In an earlier reduced test case PTH2's feeder run (8 mm capacitors, 95-105 on the tray)
@@ -27,7 +27,7 @@ from pick_common.states import rotate
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
 
-from bench.paper_case import TEST_CASE
+from studies.cases import parse_args, TEST_CASE
 
 SETTINGS = {
     'default': {},                                      # 1/480 s
@@ -73,6 +73,11 @@ def run(job: tuple[str, str, list[int], int, int, int]) -> list[str]:
     return lines
 
 
+# the size of its smoke test (tests/test_studies.py): `--small`
+SMALL = ['--file', 'pth0', '--parts', '10', '--moves', '2', '--every', '1', '--seeds', '0',
+         '--settings', 'default']
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--file', default='pth2', help='a test-case file: pth0 or pth2')
@@ -81,7 +86,7 @@ def main() -> None:
     parser.add_argument('--every', type=int, default=10)
     parser.add_argument('--seeds', default='0,1')
     parser.add_argument('--settings', default='default,dt/2')
-    args = parser.parse_args()
+    args = parse_args(parser, SMALL)
     seeds = [int(s) for s in args.seeds.split(',')]
     jobs = [(name, args.file, seeds, args.parts, args.moves, args.every)
             for name in args.settings.split(',')]

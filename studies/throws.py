@@ -3,7 +3,7 @@ test case) fed onto the tray and spread many times, per solver setting on the sa
 world reads every part's speed after every step and names the parts faster than gravity and
 the tray can make them (world.speed_limit).
 
-    tools/ws python -m bench.world.bench_throws [--settings default,warm-1] [--seeds 10,11,12]
+    tools/ws python -m studies.throws [--settings default,warm-1] [--seeds 10,11,12]
         [--parts 50] [--moves 200]
 
 Prints per setting and seed: moves with a thrown part, parts thrown, parts that ended off the
@@ -23,6 +23,8 @@ from pick_common.parts.spec import PartSpec
 from pick_common.specs import MOVES, SceneSpec
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.world import World
+
+from studies.cases import parse_args
 
 SETTINGS = {
     'default': {},                          # 1/480 s, 50 iterations, warm start 0.85
@@ -62,13 +64,17 @@ def run(job: tuple[str, list[int], int, int]) -> list[str]:
     return lines
 
 
+# the size of its smoke test (tests/test_studies.py): `--small`
+SMALL = ['--settings', 'default', '--seeds', '10', '--parts', '10', '--moves', '2']
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--settings', default='default,warm-1')
     parser.add_argument('--seeds', default='10,11,12')
     parser.add_argument('--parts', type=int, default=50)
     parser.add_argument('--moves', type=int, default=200)
-    args = parser.parse_args()
+    args = parse_args(parser, SMALL)
     names = args.settings.split(',')
     unknown = [n for n in names if n not in SETTINGS]
     if unknown:

@@ -12,7 +12,7 @@ the edge. The ranges are the policy's default [20, 30], a fuller table, [50, 60]
 the top of the ranges our sweeps give (PTH0's); none is a result of the paper. The runs are
 spread over a process per CPU.
 
-    tools/ws python -m bench.world.bench_vibration [--seeds 4] [--feeder-seeds 3]
+    tools/ws python -m studies.vibration [--seeds 4] [--feeder-seeds 3]
 """
 
 import argparse
@@ -28,7 +28,7 @@ from pick_sim_world.world import World
 from pick_validity.config import Setup
 from pick_validity.validity import Validator
 
-from bench.paper_case import run_on_cores
+from studies.cases import parse_args, run_on_cores
 
 PROFILES = {
     'x + z in phase, 1 x 0.5 x 1 mm, 30 Hz, 1 s (fixed)':
@@ -87,14 +87,22 @@ def feeder_runs(part_file: str, vibration: Vibration, runs: int,
                            moves=[vibration_section])
     return rows
 
+# the size of its smoke test (tests/test_studies.py): `--small`
+SMALL = ['--seeds', '1', '--feeder-seeds', '1', '--cases', '1', '--profiles', '1']
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--seeds', type=int, default=4)
     parser.add_argument('--feeder-seeds', type=int, default=3)
-    args = parser.parse_args()
+    parser.add_argument('--cases', type=int, help='only the first N feeder cases (part, range, '
+                        'profile); default: all')
+    parser.add_argument('--profiles', type=int, help='only the first N scatter profiles; '
+                        'default: all')
+    args = parse_args(parser, SMALL)
     print(f'feeder_emptying: 100 parts, limit 300 vibrations, {args.feeder_seeds} runs each')
     cases = [(part, optimal_range, name) for part, optimal_range, name in itertools.product(
-        FEEDER_PARTS, FEEDER_RANGES, FEEDER_PROFILES)]
+        FEEDER_PARTS, FEEDER_RANGES, FEEDER_PROFILES)][:args.cases]
     with multiprocessing.Pool(os.cpu_count()) as pool:
         results = pool.starmap(feeder_runs, [
             (FEEDER_PARTS[part], FEEDER_PROFILES[name], args.feeder_seeds, optimal_range)
@@ -110,7 +118,7 @@ def main() -> None:
               'per vibration (picks included)', flush=True)
     print()
     print(f'55 capacitors fed into the feeder zone, 10 vibrations, seeds 1..{args.seeds}')
-    for name, vibration in PROFILES.items():
+    for name, vibration in list(PROFILES.items())[:args.profiles]:
         runs = [run(vibration, seed) for seed in range(1, args.seeds + 1)]
         valid = [v for r in runs for v in r['valid']]
         print(f'{name:<66} valid per check: median {statistics.median(valid):4.1f}, '

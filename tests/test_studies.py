@@ -1,7 +1,8 @@
-"""Each study of studies/ runs on a small recorded run and prints what its docstring promises:
-a study that docs/ cites must still run. The runs are made here on the cores (no graph): the
-experiment manager's small file without its gripper sweep, once adaptively (the replays need a
-run's looks) and once at fixed counts (compare_runs needs two runs of the same seeds)."""
+"""Each study of studies/ runs and prints what its docstring promises: a study that docs/ cites
+must still run. The studies of finished runs run on a small recorded run, made here on the
+cores (no graph): the experiment manager's small file without its gripper sweep, once
+adaptively (the replays need a run's looks) and once at fixed counts (compare_runs needs two
+runs of the same seeds); the physics studies at their small size (`--small`)."""
 
 import os
 import subprocess
@@ -101,3 +102,29 @@ def test_feeder_landing_measures_the_pile_after_every_feed():
     assert 'feeder zone centred at -68.12, 0.00 mm, 38.75 x 120.00 mm, walls 27 mm' in out
     assert ' feeds: pile top median ' in out and "parts over a wall's top after a feed" in out
     assert 'spilled per run: ' in out
+
+
+# The physics studies docs/physics.md cites, each at its small size (`--small`: a few parts and
+# one seed), and a line of the figures it prints: a study a page cites is one that still runs.
+PHYSICS = [
+    ('moves', 'toward centre mm'), ('roll', 'valid at'), ('gripper_stages', 'valid per scene'),
+    ('feeds', '| pth0 | 10 | 1 |'), ('lean', '| 1/480 s |'), ('creep', 'settled'),
+    ('spills', 'default: spilled'), ('throws', 'moves with a thrown part'),
+    ('standing', 'head down/side/leaning/on leads'), ('convergence', '| default |'),
+    ('answers', 'valid at 40'), ('vibration', 'valid per check'),
+    ('part_files', 'on the tray, 2 seeds'),
+]
+
+
+@pytest.mark.parametrize('study, line', PHYSICS, ids=[s for s, _ in PHYSICS])
+def test_a_physics_study_runs_at_its_small_size_and_prints_its_figures(study, line):
+    out = _study(f'studies.{study}', '--small')
+    assert line in out, out
+
+
+def test_no_study_imports_a_benchmark():
+    for name in sorted(os.listdir(os.path.join(TOP, 'studies'))):
+        if name.endswith('.py'):
+            with open(os.path.join(TOP, 'studies', name), encoding='utf-8') as f:
+                text = f.read()
+            assert 'from bench' not in text and 'import bench' not in text, name
