@@ -17,6 +17,16 @@ PAGES = sorted([os.path.join(TOP, 'README.md'), os.path.join(TOP, 'CHANGELOG.md'
 LINK = re.compile(r'\[[^\]]*\]\(([^)\s]+)\)')
 TRACKER = re.compile(r'\b[Ii]ssues?\s+\d+|\b[Ii]ssue\s*\n\s*\d+')
 DATE = re.compile(r'#.*\b20\d\d-\d\d-\d\d\b')
+# when a figure was measured, rather than what holds: a date, a day without its year, a commit
+# or a session named as where a figure came from
+WHEN = re.compile(r'\b20\d\d-\d\d-\d\d\b|\b(?:until|since|before|after|on|of) 1[0-2]-[0-3]\d\b'
+                  r'|\b(?:as of|at|on) commit\b|\bat [0-9a-f]{7,40}\b|\([0-9a-f]{7}\)'
+                  r'|\b(?:this|that|today\'s) session\b|\b(?:first|second|third|fourth) session\b'
+                  r'|\bthis (?:morning|evening)\b')
+# the pages that say what holds; dated measurements live on studies.md and benchmarks.md, the
+# history in CHANGELOG.md
+REFERENCE = [p for p in PAGES if os.path.basename(p) not in ('studies.md', 'benchmarks.md',
+                                                             'CHANGELOG.md')]
 
 
 def _slug(heading: str) -> str:
@@ -74,6 +84,15 @@ def test_no_date_in_a_comment_of_the_code():
     assert not found, found
 
 
+def test_no_date_or_when_it_was_measured_in_the_code_or_on_a_reference_page():
+    found = []
+    for path in _files('src/**/*.py', 'studies/*.py') + REFERENCE:
+        with open(path, encoding='utf-8') as f:
+            found += [f'{os.path.relpath(path, TOP)}:{n}: {m.group(0)!r}'
+                      for n, line in enumerate(f, 1) for m in WHEN.finditer(line)]
+    assert not found, found
+
+
 def test_the_readme_is_at_most_120_lines():
     with open(os.path.join(TOP, 'README.md'), encoding='utf-8') as f:
         assert len(f.read().splitlines()) <= 120
@@ -94,4 +113,9 @@ def test_no_module_of_src_passes_400_lines():
 def test_the_checks_above_can_fail():
     assert TRACKER.search('as issue 43 asked') and TRACKER.search('the issue\n  43')
     assert DATE.search('x = 1  # measured 2026-11-27') and not DATE.search('x = "2026-11-27"')
+    for said in ('measured 2026-11-27', 'the default until 11-25', 'as of commit 10416e4',
+                 'at a147eca, 59 min', 'the metres world (a4933a7)', "this session's run",
+                 'the fourth session', 'this morning'):
+        assert WHEN.search(said), said
+    assert not WHEN.search('a 5 mm part at 30 Hz, 10-20 % of the time, seed 11')
     assert _slug('## Results (the run directory)'[3:]) == 'results-the-run-directory'
