@@ -1,8 +1,9 @@
 """The experiment file: what a run uses of it, in SI units (`model`); the file as written, its
 keys, types, ranges and defaults (`schema`, pydantic models of the `values` the cores'
 rules check); reading and checking it with every error at once (`loading`; the part section,
-its CAD file and grasps, in `part`), named by key path (`errors`); and the iterations it asks
-for, each with its seed (`plan`). Pure: no rclpy, no
+its CAD file and grasps, in `part`), named by key path (`errors`); the experiment kinds, a
+class per type in one registry (`kinds`); the iterations it asks for, each with its seed
+(`plan`); and what a run ran with, every default applied (`resolved`). Pure: no rclpy, no
 simulator.
 
 The names users call are here: `load`, `parse`, `reduced`, `InvalidFile`, and the model's
