@@ -4,9 +4,10 @@ experiment.yaml, so that a default changed later never changes what an old run's
 
 It holds the part (its model, dimensions, mesh, mass, placing, and the aspects it can rest on
 with their normals), its materials with the basis of each value, the gripper (its kind and
-every key in the file's units), the grasps, the tray (size, walls, feeder zone, the hopper's
-lip), each feeder run's dose, the table's moves, the requirements and the cell's times, and
-`defaulted`: the file's top keys it left to their defaults. In the file's units (mm, g, deg),
+every key in the file's units), the grasps, the file's named grippers its experiments run
+with (each with its grasps), the tray (size, walls, feeder zone, the hopper's lip), each
+feeder run's dose, the table's moves, the requirements and the cell's times, and `defaulted`:
+the file's top keys it left to their defaults. In the file's units (mm, g, deg),
 as the file would say them. Pure: no rclpy, no simulator.
 """
 
@@ -52,10 +53,11 @@ def resolved(file: ExperimentFile, given: set[str] | None = None) -> dict:
                              for a in file.aspects]},
         'materials': [{'pair': pair, 'basis': dict(bases), 'source': said}
                       for pair, bases, said in file.material_account],
-        'gripper': {'type': gripper.kind,
-                    **{k.file_key: round(getattr(gripper, k.field) / k.factor, 6)
-                       for k in gripper.KEYS}},
+        'gripper': _gripper(gripper),
         'grasps': [_grasp(g) for g in file.grasps],
+        'grippers': {e.gripper: {**_gripper(e.setup.gripper),
+                                 'grasps': [_grasp(g) for g in e.setup.grasps]}
+                     for e in file.experiments if e.gripper},
         'auto_grasps': file.auto_grasps,
         'tray': {'tray_mm': _mm(tray.inner_size), 'wall_mm': round(tray.wall_thickness / MM, 6),
                  'feeder_zone_mm': {'center': _mm((cx, cy)), 'size': _mm((sx, sy))},
@@ -72,6 +74,12 @@ def resolved(file: ExperimentFile, given: set[str] | None = None) -> dict:
                  'regrasp_s': file.cell.regrasp_time},
         'defaulted': [k for k in TOP_KEYS if k not in given],
     }
+
+
+def _gripper(gripper) -> dict:
+    """A gripper's kind and every key of it, in the file's units."""
+    return {'type': gripper.kind, **{k.file_key: round(getattr(gripper, k.field) / k.factor, 6)
+                                     for k in gripper.KEYS}}
 
 
 def _grasp(g) -> dict:
