@@ -89,6 +89,9 @@ def main() -> None:
         cells = []
         for c in columns:
             values = [r[2][c] for r in results if r[0] == s and not math.isnan(r[2][c])]
+            if not values:          # e.g. no part leaned, so none leaned on others
+                cells.append('-')
+                continue
             low, high = interval(values)
             half = 0.0 if low is None else (high - low) / 2
             cells.append(f'{statistics.fmean(values):.4g} +- {half:.2g}')
