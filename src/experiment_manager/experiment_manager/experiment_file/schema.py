@@ -250,7 +250,7 @@ class FeederZone(Section):
 
 class FileKeys(Section):
     """The file's top level; each section is read by its own model (SECTIONS), each
-    experiment by its type's (EXPERIMENTS)."""
+    experiment by its kind's (kinds.keys_model)."""
 
     id: Identifier
     seed: Int(0, MAX_SEED) = 0

@@ -39,8 +39,8 @@ from scipy import stats
 import trimesh
 
 from ..states import rotate
-from .geometry import build_part, PartGeometry
-from .spec import geometry_key, PartSpec
+from .geometry import PartGeometry
+from .spec import geometry_key
 
 MERGE_ANGLE = math.radians(5.0)     # faces this close in normal are one aspect
 MATCH_ANGLE = math.radians(10.0)    # a pose this far from every aspect is OTHER
@@ -231,18 +231,13 @@ _BY_GEOMETRY: dict[tuple, tuple[Aspect, ...]] = {}
 def part_aspects(part: PartGeometry) -> tuple[Aspect, ...]:
     """A built part's aspects: stable_aspects of its visual mesh about its mass centre (a
     mesh's own, a built-in model's frame origin), computed once per geometry in a process
-    (the file's check, the part's account and the summary ask for the same part's)."""
+    (the file's loading, its check and the part's account ask for the same part's)."""
     key = geometry_key(part.spec)
     if key not in _BY_GEOMETRY:
         centre = part.mass_centre
         _BY_GEOMETRY[key] = tuple(stable_aspects(part.visual, centre))
     return _BY_GEOMETRY[key]
 
-
-def spec_aspects(spec: PartSpec) -> tuple[Aspect, ...]:
-    """The aspects of the part a spec describes (part_aspects), its part built only when no
-    aspects of its geometry are known yet."""
-    return _BY_GEOMETRY.get(geometry_key(spec)) or part_aspects(build_part(spec))
 
 
 def classify(aspects: Sequence[Aspect], orientations: np.ndarray) -> list[str]:
