@@ -1,8 +1,8 @@
 """The gripper kinds, one type each: the simplified parallel jaws of the paper's figure 8
 (`Jaws`) and a single suction cup on a body (`SuctionCup`: the paper's further work, "other
 kinds of grippers, such as vacuum"). `GripperKind` is their union, told apart by `kind` (the
-experiment file's `gripper.type`) and found by it in `KINDS`; nothing outside this module asks
-which kind a gripper is. Each kind owns:
+experiment file's `gripper.type`) and found by it in `KINDS`; nothing outside this package
+asks which kind a gripper is. Each kind owns:
 - `KEYS`: its keys, one table (`Key`): the field (SI, the validity node's parameter
   `gripper.<field>`, the message's field), the experiment file's key and unit, the limit, what
   it is and where its default comes from;
@@ -14,7 +14,9 @@ which kind a gripper is. Each kind owns:
   each grasp's jaws close on, the round body a grasp may turn about, which grasps it may use);
 - `approach`: the gripper's axis over a part as it lies, before any wrist tilt;
 - `propose`: the grasps `part.grasps: auto` takes;
-- `size`: what "smaller" means when grippers of the kind are compared (a gripper_sweep).
+- `size`: what "smaller" means when grippers of the kind are compared (a gripper_sweep);
+- its lines on a part sheet (`account`, `figures`, `figures_line`, `pick_caption`,
+  `pick_marks`, `proposal_rule`, `proposed_widths`).
 Adding a kind is a module here with its class and the class's entry in `KINDS`
 (docs/extending.md lists the rest).
 
