@@ -246,8 +246,7 @@ def gripper_sweep(exp: Experiment, rows: list[dict], checks: list[dict]) -> dict
         low, high = interval(valid, counts=True)
         variants.append({
             'index': k, 'grasp_set': v.grasp_set, 'grasps': [g.name for g in v.grasps],
-            'gripper_mm': {key.file_key: round(getattr(v.gripper, key.field) / key.factor, 6)
-                           for key in v.gripper.KEYS},
+            'gripper_mm': v.gripper.file_values(),
             'scenes': len(mine), 'fractions': _fractions(mine), 'valid': stats(valid),
             'valid_ci95': [low, high], 'scenes_with_valid': sum(x > 0 for x in valid),
             'meets': low is not None and low >= exp.min_valid})

@@ -162,6 +162,7 @@ def parse(text: str, path: str = '') -> ExperimentFile:
         cell=Cell(pick_time=s['cell'].pick_s, image_time=s['cell'].image_s,
                   regrasp_time=s['cell'].regrasp_s),
         path=os.path.abspath(path) if path else '', text=text, auto_grasps=auto_grasps,
+        given=frozenset(top.model_fields_set),
         part_volume=geometry.volume, aspects=part_aspects(geometry),
         material_account=part_section.material_account(s['materials']))
 

@@ -194,6 +194,7 @@ class ExperimentFile:
     # the aspects the part can rest on (pick_common.parts.aspects), from the geometry the
     # file was checked with: what a drop test classifies by and counts
     aspects: tuple = field(default=(), compare=False, repr=False)
+    given: frozenset[str] = frozenset()     # the file's top keys it sets (the rest: defaults)
 
     def experiment(self, experiment_id: str) -> Experiment:
         return next(e for e in self.experiments if e.id == experiment_id)

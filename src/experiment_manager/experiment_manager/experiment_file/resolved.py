@@ -15,8 +15,6 @@ from dataclasses import fields
 import json
 import os
 
-import yaml
-
 from .kinds import kind_of
 from .loading import load
 from .model import ExperimentFile, MM
@@ -32,11 +30,8 @@ def _mm(values) -> list[float]:
     return [round(v / MM, 6) for v in values]
 
 
-def resolved(file: ExperimentFile, given: set[str] | None = None) -> dict:
-    """The record of `file` as a run uses it; `given`: the file's top keys as written (None:
-    read from its text)."""
-    if given is None:       # which top keys the file's text sets
-        given = set(yaml.safe_load(file.text) or {}) if file.text else set()
+def resolved(file: ExperimentFile) -> dict:
+    """The record of `file` as a run uses it."""
     part, gripper, tray, r = file.part, file.gripper, file.tray, file.requirements
     (cx, cy), (sx, sy) = tray.feeder_zone_center, tray.feeder_zone_size
     return {
@@ -72,14 +67,13 @@ def resolved(file: ExperimentFile, given: set[str] | None = None) -> dict:
                          'max_spilled_parts': r.max_spilled, 'success_rate': r.success_rate},
         'cell': {'pick_s': file.cell.pick_time, 'image_s': file.cell.image_time,
                  'regrasp_s': file.cell.regrasp_time},
-        'defaulted': [k for k in TOP_KEYS if k not in given],
+        'defaulted': [k for k in TOP_KEYS if k not in file.given],
     }
 
 
 def _gripper(gripper) -> dict:
     """A gripper's kind and every key of it, in the file's units."""
-    return {'type': gripper.kind, **{k.file_key: round(getattr(gripper, k.field) / k.factor, 6)
-                                     for k in gripper.KEYS}}
+    return {'type': gripper.kind, **gripper.file_values()}
 
 
 def _grasp(g) -> dict:

@@ -75,6 +75,10 @@ class Kind:
             key.limit.check(f'gripper.{key.field}', getattr(self, key.field))
         return self
 
+    def file_values(self) -> dict[str, float]:
+        """Every key in the experiment file's units, by its file key (6 decimals)."""
+        return {k.file_key: round(getattr(self, k.field) / k.factor, 6) for k in self.KEYS}
+
     def values(self) -> dict[str, float]:
         return {f.name: getattr(self, f.name) for f in fields(self)}
 
