@@ -35,6 +35,7 @@ IMPORT_KEYS = {
     'mcap': None,
     'mcap_ros2': None,
     'coacd': None,
+    'cascadio': None,                       # OpenCASCADE's STEP reader (solids.py)
     'markdown_it': None,
 }
 # ROS 2 Jazzy packages imported under their own names.
