@@ -43,6 +43,7 @@ FACE_SHARE = 0.05
 AXIS_NAMES = ('x', 'y', 'z')
 SNAP = np.radians(3.0)      # a direction this near a frame axis is taken as that axis
 ROUNDING = 1e-5             # jaw openings and grasp points to 0.01 mm, as a person reads them
+MAX_BODIES = 8              # the connected bodies looked at for a round body off the mass centre
 
 
 @dataclass(frozen=True)
@@ -110,45 +111,82 @@ def propose(part: PartGeometry, margin: float = JAW_MARGIN) -> tuple[Proposal, .
     # round bodies: an axis it is round about (the frame's axes where they are, else the
     # principal axes: a round body's two equal moments leave its principal axes across it
     # at any angle), and a direction across it
-    rounds: list[tuple[np.ndarray, np.ndarray]] = []
-    for a in principal[::2]:
+    triangles = surface(part)
+    rounds: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []     # axis, across, point
+    for a in [*principal[::2], *np.eye(3)]:   # a CAD file draws its bodies along its axes
         a = _snap(a)
-        if any(abs(a @ b) > 0.999 for b, _ in rounds):
+        if any(abs(a @ b) > 0.999 for b, _, _ in rounds):
             continue
         square = [s * e for e in np.eye(3) for s in (1.0, -1.0) if abs(e @ a) < 1e-6]
         sides = square or [p for p in principal if abs(p @ a) < 1e-6]
-        if sides and abs(float(round_axis(part, centre, sides[0], a) @ a)) > 0.999:
-            rounds.append((a, _distinct([sides[0]], signed=False)[0]))
-    triangles = surface(part)
+        if not sides:
+            continue
+        point = next((p for p in [centre, *_off_centre(part, triangles, centre, a, sides[0])]
+                      if abs(float(round_axis(part, p, sides[0], a) @ a)) > 0.999), None)
+        if point is not None:
+            rounds.append((a, _distinct([sides[0]], signed=False)[0], point))
     found: list[Proposal] = []
 
-    def add(u: np.ndarray, c: np.ndarray) -> None:
-        t = crossings(triangles, centre, c)
+    def add(u: np.ndarray, c: np.ndarray, at: np.ndarray = centre) -> None:
+        t = crossings(triangles, at, c)
         if len(t) == 0 or t.min() > 0 or t.max() < 0:
-            return                  # the mass centre lies in a hollow along this direction
+            return                  # the grasp point lies in a hollow along this direction
         width = float(t.max() - t.min())
         opening = float(np.round((width + 2 * margin) / ROUNDING) * ROUNDING)
         found.append(Proposal(GraspPose(
             f'up{_name(u)}_close{_name(c)}', tuple(float(v) for v in u),
-            tuple(float(v) for v in c), opening, tuple(float(v) for v in centre)), width))
+            tuple(float(v) for v in c), opening, tuple(float(v) for v in at)), width))
 
-    for a, c in rounds:
-        add(_snap(np.cross(a, c)), c)           # lying on its side, at any roll
+    for a, c, at in rounds:
+        add(_snap(np.cross(a, c)), c, at)       # lying on its side, at any roll
         for u in _distinct([-f for f in faces], signed=True):
             if abs(u @ a) > 0.999:              # standing on a flat end
-                add(u, c)
+                add(u, c, at)
     closings = _distinct([f for f in faces if any(f @ g < -0.999 for g in faces)],
                          signed=False)
     for c in closings:
-        if any(abs(c @ a) < 1e-3 for a, _ in rounds):
+        if any(abs(c @ a) < 1e-3 for a, _, _ in rounds):
             continue                            # across a round body: its grasps are above
         ups = [u for u in _distinct([-f for f in faces], signed=True) if abs(u @ c) <= 1e-3]
-        if any(abs(c @ a) > 0.999 for a, _ in rounds):
+        if any(abs(c @ a) > 0.999 for a, _, _ in rounds):
             ups = ups[:1] or [_snap(np.cross(c, _distinct([np.eye(3)[int(np.argmin(
                 np.abs(c)))]], signed=False)[0]))]   # on its ends, lying: it turns with the roll
         for u in ups:
             add(u, c)
     return tuple(found)
+
+
+def _off_centre(part: PartGeometry, triangles: np.ndarray, centre: np.ndarray,
+                axis: np.ndarray, across: np.ndarray) -> list[np.ndarray]:
+    """Where a round body about `axis` may lie off the mass centre, in the plane through the
+    centre at right angles to `axis`: the middle of each of the part's bodies (the connected
+    pieces of its mesh, the largest first, at most MAX_BODIES) brought into that plane; and,
+    along `across` and the direction at right angles to it, the middle of each stretch
+    between two crossings of the part's surface, centred along the other direction between
+    the crossings nearest it. An axial resistor's body lies above its mass centre, which its
+    leads, bent down to the board, pull below the body's axis. The candidates a check of
+    roundness (`round_axis`) then accepts or not."""
+    out: list[np.ndarray] = []
+
+    def keep(p: np.ndarray) -> None:
+        p = np.round(p / ROUNDING) * ROUNDING
+        if not any(np.allclose(p, q) for q in [centre, *out]):
+            out.append(p)
+
+    bodies = sorted(part.visual.split(only_watertight=False), key=lambda b: -b.area)
+    for body in bodies[:MAX_BODIES]:
+        middle = body.bounds.mean(axis=0)
+        keep(middle + ((centre - middle) @ axis) * axis)
+    for b in (across, np.cross(axis, across)):
+        c = np.cross(axis, b)
+        t = np.unique(np.round(crossings(triangles, centre, b) / ROUNDING) * ROUNDING)
+        for enter, leave in zip(t[:-1], t[1:], strict=True):
+            p = centre + 0.5 * (enter + leave) * b
+            s = crossings(triangles, p, c)
+            below, above = s[s < -ROUNDING], s[s > ROUNDING]
+            if len(below) and len(above):
+                keep(p + 0.5 * (below.max() + above.min()) * c)
+    return out
 
 
 def _distinct(directions: list[np.ndarray], signed: bool) -> list[np.ndarray]:

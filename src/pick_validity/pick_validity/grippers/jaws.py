@@ -177,8 +177,8 @@ class Jaws(Kind):
     @property
     def proposal_rule(self) -> str:
         from ..grasp_proposals import JAW_MARGIN  # builds on this package's records
-        return ('across opposed faces and round bodies at the mass centre, jaws '
-                f'{JAW_MARGIN * MM:g} mm wider than the part each side')
+        return ('across opposed faces at the mass centre and round bodies level with it, '
+                f'jaws {JAW_MARGIN * MM:g} mm wider than the part each side')
 
     def propose(self, part: 'PartGeometry') -> tuple:
         """The jaws' proposals (grasp_proposals.propose); InvalidArgument naming `grasps`
@@ -187,8 +187,8 @@ class Jaws(Kind):
         found = propose(part)
         if not found:
             raise InvalidArgument('grasps', 'auto', 'found no grasp: the part has no opposed '
-                                  'faces and no round body across its mass centre; write its '
-                                  'grasps')
+                                  'faces and no round body (at its mass centre or off it); '
+                                  'write its grasps')
         return found
 
 
