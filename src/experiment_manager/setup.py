@@ -20,6 +20,11 @@ setup(
          sorted(p for p in glob('config/parts/*') if os.path.isfile(p))),
         ('share/' + package_name + '/config/parts/resting_rigid_bodies',
          sorted(glob('config/parts/resting_rigid_bodies/*'))),
+        # a KiCad board and the 3D models it names, with their source and licence
+        ('share/' + package_name + '/config/boards',
+         sorted(p for p in glob('config/boards/*') if os.path.isfile(p))),
+        *[('share/' + package_name + '/' + d, sorted(glob(d + '/*.step')))
+          for d in sorted(glob('config/boards/3dmodels/*.3dshapes'))],
         ('share/' + package_name + '/launch', ['launch/experiment_launch.py']),
         # the Foxglove layout for recordings of a run in the root namespace (README)
         ('share/' + package_name + '/foxglove', ['foxglove/pick_sim_layout.json']),

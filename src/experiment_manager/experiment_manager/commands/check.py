@@ -14,6 +14,7 @@ from pick_common.specs import CENTRE, FIXED, MOVES, RANDOM, Vibration
 
 from .. import experiment_file
 from ..analysis import part_sheet
+from ..experiment_file.board import Board, load_board, table, write_parts
 from ..experiment_file.kinds import kind_of
 from ..experiment_file.model import ExperimentFile
 from ..experiment_file.plan import count_iterations, experiment_iterations
@@ -26,6 +27,14 @@ def check(paths: list[str], output: str | None, iterations: int | None = None,
     `adaptive` as the run's options: the plan printed is the one the run would follow."""
     for given in paths:
         path = os.path.abspath(given)
+        try:
+            board = load_board(path)
+        except InvalidArgument as exc:
+            print(f'run --check: {path}: {exc}', file=sys.stderr)
+            return 2
+        if board is not None:
+            check_board(board, path, output, iterations, adaptive)
+            continue
         try:
             file = experiment_file.load(path)
             if iterations is not None or adaptive:
@@ -51,6 +60,30 @@ def check(paths: list[str], output: str | None, iterations: int | None = None,
                                                        os.path.join(directory, name)))
         print('\n'.join(describe_plan(file)))
     return 0
+
+
+def check_board(board: Board, path: str, output: str | None, iterations: int | None,
+                adaptive: bool) -> None:
+    """A board's check: each part's experiment file written beside the sheets
+    (<output>/<board id>_parts/) and checked as a file of its own; a part whose file does
+    not read is refused with its error, and the rest go on; then the board's table."""
+    directory = os.path.abspath(os.path.expanduser(output or board.output_dir))
+    files = write_parts(board, os.path.join(directory, f'{board.id}_parts'))
+    said = {}
+    for name, part_file in files.items():
+        print(f'--- {name} ({part_file})')
+        try:
+            experiment_file.load(part_file)
+        except InvalidArgument as exc:
+            errors = exc.errors if isinstance(exc, experiment_file.InvalidFile) else [exc]
+            for e in errors:
+                print(f'run --check: {part_file}: {e}', file=sys.stderr)
+            said[name] = f'refused: {errors[0]}'
+            continue
+        check([part_file], os.path.join(directory, name) if output else None, iterations,
+              adaptive)
+        said[name] = 'checked: ' + board.masses[name].split(':')[0]
+    print('\n'.join(table(board, said)))
 
 
 def describe_plan(file: ExperimentFile) -> list[str]:

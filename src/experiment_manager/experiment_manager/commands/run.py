@@ -43,6 +43,7 @@ from .. import experiment_file
 from ..analysis import summary as summary_model
 from ..analysis import wording
 from ..analysis.headlines import headlines
+from ..experiment_file.board import load_board, table, write_parts
 from . import interrupt
 from .claim import claim, NamespaceInUse
 from .supervisor import Graph, report_dead, spin_until, start_graph
@@ -169,7 +170,7 @@ def _goals(args: argparse.Namespace,
     goals = []
     files = args.experiment_files or [os.path.join(args.resume, 'experiment.yaml')
                                       if args.resume else default_file()]
-    for given in files:
+    for given in _board_parts(files, args):
         path = os.path.abspath(given)
         try:
             file = experiment_file.load(path)
@@ -189,6 +190,35 @@ def _goals(args: argparse.Namespace,
                                          output_dir=output), file.part.mesh_path, given,
                       args.adaptive or file.sampling.adaptive))
     return goals
+
+
+def _board_parts(files: list[str], args: argparse.Namespace) -> list[str]:
+    """The files to run: each board file in `files` replaced by its parts' experiment files
+    (written into <output>/<board id>_parts/, whose sheets and runs go beside), the board's
+    table printed with the parts that are not decided and why. A part whose file does not
+    read is listed as refused with its error, and the others run."""
+    out = []
+    for given in files:
+        board = load_board(os.path.abspath(given))
+        if board is None:
+            out.append(given)
+            continue
+        directory = os.path.abspath(os.path.expanduser(args.output or board.output_dir))
+        said = {}
+        for name, path in write_parts(board, os.path.join(directory,
+                                                          f'{board.id}_parts')).items():
+            try:
+                experiment_file.load(path)
+            except InvalidArgument as exc:
+                said[name] = f'refused: {exc}'
+                continue
+            said[name] = 'to run: ' + os.path.relpath(path)
+            out.append(path)
+        print('\n'.join(table(board, said)), file=sys.stderr)
+        if not any(v.startswith('to run') for v in said.values()):
+            raise InvalidArgument(given, board.path, 'has no part that can be decided (the '
+                                  'table above says why of each)')
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -90,6 +90,10 @@ def parse(text: str, path: str = '') -> ExperimentFile:
                               f'{getattr(exc, "problem", None) or exc}') from None
     if not isinstance(data, Mapping):
         raise InvalidArgument('file', short(data), 'must be a mapping of keys')
+    if 'board' in data:
+        raise InvalidArgument('board', short(data['board']), 'names a board, whose parts are '
+                              'each an experiment file of their own: `run` and `run --check` '
+                              'read it part by part (experiment_file.board)')
     base_dir = os.path.dirname(os.path.abspath(path)) if path else os.getcwd()
     errors: list[InvalidArgument] = []
 

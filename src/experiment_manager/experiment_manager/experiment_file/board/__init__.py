@@ -1,0 +1,219 @@
+"""A board as the input: an experiment file with `board:` in place of `part:` becomes one
+experiment file per distinct through-hole part of the KiCad board (`expand`), each an
+ordinary file a user could have written: its part read from the model's STEP file in KiCad's
+frame, its mass from the model's solids (pick_common.parts.solids) unless the board section
+gives it, `grasps: auto` unless given, and its requirement the board's `boards_per_hour`
+times its quantity per board; every other section of the file is the same for every part.
+
+The board section (mm, g as the other sections):
+    board:
+      pcb: FILE.kicad_pcb          # relative to the experiment file
+      models: DIR                   # KiCad's 3D library; default: KiCad's variables
+      boards_per_hour: 30
+      parts:                        # per part, by its name (run --check lists them)
+        R_Axial_DIN0207_L6.3mm_D2.5mm_P10.16mm_Horizontal: {mass_g: 0.25}
+
+Placement from KiCad's frame: a footprint's frame has the board's top surface at z = 0 and
+the leads going into -z, and KiCad draws the model at its offset, rotation and scale
+(kicad.Model.transform). In the model file's frame the part is placed along the footprint's
+-z turned back into the file (`axis`), and its seating plane, the board's top, lies at
+offset_z / scale along that axis (`seat_offset_mm`).
+"""
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+import os
+import re
+from typing import Any
+
+import numpy as np
+from pick_common.errors import InvalidArgument, MeshError
+from pick_common.parts.solids import solid_mass, SolidMass
+from pydantic import BaseModel, ConfigDict
+import yaml
+
+from ..errors import read as read_keys
+from ..model import MAX_FILE_BYTES
+from ..values import Number, Text
+from . import kicad
+from .parts import board_parts, BoardPart, DECIDE, NOT_THROUGH_HOLE, REFUSED
+
+__all__ = ['Board', 'BoardPart', 'DECIDE', 'expand', 'is_board', 'load_board',
+           'NOT_THROUGH_HOLE', 'REFUSED', 'table', 'write_parts']
+
+
+class _Keys(BaseModel):
+    model_config = ConfigDict(extra='forbid', frozen=True, validate_default=True)
+
+
+class PartOverride(_Keys):
+    """What the file says of one of the board's parts, in place of what the model gives."""
+    mass_g: Number(0.0, 10_000.0, low_open=True) | None = None
+    grasps: Any = None
+
+
+class BoardSection(_Keys):
+    pcb: Text()
+    models: Text() | None = None
+    boards_per_hour: Number(0.0, 1e6, low_open=True)
+    parts: dict[str, PartOverride] = {}
+
+
+@dataclass
+class Board:
+    """A board read: its parts (every distinct model, decided or not, and why), and per part
+    to decide its experiment file's text (`files`, by part name) and its mass's account."""
+    path: str
+    id: str
+    boards_per_hour: float
+    parts: list[BoardPart]
+    output_dir: str = 'results'
+    files: dict[str, str] = field(default_factory=dict)
+    masses: dict[str, str] = field(default_factory=dict)
+
+
+def is_board(data: Any) -> bool:
+    """An experiment file's data that names a board."""
+    return isinstance(data, Mapping) and 'board' in data
+
+
+def placement(model: kicad.Model) -> tuple[list[float], float]:
+    """(place axis in the model file's frame, seat offset mm along it) of a model KiCad draws
+    at `model`'s offset, rotation and scale (an even scale: BoardPart refuses others)."""
+    matrix = model.transform()
+    turn = matrix[:3, :3] / model.scale[0]
+    axis = turn.T @ np.array([0.0, 0.0, -1.0])
+    axis = [0.0 if abs(v) < 1e-12 else round(float(v), 12) for v in axis]
+    return axis, round(float(model.offset[2]) / model.scale[0], 9)
+
+
+def _part_section(p: BoardPart, override: PartOverride | None, mass: SolidMass | None
+                  ) -> dict:
+    axis, seat = placement(p.model)
+    mass_g = override.mass_g if override is not None and override.mass_g is not None \
+        else round(mass.mass * 1000.0, 4)
+    grasps = override.grasps if override is not None and override.grasps is not None \
+        else 'auto'
+    return {'model': 'mesh', 'mesh': p.step, 'mass_g': mass_g,
+            'place': {'axis': axis, 'seat_offset_mm': seat}, 'grasps': grasps}
+
+
+def expand(data: Mapping, path: str, environ: Mapping[str, str] | None = None) -> Board:
+    """The board file's `data` (its YAML read) at `path` as a Board. InvalidArgument naming the
+    key (board.pcb, board.parts.<name>, ...) for a board section that cannot be read."""
+    environ = os.environ if environ is None else environ
+    if 'part' in data:
+        raise InvalidArgument('part', '...', 'and board are both given: a board file takes '
+                              'its parts from the board (board.parts.<name> for what to '
+                              'give of one)')
+    requirements = data.get('requirements') or {}
+    if isinstance(requirements, Mapping) and 'parts_per_hour' in requirements:
+        raise InvalidArgument('requirements.parts_per_hour', requirements['parts_per_hour'],
+                              'is set per part from board.boards_per_hour times its quantity '
+                              'per board: leave it out')
+    section, errors = read_keys(BoardSection, data['board'], 'board')
+    if errors:
+        raise errors[0]
+    base = os.path.dirname(os.path.abspath(path)) if path else os.getcwd()
+    pcb = os.path.normpath(os.path.join(base, os.path.expanduser(section.pcb)))
+    models = None
+    if section.models is not None:
+        models = os.path.normpath(os.path.join(base, os.path.expanduser(section.models)))
+        if not os.path.isdir(models):
+            raise InvalidArgument('board.models', models, 'is not a folder')
+    _, footprints = kicad.read(pcb)
+    parts = board_parts(footprints, os.path.dirname(pcb), models, environ, pcb)
+    names = {p.name for p in parts}
+    for name in section.parts:
+        if name not in names:
+            raise InvalidArgument(f'board.parts.{name}', name, 'names no part of the board: '
+                                  f'its parts are {", ".join(sorted(names))}')
+    board = Board(path=pcb, id=str(data.get('id', 'board')),
+                  boards_per_hour=section.boards_per_hour, parts=[],
+                  output_dir=str(data.get('output_dir') or 'results'))
+    rest = {k: v for k, v in data.items() if k != 'board'}
+    for p in parts:
+        if p.status != DECIDE:
+            board.parts.append(p)
+            continue
+        override = section.parts.get(p.name)
+        mass = None
+        if override is None or override.mass_g is None:
+            try:
+                mass = solid_mass(p.step)
+            except MeshError as exc:
+                board.parts.append(_refused(p, f'its model cannot be weighed: {exc.rule}'))
+                continue
+        board.masses[p.name] = (mass.account() if mass is not None else
+                                f'{override.mass_g:g} g, given in board.parts.{p.name}.mass_g')
+        one = {**rest, 'id': _file_id(board.id, p.name, board.files),
+               'part': _part_section(p, override, mass),
+               'requirements': {**requirements,
+                                'parts_per_hour': section.boards_per_hour * p.quantity}}
+        header = (f'# {os.path.basename(pcb)}: {p.name}, {p.quantity} per board '
+                  f'({", ".join(p.references)}), from the board file {path or "given"}\n'
+                  f'# mass: {board.masses[p.name]}\n')
+        board.files[p.name] = header + yaml.safe_dump(one, sort_keys=False)
+        board.parts.append(p)
+    return board
+
+
+def _file_id(board_id: str, name: str, taken: Mapping[str, str]) -> str:
+    """A part's file id: the board's and the part's names in the id's letters (a '.' of a
+    model's name as '_'), at most 64, numbered where two would be the same."""
+    base = re.sub(r'[^A-Za-z0-9_-]', '_', f'{board_id}-{name}')[:64]
+    ids = {yaml.safe_load(text)['id'] for text in taken.values()}
+    out, n = base, 1
+    while out in ids:
+        n += 1
+        out = f'{base[:60]}-{n}'
+    return out
+
+
+def _refused(p: BoardPart, reason: str) -> BoardPart:
+    return BoardPart(**{**p.__dict__, 'status': REFUSED, 'reason': reason})
+
+
+def load_board(path: str) -> Board | None:
+    """The board of the experiment file at `path`, or None when the file names no board.
+    InvalidArgument for a file that cannot be read, or a board that cannot."""
+    try:
+        if os.path.getsize(path) > MAX_FILE_BYTES:
+            return None                         # the experiment file's loader says why
+        with open(path, encoding='utf-8') as f:
+            data = yaml.safe_load(f)
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return None                             # the experiment file's loader says why
+    return expand(data, path) if is_board(data) else None
+
+
+def write_parts(board: Board, directory: str) -> dict[str, str]:
+    """Each part's experiment file written into `directory` (created): its path by part
+    name."""
+    os.makedirs(directory, exist_ok=True)
+    out = {}
+    for name, text in board.files.items():
+        out[name] = os.path.join(directory, f'{yaml.safe_load(text)["id"]}.yaml')
+        with open(out[name], 'w', encoding='utf-8') as f:
+            f.write(text)
+    return out
+
+
+def table(board: Board, said: Mapping[str, str] | None = None) -> list[str]:
+    """The board as lines of a table, a row per distinct part: its name, quantity per board,
+    references, and what became of it (`said`, by part name, over its status and reason)."""
+    said = said or {}
+    rows = [(p.name, str(p.quantity), ' '.join(p.references),
+             said.get(p.name) or (p.status + (f': {p.reason}' if p.reason else '')))
+            for p in board.parts]
+    width = [max(len(r[i]) for r in rows + [('part', 'qty', 'references', '')])
+             for i in range(2)]
+    refs = min(28, max(len(r[2]) for r in rows))
+    lines = [f'board {os.path.basename(board.path)}: {len(board.parts)} distinct part(s), '
+             f'{sum(p.quantity for p in board.parts)} footprint(s); '
+             f'{board.boards_per_hour:g} boards per hour',
+             f'  {"part":{width[0]}}  {"qty":>{width[1]}}  {"references":{refs}}  status']
+    for name, qty, ref, what in rows:
+        ref = ref if len(ref) <= refs else ref[:refs - 3] + '...'
+        lines.append(f'  {name:{width[0]}}  {qty:>{width[1]}}  {ref:{refs}}  {what}')
+    return lines

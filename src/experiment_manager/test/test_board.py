@@ -1,0 +1,197 @@
+"""A KiCad board as the input: KiCad's ecc83 demo board and the 3D models it names
+(config/boards/), read into its distinct parts, each part's experiment file, its mass from the
+model's solids and its grasps; and bad boards, each refused naming the file, the line or key,
+and what is wrong."""
+
+import os
+import shutil
+
+from experiment_manager import experiment_file
+from experiment_manager.experiment_file.board import (
+    expand,
+    kicad,
+    load_board,
+    placement,
+    table,
+)
+from experiment_manager.experiment_file.board.parts import DECIDE, NOT_THROUGH_HOLE, REFUSED
+from experiment_manager.experiment_file.part import geometry
+import numpy as np
+from pick_common.errors import InvalidArgument
+from pick_common.parts.solids import body_density, LEADS, solid_mass
+import pytest
+import yaml
+
+BOARDS = os.path.join(os.path.dirname(__file__), '..', 'config', 'boards')
+PCB = os.path.join(BOARDS, 'ecc83-pp.kicad_pcb')
+MODELS = os.path.join(BOARDS, '3dmodels')
+RESISTOR = 'R_Axial_DIN0207_L6.3mm_D2.5mm_P7.62mm_Horizontal'
+
+
+def _board_file(tmp_path, pcb=PCB, models=MODELS, **board) -> str:
+    data = yaml.safe_load(open(os.path.join(BOARDS, 'ecc83.yaml')))
+    data['board'] = {'pcb': os.path.abspath(pcb), 'models': os.path.abspath(models),
+                     'boards_per_hour': 30, **board}
+    path = tmp_path / 'board.yaml'
+    path.write_text(yaml.safe_dump(data))
+    return str(path)
+
+
+def test_the_demo_board_reads_into_its_distinct_parts_with_their_references():
+    board = load_board(os.path.join(BOARDS, 'ecc83.yaml'))
+    parts = {p.name: p for p in board.parts}
+    assert parts[RESISTOR].references == ('R1', 'R2', 'R3', 'R4')
+    assert parts[RESISTOR].status == DECIDE
+    assert parts['Altech_AK300_1x02_P5.00mm_45-Degree'].quantity == 4
+    assert parts['CP_Radial_D10.0mm_P5.00mm'].references == ('C1',)
+    # the valve's model is the project's own and is not here: refused, with the line
+    assert parts['ecc83'].status == REFUSED
+    assert 'ecc83.wrl does not exist' in parts['ecc83'].reason
+    assert 'board line' in parts['ecc83'].reason
+    # mounting holes are neither through-hole nor SMD in KiCad 6: not decided
+    assert parts['MountingHole_3'].status == NOT_THROUGH_HOLE
+    assert sum(p.quantity for p in board.parts) == 15     # every footprint, in one row or other
+    lines = table(board)
+    assert len(lines) == 2 + len(board.parts)
+    assert any('R1 R2 R3 R4' in line for line in lines)
+
+
+def test_each_part_becomes_an_experiment_file_with_its_requirement_mass_and_grasps(tmp_path):
+    board = expand(yaml.safe_load(open(_board_file(tmp_path))), str(tmp_path / 'board.yaml'))
+    data = yaml.safe_load(board.files[RESISTOR])
+    assert data['requirements']['parts_per_hour'] == 30 * 4     # boards per hour x quantity
+    assert data['part']['place'] == {'axis': [0.0, 0.0, -1.0], 'seat_offset_mm': 0.0}
+    assert data['part']['grasps'] == 'auto'
+    mass = solid_mass(data['part']['mesh'])
+    assert data['part']['mass_g'] == pytest.approx(mass.mass * 1000, abs=1e-4)
+    file = experiment_file.parse(board.files[RESISTOR], str(tmp_path / 'r.yaml'))
+    # the resistor's body is round about x above its mass centre, which its bent leads pull
+    # below the body's axis: the jaws close across the body on its axis, at any roll
+    (grasp,) = file.setup.grasps
+    centre = geometry(file.setup.part).mass_centre
+    assert grasp.closing_axis == (0.0, 1.0, 0.0)
+    point = np.array(grasp.grasp_point) * 1000
+    assert point[2] == pytest.approx(1.25, abs=0.05)           # the body's axis, z 1.25 mm
+    assert centre[2] * 1000 < point[2] - 0.1
+
+
+def test_a_given_mass_and_grasps_replace_the_models(tmp_path):
+    path = _board_file(tmp_path, parts={RESISTOR: {'mass_g': 0.25}})
+    board = load_board(path)
+    assert yaml.safe_load(board.files[RESISTOR])['part']['mass_g'] == 0.25
+    assert 'given in board.parts' in board.masses[RESISTOR]
+    with pytest.raises(InvalidArgument) as err:
+        load_board(_board_file(tmp_path, parts={'R_none': {'mass_g': 0.25}}))
+    assert err.value.field == 'board.parts.R_none' and RESISTOR in err.value.rule
+
+
+def test_the_mass_is_the_leads_and_the_body_by_their_colours_and_densities():
+    step = os.path.join(MODELS, 'Resistor_THT.3dshapes', f'{RESISTOR}.step')
+    mass = solid_mass(step)
+    assert mass.lead_volume > 0 and mass.body_volume > mass.lead_volume
+    assert mass.body == body_density(step) and mass.body.family == 'axial resistor'
+    assert mass.mass == pytest.approx(mass.lead_mass + mass.body_mass)
+    assert mass.lead_mass == pytest.approx(mass.lead_volume * LEADS[1] * 1000)
+    assert 'assumed' in mass.account() and 'CRC' in mass.account()
+
+
+def test_kicad_5_modules_8_properties_hidden_models_and_inch_offsets_are_read(tmp_path):
+    pcb = tmp_path / 'old.kicad_pcb'
+    pcb.write_text("""(kicad_pcb (version 20171130) (host pcbnew 5.1)
+  (module Resistor_THT:R_Axial (layer F.Cu) (at 10 20)
+    (fp_text reference R7 (at 0 0) (layer F.SilkS))
+    (pad 1 thru_hole circle (at 0 0) (size 1.6 1.6) (drill 0.8) (layers *.Cu))
+    (model ${KISYS3DMOD}/Resistor_THT.3dshapes/R_Axial.wrl
+      (at (xyz 0 0 0.1)) (scale (xyz 1 1 1)) (rotate (xyz 0 0 90))))
+  (module Pad:SMD (layer B.Cu) (attr smd)
+    (fp_text reference C3 (at 0 0) (layer F.SilkS)))
+  (footprint "X:Y" (layer "F.Cu") (attr through_hole)
+    (property "Reference" "U5")
+    (model "a.wrl" hide (offset (xyz 0 0 0)))
+    (model "b.step" (hide yes) (offset (xyz 0 0 0)))))
+""")
+    _, fps = kicad.read(str(pcb))
+    r7, c3, u5 = fps
+    assert (r7.reference, r7.kind, r7.side) == ('R7', 'through_hole', 'top')
+    assert r7.models[0].offset == pytest.approx((0.0, 0.0, 2.54))       # 0.1 inch
+    assert (c3.kind, c3.side) == ('smd', 'bottom')
+    assert (u5.reference, u5.models, len(u5.hidden)) == ('U5', (), 2)
+    axis, seat = placement(r7.models[0])
+    assert axis == [0.0, 0.0, -1.0] and seat == pytest.approx(2.54)    # a turn about z keeps z
+
+
+def test_a_model_turned_in_the_board_places_along_the_turned_axis():
+    axis, seat = placement(kicad.Model('m.step', offset=(0, 0, 1.5), rotate=(90, 0, 0)))
+    # KiCad draws it turned -90 degrees about x, which takes the file's +y to -z: the leads
+    # go into the board along the file's +y
+    assert axis == pytest.approx([0.0, 1.0, 0.0]) and seat == pytest.approx(1.5)
+
+
+def test_a_truncated_board_is_refused_with_the_line_left_open(tmp_path):
+    text = open(PCB).read()
+    cut = tmp_path / 'cut.kicad_pcb'
+    cut.write_text(text[:len(text) // 2])
+    with pytest.raises(InvalidArgument) as err:
+        kicad.read(str(cut))
+    assert err.value.field == 'board.pcb' and err.value.value == str(cut)
+    assert 'is not closed by the end of the file' in err.value.rule
+    assert 'truncated' in err.value.rule and err.value.rule.startswith('line ')
+
+
+def test_a_board_with_no_through_hole_part_is_refused(tmp_path):
+    smd = tmp_path / 'smd.kicad_pcb'
+    smd.write_text(open(PCB).read().replace('(attr through_hole)', '(attr smd)'))
+    with pytest.raises(InvalidArgument) as err:
+        load_board(_board_file(tmp_path, pcb=smd))
+    assert err.value.field == 'board.pcb' and 'has no through-hole footprint' in err.value.rule
+
+
+def test_a_model_that_does_not_exist_and_a_wrl_with_no_step_are_refused_and_the_rest_goes_on(
+        tmp_path):
+    models = tmp_path / 'models'
+    shutil.copytree(MODELS, models)
+    os.remove(models / 'Resistor_THT.3dshapes' / f'{RESISTOR}.step')
+    (models / 'Resistor_THT.3dshapes' / f'{RESISTOR}.wrl').write_text('#VRML V2.0 utf8\n')
+    os.remove(models / 'Capacitor_THT.3dshapes' / 'CP_Radial_D10.0mm_P5.00mm.step')
+    board = load_board(_board_file(tmp_path, models=models))
+    parts = {p.name: p for p in board.parts}
+    assert parts[RESISTOR].status == REFUSED
+    assert 'has no STEP file beside it' in parts[RESISTOR].reason
+    assert parts['CP_Radial_D10.0mm_P5.00mm'].status == REFUSED
+    assert 'does not exist' in parts['CP_Radial_D10.0mm_P5.00mm'].reason
+    assert parts['Altech_AK300_1x02_P5.00mm_45-Degree'].status == DECIDE
+    assert set(board.files) == {'Altech_AK300_1x02_P5.00mm_45-Degree',
+                                'C_Disc_D4.7mm_W2.5mm_P5.00mm'}
+
+
+def test_bad_board_keys_are_named(tmp_path):
+    with pytest.raises(InvalidArgument) as err:
+        load_board(_board_file(tmp_path, boards_per_hour=0))
+    assert err.value.field == 'board.boards_per_hour'
+    with pytest.raises(InvalidArgument) as err:
+        load_board(_board_file(tmp_path, models=tmp_path / 'nowhere'))
+    assert err.value.field == 'board.models' and 'is not a folder' in err.value.rule
+    with pytest.raises(InvalidArgument) as err:
+        load_board(_board_file(tmp_path, pcb=tmp_path / 'none.kicad_pcb'))
+    assert err.value.field == 'board.pcb' and 'cannot be read' in err.value.rule
+    data = yaml.safe_load(open(_board_file(tmp_path)))
+    data['requirements']['parts_per_hour'] = 60
+    with pytest.raises(InvalidArgument) as err:
+        expand(data, str(tmp_path / 'b.yaml'))
+    assert err.value.field == 'requirements.parts_per_hour'
+    with pytest.raises(InvalidArgument) as err:       # a board file read as one part's file
+        experiment_file.load(_board_file(tmp_path))
+    assert err.value.field == 'board' and 'part by part' in err.value.rule
+
+
+def test_the_diode_body_lies_off_its_mass_centre_and_gets_a_grasp():
+    from pick_common.parts.geometry import build_part
+    from pick_common.parts.spec import PartSpec
+    from pick_validity.grasp_proposals import propose
+    step = os.path.join(MODELS, 'Diode_THT.3dshapes', 'D_DO-35_SOD27_P7.62mm_Horizontal.step')
+    part = build_part(PartSpec(model='mesh', mesh_path=step, mass=solid_mass(step).mass))
+    (found,) = propose(part)
+    point = np.array(found.grasp.grasp_point) * 1000
+    assert point[2] > part.mass_centre[2] * 1000 + 0.1      # above the mass centre
+    assert found.grasp.closing_axis == (0.0, 1.0, 0.0)
+    assert 1.5 < found.width * 1000 < 2.1                   # across the 2 mm glass body
