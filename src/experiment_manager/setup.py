@@ -12,7 +12,8 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml', 'README.md']),
-        ('share/' + package_name + '/config', ['config/default_experiment.yaml']),
+        ('share/' + package_name + '/config', ['config/default_experiment.yaml',
+                                                'config/board_cell.yaml']),
         # the paper's test case, so that an installed workspace can run it by its share path
         ('share/' + package_name + '/config/test_case', sorted(glob('config/test_case/*.yaml'))),
         # parts from real CAD files, with their source and licence

@@ -8,11 +8,14 @@ import shutil
 
 from experiment_manager import experiment_file
 from experiment_manager.experiment_file.board import (
+    answer,
     expand,
     kicad,
     load_board,
     placement,
+    settle,
     table,
+    write_parts,
 )
 from experiment_manager.experiment_file.board.parts import DECIDE, NOT_THROUGH_HOLE, REFUSED
 from experiment_manager.experiment_file.part import geometry
@@ -195,3 +198,42 @@ def test_the_diode_body_lies_off_its_mass_centre_and_gets_a_grasp():
     assert point[2] > part.mass_centre[2] * 1000 + 0.1      # above the mass centre
     assert found.grasp.closing_axis == (0.0, 1.0, 0.0)
     assert 1.5 < found.width * 1000 < 2.1                   # across the 2 mm glass body
+
+
+def test_a_disc_capacitor_with_no_flat_faces_and_no_round_body_gets_grasps_across_its_axes():
+    from pick_common.parts.geometry import build_part
+    from pick_common.parts.spec import PartSpec
+    from pick_validity.grasp_proposals import propose
+    step = os.path.join(MODELS, 'Capacitor_THT.3dshapes', 'C_Disc_D4.7mm_W2.5mm_P5.00mm.step')
+    part = build_part(PartSpec(model='mesh', mesh_path=step, mass=solid_mass(step).mass))
+    found = propose(part)
+    assert found
+    # across the disc's 2.5 mm thickness (y) and across its 4.7 mm face, at the mass centre
+    widths = sorted({round(p.width * 1000, 1) for p in found})
+    assert widths[0] == pytest.approx(2.3, abs=0.3) and widths[-1] < 5.0
+    assert all(np.allclose(p.grasp.grasp_point, np.round(part.mass_centre, 5)) for p in found)
+
+
+def test_the_built_in_cell_leaves_out_for_a_part_what_cannot_run_and_says_why(tmp_path):
+    cell = yaml.safe_load(open(os.path.join(BOARDS, '..', 'board_cell.yaml')))
+    cell['board'] = {'pcb': os.path.abspath(PCB), 'models': os.path.abspath(MODELS),
+                     'boards_per_hour': 60}
+    path = tmp_path / 'cell.yaml'
+    path.write_text(yaml.safe_dump(cell))
+    board = load_board(str(path))
+    files = write_parts(board, str(tmp_path / 'parts'))
+    # 240 terminal blocks do not fit the 100 x 150 x 18 mm bin: its emptying is left out,
+    # with the station's that names it; the table and the cup still run
+    file, left = settle(files['Altech_AK300_1x02_P5.00mm_45-Degree'])
+    assert '240 parts do not fit' in left['emptying']
+    assert left['emptying_station'] == 'it names emptying'
+    assert {e.id for e in file.experiments} >= {'sweep', 'feeder'}
+    assert 'left out for this part' in open(files['Altech_AK300_1x02_P5.00mm_45-Degree']).read()
+    lines = answer(board, {}, {'Altech_AK300_1x02_P5.00mm_45-Degree': [
+        ('vibrating table', 'FEASIBLE', 'ok'), ('vibrating table, gripper cup', 'UNDECIDED',
+                                                'runs straddle')]},
+        {'Altech_AK300_1x02_P5.00mm_45-Degree': left})
+    row = next(line for line in lines if line.startswith('  Altech'))
+    assert row.split()[-3:] == ['yes', '?', '[1]']          # the best: the first feasible
+    assert any('emptying left out: ' in line for line in lines)
+    assert any('[2] UNDECIDED: runs straddle' in line for line in lines)

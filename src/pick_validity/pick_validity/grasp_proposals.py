@@ -2,11 +2,14 @@
 
 The jaws close across the part at its mass centre, along a direction in which the part has
 two opposed parallel faces (each direction at least FACE_SHARE of the surface), or across a
-round body (a principal axis at right angles to one the part is round about at its mass
-centre, `grasp_fit.round_axis`: a cylinder has no flat faces to close on). Each closing
-direction gets one grasp per way the part can lie with it horizontal: on a face of at least
-FACE_SHARE (the up axis that face's opposite), or on a round body's side. The jaws open to the
-width measured across the mass centre plus JAW_MARGIN on each side.
+round body (a principal axis, or an axis of the file's frame, at right angles to one the part
+is round about, `grasp_fit.round_axis`: a cylinder has no flat faces to close on), at the mass
+centre or, where the body lies off it, on the body's axis level with it (an axial resistor's
+body above the leads bent down to the board). Each closing direction gets one grasp per way
+the part can lie with it horizontal: on a face of at least FACE_SHARE (the up axis that face's
+opposite), or on a round body's side. A part with neither (a ceramic disc capacitor's domed
+faces) gets the jaws across each principal axis at the mass centre, lying on each other. The
+jaws open to the width measured across the grasp point plus JAW_MARGIN on each side.
 
 For a suction cup (`propose_suction`): per way the part can lie (its stable aspects, from
 the hull's faces; a round body's side at four rolls), the cup comes down along the aspect's
@@ -104,7 +107,8 @@ def propose(part: PartGeometry, margin: float = JAW_MARGIN) -> tuple[Proposal, .
     """Grasps at the mass centre across opposed faces, one per way the part can lie with the
     closing direction horizontal; and across each round body, one grasp that the check turns
     with the body's roll (`Validator.free_axes`), lying on its side, plus one per flat end it
-    can stand on; on a round body's two ends, lying, one grasp, which turns the same way."""
+    can stand on; on a round body's two ends, lying, one grasp, which turns the same way.
+    With none of these, across each principal axis, lying on each at right angles to it."""
     centre = part.mass_centre
     centre = np.round(centre / ROUNDING) * ROUNDING
     faces, principal = _directions(part)
@@ -121,8 +125,10 @@ def propose(part: PartGeometry, margin: float = JAW_MARGIN) -> tuple[Proposal, .
         sides = square or [p for p in principal if abs(p @ a) < 1e-6]
         if not sides:
             continue
-        point = next((p for p in [centre, *_off_centre(part, triangles, centre, a, sides[0])]
+        others = _off_centre(part, triangles, centre, a, sides[0])
+        point = next((p for p in [centre, *others]
                       if abs(float(round_axis(part, p, sides[0], a) @ a)) > 0.999), None)
+
         if point is not None:
             rounds.append((a, _distinct([sides[0]], signed=False)[0], point))
     found: list[Proposal] = []
@@ -153,6 +159,11 @@ def propose(part: PartGeometry, margin: float = JAW_MARGIN) -> tuple[Proposal, .
                 np.abs(c)))]], signed=False)[0]))]   # on its ends, lying: it turns with the roll
         for u in ups:
             add(u, c)
+    if not found:           # no opposed faces, no round body: across its principal axes
+        for c in _distinct(principal, signed=False):
+            for u in _distinct(principal, signed=True):
+                if abs(u @ c) <= 1e-3:
+                    add(u, c)
     return tuple(found)
 
 

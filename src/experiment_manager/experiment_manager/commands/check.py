@@ -14,7 +14,7 @@ from pick_common.specs import CENTRE, FIXED, MOVES, RANDOM, Vibration
 
 from .. import experiment_file
 from ..analysis import part_sheet
-from ..experiment_file.board import Board, load_board, table, write_parts
+from ..experiment_file.board import Board, load_board, settle, table, write_parts
 from ..experiment_file.kinds import kind_of
 from ..experiment_file.model import ExperimentFile
 from ..experiment_file.plan import count_iterations, experiment_iterations
@@ -73,7 +73,7 @@ def check_board(board: Board, path: str, output: str | None, iterations: int | N
     for name, part_file in files.items():
         print(f'--- {name} ({part_file})')
         try:
-            experiment_file.load(part_file)
+            _, dropped = settle(part_file)
         except InvalidArgument as exc:
             errors = exc.errors if isinstance(exc, experiment_file.InvalidFile) else [exc]
             for e in errors:
@@ -82,7 +82,8 @@ def check_board(board: Board, path: str, output: str | None, iterations: int | N
             continue
         check([part_file], os.path.join(directory, name) if output else None, iterations,
               adaptive)
-        said[name] = 'checked: ' + board.masses[name].split(':')[0]
+        said[name] = 'checked: ' + board.masses[name].split(':')[0] + ''.join(
+            f'; {g} left out: {why}' for g, why in dropped.items())
     print('\n'.join(table(board, said)))
 
 

@@ -43,8 +43,9 @@ from .. import experiment_file
 from ..analysis import summary as summary_model
 from ..analysis import wording
 from ..analysis.headlines import headlines
-from ..experiment_file.board import load_board, table, write_parts
+from ..analysis.verdicts import verdicts
 from . import interrupt
+from .boards import board_file, BoardRun, cell_file, expand_boards, record
 from .claim import claim, NamespaceInUse
 from .supervisor import Graph, report_dead, spin_until, start_graph
 
@@ -117,6 +118,15 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     where.add_argument('--resume', metavar='RUN_DIR',
                        help='finish the interrupted run in RUN_DIR (with the file it keeps, '
                        'RUN_DIR/experiment.yaml, unless a file is given: it must be the same)')
+    parser.add_argument('--board', metavar='FILE.kicad_pcb',
+                        help='decide every through-hole part of a KiCad board in the built-in '
+                        'cell (config/board_cell.yaml: every option, jaws and a cup); a board '
+                        'file of your own is an experiment file with board: (docs/boards.md)')
+    parser.add_argument('--models', metavar='DIR', help="with --board: KiCad's 3D library "
+                        "folder (default: KiCad's KICAD<n>_3DMODEL_DIR variables)")
+    parser.add_argument('--boards-per-hour', type=float, metavar='N',
+                        help="with --board: the line's boards per hour (default: the built-in "
+                        "cell's)")
     parser.add_argument('--namespace', default='/',
                         help='namespace of the graph (default /): worker k runs in '
                         '<namespace>/worker_<k>')
@@ -140,8 +150,13 @@ def _parse(argv: list[str]) -> argparse.Namespace:
                         "run would run (with --iterations and --adaptive as given); no graph "
                         "is started")
     args = parser.parse_args(argv)
-    if args.check and (args.resume or not args.experiment_files):
+    if args.check and (args.resume or not (args.experiment_files or args.board)):
         parser.error('--check reads the experiment files given: give one or more')
+    if args.board and (args.experiment_files or args.resume):
+        parser.error('--board runs one board in the built-in cell: give no experiment file '
+                     'and no --resume (a board file of your own is an experiment file)')
+    if (args.models or args.boards_per_hour is not None) and not args.board:
+        parser.error('--models and --boards-per-hour go with --board')
     if args.resume and len(args.experiment_files) > 1:
         parser.error('--resume finishes one run: give one experiment file')
     if (args.iterations is not None or args.adaptive) and args.resume:
@@ -170,7 +185,11 @@ def _goals(args: argparse.Namespace,
     goals = []
     files = args.experiment_files or [os.path.join(args.resume, 'experiment.yaml')
                                       if args.resume else default_file()]
-    for given in _board_parts(files, args):
+    if args.board:
+        files = [board_file(args.board, args.models, args.boards_per_hour,
+                            cell_file(get_package_share_directory('experiment_manager')),
+                            os.path.abspath(os.path.expanduser(args.output or 'results')))]
+    for given in expand_boards(files, args, args.boards):
         path = os.path.abspath(given)
         try:
             file = experiment_file.load(path)
@@ -192,40 +211,17 @@ def _goals(args: argparse.Namespace,
     return goals
 
 
-def _board_parts(files: list[str], args: argparse.Namespace) -> list[str]:
-    """The files to run: each board file in `files` replaced by its parts' experiment files
-    (written into <output>/<board id>_parts/, whose sheets and runs go beside), the board's
-    table printed with the parts that are not decided and why. A part whose file does not
-    read is listed as refused with its error, and the others run."""
-    out = []
-    for given in files:
-        board = load_board(os.path.abspath(given))
-        if board is None:
-            out.append(given)
-            continue
-        directory = os.path.abspath(os.path.expanduser(args.output or board.output_dir))
-        said = {}
-        for name, path in write_parts(board, os.path.join(directory,
-                                                          f'{board.id}_parts')).items():
-            try:
-                experiment_file.load(path)
-            except InvalidArgument as exc:
-                said[name] = f'refused: {exc}'
-                continue
-            said[name] = 'to run: ' + os.path.relpath(path)
-            out.append(path)
-        print('\n'.join(table(board, said)), file=sys.stderr)
-        if not any(v.startswith('to run') for v in said.values()):
-            raise InvalidArgument(given, board.path, 'has no part that can be decided (the '
-                                  'table above says why of each)')
-    return out
-
-
 def main(argv: list[str] | None = None) -> int:
     args = _parse(sys.argv[1:] if argv is None else argv)
+    args.boards = []        # the boards run, for their one answer at the end
     if args.check:
         from .check import check  # the sheet's drawing is loaded only to draw it
-        return check(args.experiment_files, args.output, args.iterations, args.adaptive)
+        files = args.experiment_files
+        if args.board:
+            files = [board_file(args.board, args.models, args.boards_per_hour,
+                                cell_file(get_package_share_directory('experiment_manager')),
+                                os.path.abspath(os.path.expanduser(args.output or 'results')))]
+        return check(files, args.output, args.iterations, args.adaptive)
     temporary: list[str] = []
     try:
         return _main(args, temporary)
@@ -261,9 +257,11 @@ def _main(args: argparse.Namespace, temporary: list[str]) -> int:
         client = LockedActionClient(node, RunExperiment, 'run_experiment')
         for goal, _, given, adaptive in goals:
             bar.at_most = adaptive
-            code = _run(node, client, goal, given, graph, bar)
+            code = _run(node, client, goal, given, graph, bar, args.boards)
             if code:
                 return code
+        for board in args.boards:
+            print('\n'.join(board.lines()))
         return 0
     except (FileNotFoundError, NamespaceInUse) as exc:   # before any goal was sent
         print(f'run: {exc}', file=sys.stderr)
@@ -285,7 +283,8 @@ def _main(args: argparse.Namespace, temporary: list[str]) -> int:
             lock.close()        # the namespace is free once our nodes are gone
 
 
-def _run(node: Node, client: LockedActionClient, goal, given: str, graph: Graph, bar) -> int:
+def _run(node: Node, client: LockedActionClient, goal, given: str, graph: Graph, bar,
+         boards: list[BoardRun]) -> int:
     print(f'run: {given}', file=sys.stderr)
     manager = graph.manager
     if not report_dead(node, client.server_is_ready, graph, START_TIMEOUT, bar) \
@@ -325,6 +324,8 @@ def _run(node: Node, client: LockedActionClient, goal, given: str, graph: Graph,
         print(f'report:    {result.report_path}')
     summary = summary_model.validate(summary_model.migrate(json.loads(result.summary_json)))
     print('\n'.join(headlines(summary)))
+    record(boards, given, [(v.kind, v.verdict, v.reasons[0])
+                                          for v in verdicts(summary)])
     # the manager's decisions in one table, each with the stage that stops most parts and
     # its first reason (the report gives them all)
     print('verdicts:\n' + '\n'.join(wording.verdict_table(

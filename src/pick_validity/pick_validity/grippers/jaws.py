@@ -177,8 +177,9 @@ class Jaws(Kind):
     @property
     def proposal_rule(self) -> str:
         from ..grasp_proposals import JAW_MARGIN  # builds on this package's records
-        return ('across opposed faces at the mass centre and round bodies level with it, '
-                f'jaws {JAW_MARGIN * MM:g} mm wider than the part each side')
+        return ('across opposed faces at the mass centre and round bodies level with it (or, '
+                'with neither, across its principal axes), jaws '
+                f'{JAW_MARGIN * MM:g} mm wider than the part each side')
 
     def propose(self, part: 'PartGeometry') -> tuple:
         """The jaws' proposals (grasp_proposals.propose); InvalidArgument naming `grasps`

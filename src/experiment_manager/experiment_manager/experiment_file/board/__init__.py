@@ -217,3 +217,104 @@ def table(board: Board, said: Mapping[str, str] | None = None) -> list[str]:
         ref = ref if len(ref) <= refs else ref[:refs - 3] + '...'
         lines.append(f'  {name:{width[0]}}  {qty:>{width[1]}}  {ref:{refs}}  {what}')
     return lines
+
+
+# An experiment's keys that name another experiment or a gripper.
+REFERENCES = ('scenes_of', 'optimal_range', 'bin', 'gripper', 'of')
+
+
+def settle(path: str) -> tuple[Any, dict[str, str]]:
+    """A part's experiment file at `path` read as a run reads it, with what cannot run for
+    this part left out: a named gripper that cannot pick it (a cup too large for a resistor's
+    body) and its experiments, and an experiment the part cannot run (240 terminal blocks do
+    not fit the bin). Those options are not feasible for this part; the others still run.
+    Returns (the ExperimentFile, per gripper or experiment left out the error that left it
+    out); the file is rewritten without them. InvalidArgument (or InvalidFile) for an error of
+    the part itself, or when no experiment is left."""
+    from .. import loading  # the loader, which refers back to this package by name only
+    dropped: dict[str, str] = {}
+    while True:
+        try:
+            return loading.load(path), dropped
+        except InvalidArgument as exc:
+            errors = exc.errors if isinstance(exc, loading.InvalidFile) else [exc]
+            found = [(m, e) for e in errors
+                     if (m := re.match(r'grippers\.(\w+)|experiments\[(\d+)\]', e.field))]
+            if len(found) < len(errors):
+                raise
+        with open(path, encoding='utf-8') as f:
+            head = ''.join(line for line in f if line.startswith('#'))
+        with open(path, encoding='utf-8') as f:
+            data = yaml.safe_load(f)
+        experiments = data['experiments']
+        left: set[str] = set()
+        for m, e in found:
+            if m.group(1):
+                dropped.setdefault(f'gripper {m.group(1)}', str(e))
+                data.get('grippers', {}).pop(m.group(1), None)
+                left |= {x['id'] for x in experiments if x.get('gripper') == m.group(1)}
+        for m, e in found:
+            if m.group(2) and int(m.group(2)) < len(experiments):
+                exp = experiments[int(m.group(2))]
+                # an error for naming what is left out is not news: the experiment's own is
+                if e.field.rsplit('.', 1)[-1] not in REFERENCES and exp['id'] not in left:
+                    dropped.setdefault(exp['id'], str(e))
+                elif exp['id'] not in left:
+                    dropped.setdefault(exp['id'], 'it names ' + ', '.join(
+                        str(exp[k]) for k in REFERENCES if isinstance(exp.get(k), str)
+                        and exp[k] in left | {g.split()[-1] for g in dropped}))
+                left.add(exp['id'])
+        kept = [x for x in experiments if x['id'] not in left]
+        ids = {x['id'] for x in kept}
+        for x in kept:              # scenes of an experiment left out: its own seeds
+            if x.get('scenes_of') is not None and x['scenes_of'] not in ids:
+                del x['scenes_of']
+        if not kept or len(kept) == len(experiments):
+            raise InvalidArgument('experiments', [x['id'] for x in experiments],
+                                  'cannot run for this part: ' + '; '.join(dropped.values()))
+        data['experiments'] = kept
+        if not data.get('grippers'):
+            data.pop('grippers', None)
+        with open(path, 'w', encoding='utf-8') as f:
+            f.write(head + f'# left out for this part: {", ".join(sorted(left))}\n'
+                    + yaml.safe_dump(data, sort_keys=False))
+
+
+SHORT = {'FEASIBLE': 'yes', 'NOT FEASIBLE': 'no', 'UNDECIDED': '?', 'not analysed': '-'}
+
+
+def answer(board: Board, said: Mapping[str, str],
+           decided: Mapping[str, list[tuple[str, str, str]]],
+           left: Mapping[str, Mapping[str, str]] | None = None) -> list[str]:
+    """The board's one answer: a row per distinct part (its quantity, references, each
+    option's verdict, the best option), then per part what stops each option that is not
+    feasible. `decided`: per part that ran, its options in the run's order as (option,
+    verdict, the first reason); `said`: what became of the others; `left`: per part, the
+    grippers and experiments left out for it (`settle`) and why. The best option is the
+    first feasible one in the run's order, which lists the cheapest cell first: a static bin
+    before a bin with a regrasp station before a vibrating table, the file's gripper before
+    its named ones."""
+    options = list(dict.fromkeys(o for rows in decided.values() for o, _, _ in rows))
+    head = ['part', 'qty', 'references', *[f'[{i + 1}]' for i in range(len(options))], 'best']
+    rows, notes = [], []
+    for p in board.parts:
+        got = {o: (v, why) for o, v, why in decided.get(p.name, [])}
+        cells = [SHORT.get(got[o][0], got[o][0]) if o in got else '' for o in options]
+        best = next((f'[{i + 1}]' for i, o in enumerate(options)
+                     if got.get(o, ('',))[0] == 'FEASIBLE'), '')
+        if p.name not in decided:
+            best = said.get(p.name) or (p.status + (f': {p.reason}' if p.reason else ''))
+        refs = ' '.join(p.references)
+        rows.append([p.name, str(p.quantity), refs if len(refs) <= 28 else refs[:25] + '...',
+                     *cells, best or 'none'])
+        notes += [f'  {p.name} [{options.index(o) + 1}] {v}: {why}'
+                  for o, (v, why) in got.items() if v != 'FEASIBLE']
+        notes += [f'  {p.name}: {what} left out: {why}'
+                  for what, why in (left or {}).get(p.name, {}).items()]
+    width = [max(len(r[i]) for r in [head, *rows]) for i in range(len(head) - 1)]
+    lines = [f'board {os.path.basename(board.path)}: {board.boards_per_hour:g} boards per '
+             'hour; verdicts yes, no, ? (undecided), - (not analysed)']
+    lines += ['  ' + '  '.join(c.ljust(w) for c, w in zip(r[:-1], width, strict=True))
+              + '  ' + r[-1] for r in [head, *rows]]
+    lines += [f'  [{i + 1}] {o}' for i, o in enumerate(options)]
+    return lines + (['what stops the options not feasible:'] + notes if notes else [])
