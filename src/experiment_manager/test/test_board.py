@@ -237,3 +237,62 @@ def test_the_built_in_cell_leaves_out_for_a_part_what_cannot_run_and_says_why(tm
     assert row.split()[-3:] == ['yes', '?', '[1]']          # the best: the first feasible
     assert any('emptying left out: ' in line for line in lines)
     assert any('[2] UNDECIDED: runs straddle' in line for line in lines)
+
+
+# Datasheet weights of three families, each of a part as supplied, with its leads' count,
+# least length and diameter (mm) from the same datasheet: KiCad's model has its leads formed
+# and cut to the board, so the comparison is the model's body and the datasheet's leads, of
+# the leads' density (pick_common/parts/solids.py).
+DATASHEETS = [
+    # Comchip 1N4148-G (QW-B0050): glass DO-35, "Weight: 0.13gram", leads 26.00 mm min,
+    # 0.52 mm typ (https://dtsheet.com/doc/559880/comchip-1n4148-g)
+    ('Diode_THT.3dshapes/D_DO-35_SOD27_P7.62mm_Horizontal.step', 0.13, 2, 26.0, 0.52),
+    # Diodes Inc. 1N4001-1N4007 (DS28002): DO-41 "0.30 grams (approx)", leads 25.40 mm min,
+    # 0.71 to 0.864 mm (https://dtsheet.com/doc/260565/diodes-1n4006)
+    ('Diode_THT.3dshapes/D_DO-41_SOD81_P12.70mm_Horizontal.step', 0.30, 2, 25.4, 0.787),
+    # Vishay 2N3904 (document 88113): TO-92 "Weight: approx. 0.18g", leads 12.5 mm min,
+    # 0.55 mm max (https://dtsheet.com/doc/433575/etc-2n3904-e6)
+    ('Package_TO_SOT_THT.3dshapes/TO-92.step', 0.18, 3, 12.5, 0.55),
+]
+
+
+@pytest.mark.parametrize('model, grams, leads, length, diameter', DATASHEETS)
+def test_the_mass_from_the_model_is_within_30_percent_of_the_datasheet(model, grams, leads,
+                                                                       length, diameter):
+    mass = solid_mass(os.path.join(MODELS, model))
+    supplied = mass.body_mass + leads * length * np.pi * (diameter / 2) ** 2 * 1e-9 \
+        * LEADS[1] * 1000
+    assert supplied * 1000 == pytest.approx(grams, rel=0.30)
+
+
+def test_a_board_run_again_keeps_the_parts_done_with_the_same_file_and_writes_its_page(
+        tmp_path):
+    import argparse
+    import json
+
+    from experiment_manager.commands.boards import decided, expand_boards
+    path = _board_file(tmp_path)
+    args = argparse.Namespace(output=str(tmp_path / 'out'))
+    boards = []
+    first = expand_boards([path], args, boards)
+    assert len(first) == 4                     # the four parts with a STEP model
+    part = next(p for p in first if RESISTOR.replace('.', '_') in p)
+    run_dir = tmp_path / 'out' / 'resistor_run'
+    run_dir.mkdir()
+    (run_dir / 'summary.json').write_text('{}')   # a finished run of the part, as run leaves it
+    decided(boards, part, [('vibrating table', 'FEASIBLE', 'all emptied')], str(run_dir))
+    page = (tmp_path / 'out' / 'ecc83_board.md').read_text()
+    assert '| R_Axial_DIN0207_L6.3mm_D2.5mm_P7.62mm_Horizontal | 4 | R1 R2 R3 R4 | ' \
+           '**FEASIBLE** | vibrating table |' in page
+    assert '](resistor_run/part.png)' in page and '## Not decided' in page
+    assert (tmp_path / 'out' / 'ecc83_board.html').is_file()
+    # the same board again: the resistor is kept, the other three run
+    again = []
+    second = expand_boards([path], args, again)
+    assert part not in second and len(second) == 3
+    assert again[0].decided[RESISTOR] == [('vibrating table', 'FEASIBLE', 'all emptied')]
+    # a changed file (another mass) runs the part again
+    changed = _board_file(tmp_path, parts={RESISTOR: {'mass_g': 0.2}})
+    assert any(RESISTOR.replace('.', '_') in p for p in expand_boards([changed], args, []))
+    data = json.loads((tmp_path / 'out' / 'ecc83_board.json').read_text())
+    assert {p['status'] for p in data['parts']} >= {'refused', 'not through-hole'}

@@ -4,13 +4,24 @@ board's one answer (experiment_file.board.answer)."""
 
 import argparse
 from dataclasses import dataclass, field
+import hashlib
+import json
 import os
 import sys
 
 from pick_common.errors import InvalidArgument
 import yaml
 
-from ..experiment_file.board import answer, Board, load_board, settle, table, write_parts
+from ..analysis.report.board import write_board_page
+from ..experiment_file.board import (
+    answer,
+    Board,
+    load_board,
+    record,
+    settle,
+    table,
+    write_parts,
+)
 
 
 @dataclass
@@ -22,9 +33,22 @@ class BoardRun:
     by_path: dict[str, str]
     decided: dict[str, list[tuple[str, str, str]]] = field(default_factory=dict)
     left: dict[str, dict[str, str]] = field(default_factory=dict)
+    runs: dict[str, str] = field(default_factory=dict)
+    shas: dict[str, str] = field(default_factory=dict)
+    directory: str = ''
 
     def lines(self) -> list[str]:
         return answer(self.board, self.said, self.decided, self.left)
+
+    def write(self) -> str:
+        """The board's answer as data, <output>/<board id>_board.json, and as a page,
+        <board id>_board.html (analysis/report/board.py); the data's path."""
+        data = record(self.board, self.said, self.decided, self.left, self.runs, self.shas)
+        path = os.path.join(self.directory, f'{self.board.id}_board.json')
+        with open(path, 'w', encoding='utf-8') as f:
+            json.dump(data, f, indent=1)
+        write_board_page(data, self.directory, f'{self.board.id}_board')
+        return path
 
 
 def cell_file(share: str) -> str:
@@ -67,7 +91,8 @@ def expand_boards(files: list[str], args: argparse.Namespace,
             out.append(given)
             continue
         directory = os.path.abspath(os.path.expanduser(args.output or board.output_dir))
-        run = BoardRun(board, {}, {})
+        run = BoardRun(board, {}, {}, directory=directory)
+        done = _done_before(os.path.join(directory, f'{board.id}_board.json'))
         for name, path in write_parts(board, os.path.join(directory,
                                                           f'{board.id}_parts')).items():
             try:
@@ -75,21 +100,48 @@ def expand_boards(files: list[str], args: argparse.Namespace,
             except InvalidArgument as exc:
                 run.said[name] = f'refused: {exc}'
                 continue
+            with open(path, 'rb') as f:
+                run.shas[name] = hashlib.sha256(f.read()).hexdigest()
+            run.left[name] = dropped
+            before = done.get(name)
+            if before is not None and before['file_sha256'] == run.shas[name]:
+                run.decided[name] = [(o['option'], o['verdict'], o['reason'])
+                                     for o in before['options']]
+                run.runs[name] = before['run']
+                run.said[name] = f'done before: {before["run"]}'
+                continue
             run.said[name] = 'to run' + ''.join(f'; {g} left out: {why}'
                                                  for g, why in dropped.items())
             run.by_path[path] = name
-            run.left[name] = dropped
             out.append(path)
         print('\n'.join(table(board, run.said)), file=sys.stderr)
-        if not run.by_path:
+        run.write()
+        if not run.by_path and not run.decided:
             raise InvalidArgument(given, board.path, 'has no part that can be decided (the '
                                   'table above says why of each)')
         boards.append(run)
     return out
 
 
-def record(boards: list[BoardRun], path: str, options: list[tuple[str, str, str]]) -> None:
-    """A part's options as its run decided them, for its board's answer."""
+def _done_before(path: str) -> dict[str, dict]:
+    """The parts an earlier run of the board decided (its <id>_board.json at `path`), by
+    name, each whose run directory still holds its summary.json; {} when there is none."""
+    try:
+        with open(path, encoding='utf-8') as f:
+            parts = json.load(f)['parts']
+    except (OSError, ValueError, KeyError, TypeError):
+        return {}
+    return {p['name']: p for p in parts if isinstance(p, dict) and p.get('status') == 'decided'
+            and p.get('file_sha256') and p.get('run')
+            and os.path.isfile(os.path.join(p['run'], 'summary.json'))}
+
+
+def decided(boards: list[BoardRun], path: str, options: list[tuple[str, str, str]],
+            results: str) -> None:
+    """A part's options as its run (in `results`) decided them, for its board's answer,
+    which is written again after each part: an interrupted board keeps the parts done."""
     for run in boards:
         if path in run.by_path:
             run.decided[run.by_path[path]] = options
+            run.runs[run.by_path[path]] = results
+            run.write()

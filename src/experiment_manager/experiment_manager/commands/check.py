@@ -6,6 +6,7 @@ when a feeder runs), and draw the part sheet
 --output DIR, DIR/check.json holds the part's account and each grasp's figures and verdicts
 (part_sheet.write_check; DIR/<id>_check.json per file when there are several)."""
 
+import json
 import os
 import sys
 
@@ -14,7 +15,7 @@ from pick_common.specs import CENTRE, FIXED, MOVES, RANDOM, Vibration
 
 from .. import experiment_file
 from ..analysis import part_sheet
-from ..experiment_file.board import Board, load_board, settle, table, write_parts
+from ..experiment_file.board import Board, load_board, record, settle, table, write_parts
 from ..experiment_file.kinds import kind_of
 from ..experiment_file.model import ExperimentFile
 from ..experiment_file.plan import count_iterations, experiment_iterations
@@ -69,7 +70,7 @@ def check_board(board: Board, path: str, output: str | None, iterations: int | N
     not read is refused with its error, and the rest go on; then the board's table."""
     directory = os.path.abspath(os.path.expanduser(output or board.output_dir))
     files = write_parts(board, os.path.join(directory, f'{board.id}_parts'))
-    said = {}
+    said, left = {}, {}
     for name, part_file in files.items():
         print(f'--- {name} ({part_file})')
         try:
@@ -82,9 +83,14 @@ def check_board(board: Board, path: str, output: str | None, iterations: int | N
             continue
         check([part_file], os.path.join(directory, name) if output else None, iterations,
               adaptive)
+        left[name] = dropped
         said[name] = 'checked: ' + board.masses[name].split(':')[0] + ''.join(
             f'; {g} left out: {why}' for g, why in dropped.items())
     print('\n'.join(table(board, said)))
+    path = os.path.join(directory, f'{board.id}_board.json')
+    with open(path, 'w', encoding='utf-8') as f:
+        json.dump(record(board, said, {}, left), f, indent=1)
+    print(f'board: {path}')
 
 
 def describe_plan(file: ExperimentFile) -> list[str]:

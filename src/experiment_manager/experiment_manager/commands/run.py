@@ -45,7 +45,7 @@ from ..analysis import wording
 from ..analysis.headlines import headlines
 from ..analysis.verdicts import verdicts
 from . import interrupt
-from .boards import board_file, BoardRun, cell_file, expand_boards, record
+from .boards import board_file, BoardRun, cell_file, decided, expand_boards
 from .claim import claim, NamespaceInUse
 from .supervisor import Graph, report_dead, spin_until, start_graph
 
@@ -236,6 +236,8 @@ def _main(args: argparse.Namespace, temporary: list[str]) -> int:
     except InvalidArgument as exc:
         print(f'run: {exc}', file=sys.stderr)
         return 2
+    if not goals:           # a board whose every part was done before: its answer again
+        return _board_answers(args.boards)
     log_dir = args.logs or tempfile.mkdtemp(prefix='pick_run_logs_')
     os.makedirs(log_dir, exist_ok=True)
     print(f'run: {len(goals)} experiment file(s); node logs in {log_dir}', file=sys.stderr)
@@ -260,9 +262,7 @@ def _main(args: argparse.Namespace, temporary: list[str]) -> int:
             code = _run(node, client, goal, given, graph, bar, args.boards)
             if code:
                 return code
-        for board in args.boards:
-            print('\n'.join(board.lines()))
-        return 0
+        return _board_answers(args.boards)
     except (FileNotFoundError, NamespaceInUse) as exc:   # before any goal was sent
         print(f'run: {exc}', file=sys.stderr)
         return 2
@@ -281,6 +281,14 @@ def _main(args: argparse.Namespace, temporary: list[str]) -> int:
             p.stop()                              # closes its files
         if lock is not None:
             lock.close()        # the namespace is free once our nodes are gone
+
+
+def _board_answers(boards: list[BoardRun]) -> int:
+    """Each board's one answer, printed and written; 0."""
+    for board in boards:
+        print('\n'.join(board.lines()))
+        print(f'board:     {board.write()}')
+    return 0
 
 
 def _run(node: Node, client: LockedActionClient, goal, given: str, graph: Graph, bar,
@@ -324,8 +332,8 @@ def _run(node: Node, client: LockedActionClient, goal, given: str, graph: Graph,
         print(f'report:    {result.report_path}')
     summary = summary_model.validate(summary_model.migrate(json.loads(result.summary_json)))
     print('\n'.join(headlines(summary)))
-    record(boards, given, [(v.kind, v.verdict, v.reasons[0])
-                                          for v in verdicts(summary)])
+    decided(boards, given, [(v.kind, v.verdict, v.reasons[0]) for v in verdicts(summary)],
+            result.results_path)
     # the manager's decisions in one table, each with the stage that stops most parts and
     # its first reason (the report gives them all)
     print('verdicts:\n' + '\n'.join(wording.verdict_table(

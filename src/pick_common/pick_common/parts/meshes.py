@@ -46,7 +46,7 @@ def _read(path: str) -> trimesh.Geometry:
     if not head.lstrip().startswith(b'ISO-10303-21'):
         raise MeshError('part.mesh_path', path, 'is not a STEP file: it does not begin with '
                         f'ISO-10303-21; (it begins {head[:20]!r})')
-    loaded, failed, said = _quietly(lambda: trimesh.load(path, force='mesh', process=False))
+    loaded, failed, said = quietly(lambda: trimesh.load(path, force='mesh', process=False))
     if failed is None:
         return loaded
     plain = re.sub(r'\x1b\[[0-9;]*m', '', said)          # the terminal's colours
@@ -58,7 +58,7 @@ def _read(path: str) -> trimesh.Geometry:
                     + '; is it whole (a truncated or partly written file)?')
 
 
-def _quietly(read: Callable[[], Any]) -> tuple[Any, Exception | None, str]:
+def quietly(read: Callable[[], Any]) -> tuple[Any, Exception | None, str]:
     """read() with the whole process's standard output and error (C libraries' included) kept
     in a temporary file: (its result or None, the exception it raised or None, what was
     written)."""

@@ -26,6 +26,7 @@ import numpy as np
 import trimesh
 
 from ..errors import MeshError
+from .meshes import quietly
 
 G_CM3 = 1000.0          # kg/m^3 per g/cm^3
 LEAD_COLOURS = ((165, 163, 146), (182, 131, 54))
@@ -117,21 +118,24 @@ def solid_mass(path: str) -> SolidMass:
 
     fd, glb = tempfile.mkstemp(suffix='.glb')
     os.close(fd)
-    try:
-        code = cascadio.step_to_glb(path, glb, merge_primitives=True, include_materials=True)
-        scene = trimesh.load(glb, force='scene') if code == 0 else None
-    except Exception as exc:    # OpenCASCADE's and trimesh's many errors on a bad file
-        raise MeshError('part.mesh_path', path, f'could not be read for its solids: {exc}'
-                        ) from None
+    try:    # OpenCASCADE prints its complaints on the process's streams: kept off them
+        code, failed, _ = quietly(lambda: cascadio.step_to_glb(
+            path, glb, merge_primitives=True, include_materials=True))
+        scene = trimesh.load(glb, force='scene') if failed is None and code == 0 else None
+    except Exception as exc:    # trimesh's many errors on a bad file
+        failed = exc
     finally:
         os.remove(glb)
+    if failed is not None:
+        raise MeshError('part.mesh_path', path, f'could not be read for its solids: {failed}')
     if scene is None or not scene.geometry:
         raise MeshError('part.mesh_path', path, 'holds no solids to weigh')
     to_metres = {'meters': 1.0, 'm': 1.0, 'millimeters': 1e-3, 'mm': 1e-3}.get(
         scene.units or 'meters', 1.0)
     lead = body = 0.0
     for mesh in scene.dump():           # each geometry placed by the scene's transforms
-        volume = abs(float(mesh.volume)) * to_metres ** 3
+        with np.errstate(invalid='ignore', divide='ignore'):    # a sliver's centre: 0 / 0
+            volume = abs(float(mesh.volume)) * to_metres ** 3
         colour = getattr(getattr(mesh.visual, 'material', None), 'baseColorFactor', None)
         if colour is not None and _is_lead(np.asarray(colour)):
             lead += volume
