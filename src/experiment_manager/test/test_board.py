@@ -296,3 +296,19 @@ def test_a_board_run_again_keeps_the_parts_done_with_the_same_file_and_writes_it
     assert any(RESISTOR.replace('.', '_') in p for p in expand_boards([changed], args, []))
     data = json.loads((tmp_path / 'out' / 'ecc83_board.json').read_text())
     assert {p['status'] for p in data['parts']} >= {'refused', 'not through-hole'}
+
+
+def test_a_part_with_no_grasp_still_gets_its_account_and_its_sheet(tmp_path, capsys):
+    from experiment_manager.commands.check import _no_grasp
+    from experiment_manager.experiment_file.part import NoGrasp
+    from pick_common.parts.geometry import build_part
+    from pick_common.parts.spec import PartSpec
+    step = os.path.join(MODELS, 'Package_TO_SOT_THT.3dshapes', 'TO-92.step')
+    part = build_part(PartSpec(model='mesh', mesh_path=step, mass=solid_mass(step).mass))
+    error = NoGrasp('part.grasps', 'auto', 'found no grasp: ...', part)
+    _no_grasp([InvalidArgument('gripper.jaw_depth_mm', 0, 'is 0'), error],
+              str(tmp_path / 'to92.yaml'), None)
+    said = capsys.readouterr().out
+    assert 'no grasp found; the part as the run would read it' in said
+    assert 'mass centre at' in said and 'collision:' in said and 'aspects it can rest on' in said
+    assert (tmp_path / 'to92_part.png').stat().st_size > 10_000

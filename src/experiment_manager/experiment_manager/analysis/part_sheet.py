@@ -53,7 +53,47 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
     """What the run will use of the file's part and grasps (as `checks`, the file's
     `validator`, holds them), one fact a line."""
     part = checks.geometry.part
+    lines = part_lines(part)
     spec = file.part
+    account = {pair: (dict(bases), said) for pair, bases, said in file.material_account}
+    for pair, where in (('part_on_surface', "on the container's floor and walls"),
+                        ('part_on_part', 'against another part')):
+        c = getattr(spec, pair)
+        bases, said = account.get(pair, ({}, 'the file'))
+        figures = ', '.join(
+            f'{label} {getattr(c, field) * scale:g}{unit} ({bases.get(field, "not said")})'
+            for label, field, scale, unit in (
+                ('friction', 'lateral_friction', 1, ''),
+                ('rolling arm', 'rolling_friction', MM, ' mm'),
+                ('spinning arm', 'spinning_friction', MM, ' mm'),
+                ('restitution', 'restitution', 1, '')))
+        lines.append(f'  contact {where} (materials.{pair}, as the physics applies it): '
+                     f'{figures}; from {said}')
+    lines += aspect_lines(part)
+    lines += grasp_lines(file, checks)
+    if file.auto_grasps:
+        gripper = checks.geometry.gripper
+        lines.append('  the grasps are part.grasps: auto, proposed from the geometry '
+                     f'({gripper.proposal_rule}); to edit them, paste these under part: in '
+                     'place of grasps: auto')
+        used = tuple(Proposal(g, width) for g, width in zip(
+            file.grasps, gripper.proposed_widths(checks.geometry), strict=True))
+        lines += ['  ' + line for line in as_yaml(used)]
+    return lines
+
+
+def aspect_lines(part) -> list[str]:
+    """The aspects a part (PartGeometry) can rest on, a line each."""
+    return ["  aspects it can rest on (a drop test's `measured` names them), each with the "
+            "outward normal of its face in the file's frame and its quasi-static share:"] + [
+        f'    {a.name}: ({", ".join(f"{v:.2f}" for v in a.normal)}), '
+        f'{100 * a.quasi_static:.1f} %' for a in part_aspects(part)]
+
+
+def part_lines(part) -> list[str]:
+    """The part (a PartGeometry) as the run reads it: its file, size, mass, mass centre
+    and collision pieces, one fact a line."""
+    spec = part.spec
     lo, hi = part.visual.bounds * MM
     lines = []
     if spec.model == 'mesh':
@@ -87,33 +127,6 @@ def describe(file: ExperimentFile, checks: Validator) -> list[str]:
                         ' (its edges rounded by the margin)'))
     else:
         lines.append(f'  collision: {len(part.primitives)} piece(s) (boxes and cylinders)')
-    account = {pair: (dict(bases), said) for pair, bases, said in file.material_account}
-    for pair, where in (('part_on_surface', "on the container's floor and walls"),
-                        ('part_on_part', 'against another part')):
-        c = getattr(spec, pair)
-        bases, said = account.get(pair, ({}, 'the file'))
-        figures = ', '.join(
-            f'{label} {getattr(c, field) * scale:g}{unit} ({bases.get(field, "not said")})'
-            for label, field, scale, unit in (
-                ('friction', 'lateral_friction', 1, ''),
-                ('rolling arm', 'rolling_friction', MM, ' mm'),
-                ('spinning arm', 'spinning_friction', MM, ' mm'),
-                ('restitution', 'restitution', 1, '')))
-        lines.append(f'  contact {where} (materials.{pair}, as the physics applies it): '
-                     f'{figures}; from {said}')
-    lines.append("  aspects it can rest on (a drop test's `measured` names them), each with the "
-                 "outward normal of its face in the file's frame and its quasi-static share:")
-    lines += [f'    {a.name}: ({", ".join(f"{v:.2f}" for v in a.normal)}), '
-              f'{100 * a.quasi_static:.1f} %' for a in part_aspects(part)]
-    lines += grasp_lines(file, checks)
-    if file.auto_grasps:
-        gripper = checks.geometry.gripper
-        lines.append('  the grasps are part.grasps: auto, proposed from the geometry '
-                     f'({gripper.proposal_rule}); to edit them, paste these under part: in '
-                     'place of grasps: auto')
-        used = tuple(Proposal(g, width) for g, width in zip(
-            file.grasps, gripper.proposed_widths(checks.geometry), strict=True))
-        lines += ['  ' + line for line in as_yaml(used)]
     return lines
 
 
@@ -256,19 +269,7 @@ def write(checks: Validator, path: str) -> str:
     rows = 1 + len(grasps)
     fig = plt.figure(figsize=(8.0, 3.4 * rows))
     visual = part.visual
-    # the part as drawn in its file, and its collision pieces
-    ax = fig.add_subplot(rows, 2, 1, projection='3d')
-    _draw(ax, visual, np.eye(3), '#999999', 0.6)
-    ax.scatter(*np.zeros(3), color='k', s=12)
-    if part.mass_frame is not None:
-        ax.scatter(*(part.mass_frame[0] * MM), color='r', s=18)
-    _frame(ax, visual.vertices * MM, 'as drawn in its file\n(black: origin, red: mass centre)')
-    ax = fig.add_subplot(rows, 2, 2, projection='3d')
-    for i, shape in enumerate(part_shapes(part)):
-        _draw(ax, _shape_mesh(shape, shape.rotation, shape.center), np.eye(3),
-              PIECE_COLOURS[i % len(PIECE_COLOURS)], 0.55)
-    _frame(ax, visual.vertices * MM, f'what the physics and the checks collide:\n'
-           f'{len(part.primitives)} convex piece(s)')
+    _part_row(fig, rows, part)
     tilts = geometry.tilts
     shown = sorted({0, len(tilts) - 1, int(np.abs(tilts).argmin())})
     for g, grasp in enumerate(grasps):
@@ -294,6 +295,34 @@ def write(checks: Validator, path: str) -> str:
                      for k in shown]
         draw_place(ax, checks, g, relatives, [tilts[k] for k in shown],
                    f'{grasp.name}: place (yellow: the surface)\n')
+    fig.tight_layout()
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path
+
+
+def _part_row(fig, rows: int, part) -> None:
+    """The sheet's first row: the part as drawn in its file, and its collision pieces."""
+    visual = part.visual
+    ax = fig.add_subplot(rows, 2, 1, projection='3d')
+    _draw(ax, visual, np.eye(3), '#999999', 0.6)
+    ax.scatter(*np.zeros(3), color='k', s=12)
+    if part.mass_frame is not None:
+        ax.scatter(*(part.mass_frame[0] * MM), color='r', s=18)
+    _frame(ax, visual.vertices * MM, 'as drawn in its file\n(black: origin, red: mass centre)')
+    ax = fig.add_subplot(rows, 2, 2, projection='3d')
+    for i, shape in enumerate(part_shapes(part)):
+        _draw(ax, _shape_mesh(shape, shape.rotation, shape.center), np.eye(3),
+              PIECE_COLOURS[i % len(PIECE_COLOURS)], 0.55)
+    _frame(ax, visual.vertices * MM, f'what the physics and the checks collide:\n'
+           f'{len(part.primitives)} convex piece(s)')
+
+
+def write_part(part, path: str) -> str:
+    """The sheet's first row alone, for a part with no grasp yet: `path` (PNG)."""
+    fig = plt.figure(figsize=(8.0, 3.4))
+    _part_row(fig, 1, part)
     fig.tight_layout()
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     fig.savefig(path, dpi=90)

@@ -18,6 +18,7 @@ from ..analysis import part_sheet
 from ..experiment_file.board import Board, load_board, record, settle, table, write_parts
 from ..experiment_file.kinds import kind_of
 from ..experiment_file.model import ExperimentFile
+from ..experiment_file.part import NoGrasp
 from ..experiment_file.plan import count_iterations, experiment_iterations
 
 
@@ -45,6 +46,7 @@ def check(paths: list[str], output: str | None, iterations: int | None = None,
             errors = exc.errors if isinstance(exc, experiment_file.InvalidFile) else [exc]
             for e in errors:
                 print(f'run --check: {path}: {e}', file=sys.stderr)
+            _no_grasp(errors, path, output)
             return 2
         checks = part_sheet.validator(file)
         print(f'{path}: reads as a run would')
@@ -61,6 +63,20 @@ def check(paths: list[str], output: str | None, iterations: int | None = None,
                                                        os.path.join(directory, name)))
         print('\n'.join(describe_plan(file)))
     return 0
+
+
+def _no_grasp(errors: list[InvalidArgument], path: str, output: str | None) -> None:
+    """For a part `grasps: auto` found no grasp on: its account and the sheet of the part
+    alone (what it is, where its mass centre lies, what collides), to write its grasps from."""
+    found = next((e for e in errors if isinstance(e, NoGrasp)), None)
+    if found is None:
+        return
+    part = found.geometry
+    print(f'{path}: no grasp found; the part as the run would read it:')
+    print('\n'.join(part_sheet.part_lines(part) + part_sheet.aspect_lines(part)))
+    directory = os.path.abspath(os.path.expanduser(output or os.path.dirname(path)))
+    stem = os.path.splitext(os.path.basename(path))[0]
+    print('sheet: ' + part_sheet.write_part(part, os.path.join(directory, f'{stem}_part.png')))
 
 
 def check_board(board: Board, path: str, output: str | None, iterations: int | None,

@@ -202,6 +202,15 @@ def check_held(geometry: PartGeometry, setup: Setup, where: str = 'part.grasps')
                               exc.rule) from None
 
 
+class NoGrasp(InvalidArgument):
+    """`grasps: auto` found no grasp on a part that reads: the part's geometry comes with
+    the error, for `run --check` to print its account and draw its sheet all the same."""
+
+    def __init__(self, field: str, value: object, rule: str, geometry: PartGeometry) -> None:
+        super().__init__(field, value, rule)
+        self.geometry = geometry
+
+
 def proposed(geometry: PartGeometry, gripper: GripperKind, where: str = 'part.grasps'
              ) -> tuple:
     """`part.grasps: auto`: the grasps the gripper's kind proposes from the part's geometry;
@@ -211,8 +220,8 @@ def proposed(geometry: PartGeometry, gripper: GripperKind, where: str = 'part.gr
     except InvalidArgument as exc:
         field = exc.field
         if field == 'grasps':
-            field = where
-        elif field.startswith('gripper.'):
+            raise NoGrasp(where, exc.value, exc.rule.removeprefix('(mm) '), geometry) from None
+        if field.startswith('gripper.'):
             key = next(k for k in gripper.KEYS if f'gripper.{k.field}' == field)
             field = f'gripper.{key.file_key}'
         raise InvalidArgument(field, exc.value, exc.rule.removeprefix('(mm) ')) from None
