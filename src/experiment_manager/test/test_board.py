@@ -29,6 +29,7 @@ BOARDS = os.path.join(os.path.dirname(__file__), '..', 'config', 'boards')
 PCB = os.path.join(BOARDS, 'ecc83-pp.kicad_pcb')
 MODELS = os.path.join(BOARDS, '3dmodels')
 RESISTOR = 'R_Axial_DIN0207_L6.3mm_D2.5mm_P7.62mm_Horizontal'
+DOCS = os.path.join(os.path.dirname(__file__), '..', '..', '..', 'docs')
 
 
 def _board_file(tmp_path, pcb=PCB, models=MODELS, **board) -> str:
@@ -296,6 +297,29 @@ def test_a_board_run_again_keeps_the_parts_done_with_the_same_file_and_writes_it
     assert any(RESISTOR.replace('.', '_') in p for p in expand_boards([changed], args, []))
     data = json.loads((tmp_path / 'out' / 'ecc83_board.json').read_text())
     assert {p['status'] for p in data['parts']} >= {'refused', 'not through-hole'}
+    _valid_against_the_published_schema(data)
+
+
+def _valid_against_the_published_schema(data: dict) -> None:
+    import json
+
+    import jsonschema
+    with open(os.path.join(DOCS, 'board.schema.json'), encoding='utf-8') as f:
+        schema = json.load(f)
+    jsonschema.Draft202012Validator.check_schema(schema)
+    jsonschema.validate(data, schema, cls=jsonschema.Draft202012Validator)
+    for broken in ({**data, 'colour': 'red'},
+                   {**data, 'parts': [{**data['parts'][0], 'status': 'maybe'}]}):
+        with pytest.raises(jsonschema.ValidationError):
+            jsonschema.validate(broken, schema, cls=jsonschema.Draft202012Validator)
+
+
+def test_the_published_board_schema_is_the_models():
+    from experiment_manager.experiment_file.board.record import schema_text
+    with open(os.path.join(DOCS, 'board.schema.json'), encoding='utf-8') as f:
+        assert f.read() == schema_text(), (
+            "docs/board.schema.json is not the model's: write it again with `python -m "
+            'experiment_manager.experiment_file.board.record --schema docs/board.schema.json`')
 
 
 def test_a_part_with_no_grasp_still_gets_its_account_and_its_sheet(tmp_path, capsys):

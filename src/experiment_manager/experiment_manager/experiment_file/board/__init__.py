@@ -320,37 +320,35 @@ def answer(board: Board, said: Mapping[str, str],
     return lines + (['what stops the options not feasible:'] + notes if notes else [])
 
 
-BOARD_JSON_VERSION = 1
-
-
 def record(board: Board, said: Mapping[str, str],
            decided: Mapping[str, list[tuple[str, str, str]]],
            left: Mapping[str, Mapping[str, str]] | None = None,
            runs: Mapping[str, str] | None = None,
            shas: Mapping[str, str] | None = None) -> dict:
-    """The board's answer as data (`<output>/<board id>_board.json`): per distinct part its
-    model, references, quantity, status (decided, refused, not through-hole) with its reason,
-    its mass's account, what was left out for it and why, its run directory, and its options'
-    verdicts with the first reason and the best option (`answer`'s rule), and the SHA-256 of
-    the experiment file it ran (`file_sha256`: a resumed board keeps a part done only when
-    its file is the same)."""
+    """The board's answer as data (`<output>/<board id>_board.json`, its model and schema in
+    `record`): per distinct part its model, references, quantity, status with its reason,
+    its mass's account, what was left out for it and why, its run directory, the SHA-256 of
+    the experiment file it ran (a board run again keeps a part done only when its file is the
+    same), and its options' verdicts with the first reason and the best option (`answer`'s
+    rule)."""
+    # the records' module is also a command (it writes their schema): loaded here, not above
+    from .record import BOARD_JSON_VERSION, BoardOption, BoardPartRecord, BoardRecord
     parts = []
     for p in board.parts:
-        options = [{'option': o, 'verdict': v, 'reason': why}
+        options = [BoardOption(option=o, verdict=v, reason=why)
                    for o, v, why in decided.get(p.name, [])]
         status = p.status
-        if p.status == DECIDE and p.name not in decided:
+        if p.name in decided:
+            status = 'decided'
+        elif p.status == DECIDE:
             status = REFUSED if said.get(p.name, '').startswith('refused') else 'not run'
-        parts.append({
-            'name': p.name, 'model': p.step or (p.model.path if p.model else ''),
-            'references': list(p.references), 'quantity': p.quantity,
-            'status': 'decided' if p.name in decided else status,
-            'reason': p.reason or (said.get(p.name, '') if status != DECIDE else ''),
-            'mass': board.masses.get(p.name, ''),
-            'left_out': dict((left or {}).get(p.name, {})),
-            'run': (runs or {}).get(p.name, ''),
-            'file_sha256': (shas or {}).get(p.name, ''),
-            'options': options,
-            'best': next((o['option'] for o in options if o['verdict'] == 'FEASIBLE'), None)})
-    return {'board_json_version': BOARD_JSON_VERSION, 'board': board.path, 'id': board.id,
-            'boards_per_hour': board.boards_per_hour, 'parts': parts}
+        reason = p.reason or (said.get(p.name, '') if status == REFUSED else '')
+        parts.append(BoardPartRecord(
+            name=p.name, model=p.step or (p.model.path if p.model else ''),
+            references=list(p.references), quantity=p.quantity, status=status,
+            reason=reason.removeprefix('refused: '), mass=board.masses.get(p.name, ''),
+            left_out=dict((left or {}).get(p.name, {})), run=(runs or {}).get(p.name, ''),
+            file_sha256=(shas or {}).get(p.name, ''), options=options,
+            best=next((o.option for o in options if o.verdict == 'FEASIBLE'), None)))
+    return BoardRecord(board_json_version=BOARD_JSON_VERSION, board=board.path, id=board.id,
+                       boards_per_hour=board.boards_per_hour, parts=parts).model_dump()
