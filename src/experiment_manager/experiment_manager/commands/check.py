@@ -15,6 +15,7 @@ from pick_common.specs import CENTRE, FIXED, MOVES, RANDOM, Vibration
 
 from .. import experiment_file
 from ..analysis import part_sheet
+from ..analysis.report.board import write_board_page
 from ..experiment_file.board import Board, load_board, record, settle, table, write_parts
 from ..experiment_file.kinds import kind_of
 from ..experiment_file.model import ExperimentFile
@@ -103,10 +104,11 @@ def check_board(board: Board, path: str, output: str | None, iterations: int | N
         said[name] = 'checked: ' + board.masses[name].split(':')[0] + ''.join(
             f'; {g} left out: {why}' for g, why in dropped.items())
     print('\n'.join(table(board, said)))
+    data = record(board, said, {}, left)
     path = os.path.join(directory, f'{board.id}_board.json')
     with open(path, 'w', encoding='utf-8') as f:
-        json.dump(record(board, said, {}, left), f, indent=1)
-    print(f'board: {path}')
+        json.dump(data, f, indent=1)
+    print(f'board: {path}, {write_board_page(data, directory, f"{board.id}_board")}')
 
 
 def describe_plan(file: ExperimentFile) -> list[str]:
