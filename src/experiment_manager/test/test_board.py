@@ -109,14 +109,18 @@ def test_kicad_5_modules_8_properties_hidden_models_and_inch_offsets_are_read(tm
       (at (xyz 0 0 0.1)) (scale (xyz 1 1 1)) (rotate (xyz 0 0 90))))
   (module Pad:SMD (layer B.Cu) (attr smd)
     (fp_text reference C3 (at 0 0) (layer F.SilkS)))
+  (module Logo:POLY (layer F.Cu)
+    (fp_text reference G1 (at 0 0) (layer F.SilkS))
+    (pad 1 smd rect (at 0 0) (size 1 1) (layers F.Cu)))
   (footprint "X:Y" (layer "F.Cu") (attr through_hole)
     (property "Reference" "U5")
     (model "a.wrl" hide (offset (xyz 0 0 0)))
     (model "b.step" (hide yes) (offset (xyz 0 0 0)))))
 """)
     _, fps = kicad.read(str(pcb))
-    r7, c3, u5 = fps
+    r7, c3, g1, u5 = fps
     assert (r7.reference, r7.kind, r7.side) == ('R7', 'through_hole', 'top')
+    assert g1.kind == 'other'           # KiCad 5, no type and no plated hole: not inserted
     assert r7.models[0].offset == pytest.approx((0.0, 0.0, 2.54))       # 0.1 inch
     assert (c3.kind, c3.side) == ('smd', 'bottom')
     assert (u5.reference, u5.models, len(u5.hidden)) == ('U5', (), 2)

@@ -8,7 +8,8 @@ read of each:
 - its library name, `at` (x y [angle]; mm, y down) and `layer` (F.Cu top, B.Cu bottom);
 - its type: KiCad 6+ `(attr through_hole | smd [board_only] ...)`; no type means "other"
   (neither), `board_only` a footprint with no part (KiCad 5's `virtual`). KiCad 5 writes
-  `(attr smd)` or `(attr virtual)` and nothing for a through-hole footprint;
+  `(attr smd)` or `(attr virtual)` and nothing for a through-hole footprint, read as one
+  when it has a plated hole (`(pad ... thru_hole ...)`), else as "other";
 - its reference: `(fp_text reference "R1" ...)` (KiCad 5 to 7) or `(property "Reference"
   "R1" ...)` (KiCad 8+);
 - its models: `(model PATH [hide] [(hide yes)] (offset (xyz mm)) (scale (xyz)) (rotate (xyz
@@ -189,7 +190,10 @@ def _kind(node: Node, legacy: bool) -> str:
         return 'virtual'
     if 'smd' in flags:
         return 'smd'
-    if 'through_hole' in flags or legacy:
+    if 'through_hole' in flags:
+        return 'through_hole'
+    # KiCad 5 writes no type for a through-hole footprint: one with a plated hole is one
+    if legacy and any('thru_hole' in pad.atoms() for pad in node.children('pad')):
         return 'through_hole'
     return 'other'
 
