@@ -187,6 +187,11 @@ def test_bad_board_keys_are_named(tmp_path):
     with pytest.raises(InvalidArgument) as err:
         expand(data, str(tmp_path / 'b.yaml'))
     assert err.value.field == 'requirements.parts_per_hour'
+    data = yaml.safe_load(open(_board_file(tmp_path)))
+    data['id'] = '../elsewhere'
+    with pytest.raises(InvalidArgument) as err:       # its id names files and folders
+        expand(data, str(tmp_path / 'b.yaml'))
+    assert err.value.field == 'id'
     with pytest.raises(InvalidArgument) as err:       # a board file read as one part's file
         experiment_file.load(_board_file(tmp_path))
     assert err.value.field == 'board' and 'part by part' in err.value.rule
@@ -340,3 +345,15 @@ def test_a_part_with_no_grasp_still_gets_its_account_and_its_sheet(tmp_path, cap
     assert 'no grasp found; the part as the run would read it' in said
     assert 'mass centre at' in said and 'collision:' in said and 'aspects it can rest on' in said
     assert (tmp_path / 'to92_part.png').stat().st_size > 10_000
+
+
+def test_an_error_in_the_keys_every_part_shares_is_the_files_not_a_part_option_left_out(
+        tmp_path):
+    from experiment_manager.experiment_file import InvalidFile
+    data = yaml.safe_load(open(_board_file(tmp_path)))
+    data['experiments'][0]['iterations'] = 0
+    data['grippers'] = {'cup': {'type': 'suction', 'cup_colour': 'red'}}
+    with pytest.raises(InvalidFile) as err:
+        expand(data, str(tmp_path / 'b.yaml'))
+    assert {e.field for e in err.value.errors} == {'experiments[0].iterations',
+                                                   'grippers.cup.cup_colour'}

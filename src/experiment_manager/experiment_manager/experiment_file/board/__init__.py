@@ -32,14 +32,18 @@ from pick_common.parts.solids import solid_mass, SolidMass
 from pydantic import BaseModel, ConfigDict
 import yaml
 
+from .. import loading
 from ..errors import read as read_keys
+from ..kinds import keys_model
 from ..model import MAX_FILE_BYTES
+from ..schema import NamedGripper
 from ..values import Number, Text
 from . import kicad
 from .parts import board_parts, BoardPart, DECIDE, NOT_THROUGH_HOLE, REFUSED
 
-__all__ = ['Board', 'BoardPart', 'DECIDE', 'expand', 'is_board', 'load_board',
-           'NOT_THROUGH_HOLE', 'REFUSED', 'table', 'write_parts']
+__all__ = ['answer', 'Board', 'BoardPart', 'DECIDE', 'expand', 'is_board', 'load_board',
+           'NOT_THROUGH_HOLE', 'placement', 'record', 'REFUSED', 'settle', 'table',
+           'write_parts']
 
 
 class _Keys(BaseModel):
@@ -112,8 +116,16 @@ def expand(data: Mapping, path: str, environ: Mapping[str, str] | None = None) -
                               'is set per part from board.boards_per_hour times its quantity '
                               'per board: leave it out')
     section, errors = read_keys(BoardSection, data['board'], 'board')
+    # the keys every part's file shares: an error there is the file's, refused here, not an
+    # option one part cannot run (`settle`)
+    raw = data.get('experiments')
+    for i, item in enumerate(raw if isinstance(raw, list) else []):
+        errors += read_keys(keys_model(item), item, f'experiments[{i}]')[1]
+    named = data.get('grippers')
+    for name, entry in (named.items() if isinstance(named, Mapping) else ()):
+        errors += read_keys(NamedGripper, entry, f'grippers.{name}')[1]
     if errors:
-        raise errors[0]
+        raise errors[0] if len(errors) == 1 else loading.InvalidFile(errors)
     base = os.path.dirname(os.path.abspath(path)) if path else os.getcwd()
     pcb = os.path.normpath(os.path.join(base, os.path.expanduser(section.pcb)))
     models = None
@@ -128,7 +140,10 @@ def expand(data: Mapping, path: str, environ: Mapping[str, str] | None = None) -
         if name not in names:
             raise InvalidArgument(f'board.parts.{name}', name, 'names no part of the board: '
                                   f'its parts are {", ".join(sorted(names))}')
-    board = Board(path=pcb, id=str(data.get('id', 'board')),
+    board_id = data.get('id', 'board')
+    if not isinstance(board_id, str) or not re.fullmatch(r'[A-Za-z0-9_-]{1,64}', board_id):
+        raise InvalidArgument('id', board_id, 'must be 1..64 letters, digits, _ or -')
+    board = Board(path=pcb, id=board_id,
                   boards_per_hour=section.boards_per_hour, parts=[],
                   output_dir=str(data.get('output_dir') or 'results'))
     rest = {k: v for k, v in data.items() if k != 'board'}
@@ -231,7 +246,6 @@ def settle(path: str) -> tuple[Any, dict[str, str]]:
     Returns (the ExperimentFile, per gripper or experiment left out the error that left it
     out); the file is rewritten without them. InvalidArgument (or InvalidFile) for an error of
     the part itself, or when no experiment is left."""
-    from .. import loading  # the loader, which refers back to this package by name only
     dropped: dict[str, str] = {}
     while True:
         try:
