@@ -125,10 +125,12 @@ def propose(part: PartGeometry, margin: float = JAW_MARGIN) -> tuple[Proposal, .
         sides = square or [p for p in principal if abs(p @ a) < 1e-6]
         if not sides:
             continue
-        others = _off_centre(part, triangles, centre, a, sides[0])
-        point = next((p for p in [centre, *others]
-                      if abs(float(round_axis(part, p, sides[0], a) @ a)) > 0.999), None)
+        def round_at(p: np.ndarray, a: np.ndarray = a, side: np.ndarray = sides[0]) -> bool:
+            return abs(float(round_axis(part, p, side, a) @ a)) > 0.999
 
+        # the mass centre first; the bodies off it only when the part is not round there
+        point = centre if round_at(centre) else next(
+            (p for p in _off_centre(part, triangles, centre, a, sides[0]) if round_at(p)), None)
         if point is not None:
             rounds.append((a, _distinct([sides[0]], signed=False)[0], point))
     found: list[Proposal] = []

@@ -41,14 +41,19 @@ class BoardRun:
         return answer(self.board, self.said, self.decided, self.left)
 
     def write(self) -> str:
-        """The board's answer as data, <output>/<board id>_board.json, and as a page,
-        <board id>_board.html (analysis/report/board.py); the data's path."""
-        data = record(self.board, self.said, self.decided, self.left, self.runs, self.shas)
-        path = os.path.join(self.directory, f'{self.board.id}_board.json')
-        with open(path, 'w', encoding='utf-8') as f:
-            json.dump(data, f, indent=1)
-        write_board_page(data, self.directory, f'{self.board.id}_board')
-        return path
+        """The board's answer written (`write_answer`); the data's path."""
+        return write_answer(record(self.board, self.said, self.decided, self.left, self.runs,
+                                   self.shas), self.directory, self.board.id)
+
+
+def write_answer(data: dict, directory: str, board_id: str) -> str:
+    """A board's answer (`record`'s data) as <directory>/<board id>_board.json and as a
+    page, <board id>_board.html (analysis/report/board.py); the data's path."""
+    path = os.path.join(directory, f'{board_id}_board.json')
+    with open(path, 'w', encoding='utf-8') as f:
+        json.dump(data, f, indent=1)
+    write_board_page(data, directory, f'{board_id}_board')
+    return path
 
 
 def cell_file(share: str) -> str:

@@ -6,7 +6,6 @@ when a feeder runs), and draw the part sheet
 --output DIR, DIR/check.json holds the part's account and each grasp's figures and verdicts
 (part_sheet.write_check; DIR/<id>_check.json per file when there are several)."""
 
-import json
 import os
 import sys
 
@@ -15,12 +14,12 @@ from pick_common.specs import CENTRE, FIXED, MOVES, RANDOM, Vibration
 
 from .. import experiment_file
 from ..analysis import part_sheet
-from ..analysis.report.board import write_board_page
 from ..experiment_file.board import Board, load_board, record, settle, table, write_parts
 from ..experiment_file.kinds import kind_of
 from ..experiment_file.model import ExperimentFile
 from ..experiment_file.part import NoGrasp
 from ..experiment_file.plan import count_iterations, experiment_iterations
+from .boards import write_answer
 
 
 def check(paths: list[str], output: str | None, iterations: int | None = None,
@@ -36,7 +35,7 @@ def check(paths: list[str], output: str | None, iterations: int | None = None,
             print(f'run --check: {path}: {exc}', file=sys.stderr)
             return 2
         if board is not None:
-            check_board(board, path, output, iterations, adaptive)
+            check_board(board, output, iterations, adaptive)
             continue
         try:
             file = experiment_file.load(path)
@@ -80,7 +79,7 @@ def _no_grasp(errors: list[InvalidArgument], path: str, output: str | None) -> N
     print('sheet: ' + part_sheet.write_part(part, os.path.join(directory, f'{stem}_part.png')))
 
 
-def check_board(board: Board, path: str, output: str | None, iterations: int | None,
+def check_board(board: Board, output: str | None, iterations: int | None,
                 adaptive: bool) -> None:
     """A board's check: each part's experiment file written beside the sheets
     (<output>/<board id>_parts/) and checked as a file of its own; a part whose file does
@@ -96,6 +95,7 @@ def check_board(board: Board, path: str, output: str | None, iterations: int | N
             errors = exc.errors if isinstance(exc, experiment_file.InvalidFile) else [exc]
             for e in errors:
                 print(f'run --check: {part_file}: {e}', file=sys.stderr)
+            _no_grasp(errors, part_file, os.path.join(directory, name) if output else None)
             said[name] = f'refused: {errors[0]}'
             continue
         check([part_file], os.path.join(directory, name) if output else None, iterations,
@@ -104,11 +104,7 @@ def check_board(board: Board, path: str, output: str | None, iterations: int | N
         said[name] = 'checked: ' + board.masses[name].split(':')[0] + ''.join(
             f'; {g} left out: {why}' for g, why in dropped.items())
     print('\n'.join(table(board, said)))
-    data = record(board, said, {}, left)
-    path = os.path.join(directory, f'{board.id}_board.json')
-    with open(path, 'w', encoding='utf-8') as f:
-        json.dump(data, f, indent=1)
-    print(f'board: {path}, {write_board_page(data, directory, f"{board.id}_board")}')
+    print(f'board: {write_answer(record(board, said, {}, left), directory, board.id)}')
 
 
 def describe_plan(file: ExperimentFile) -> list[str]:

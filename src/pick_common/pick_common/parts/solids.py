@@ -44,7 +44,6 @@ class BodyDensity:
     source: str             # where the density comes from; 'assumed: ...' with the basis
 
 
-ASSUMED = 'assumed'
 # First match wins; the last row catches every other model.
 BODY_DENSITIES: tuple[BodyDensity, ...] = (
     BodyDensity(r'CP_(Radial|Axial)', 'aluminium electrolytic capacitor',
