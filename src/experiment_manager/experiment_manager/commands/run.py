@@ -2,6 +2,7 @@
 
     run [EXPERIMENT_FILE ...] [--output DIR | --resume RUN_DIR] [--iterations N] [--adaptive]
         [--workers N] [--respawns N] [--namespace NS] [--logs DIR]
+    run --board FILE.kicad_pcb [--models DIR] [--boards-per-hour N] [--output DIR] ...
 
 Starts N workers (`world`, `validity` and `feeder_controller` under <NS>/worker_<k>, default: a
 worker per CPU) and `experiment_manager` under <NS> as separate processes (DDS between them, as
@@ -13,7 +14,9 @@ need (mesh_dirs, experiment_dirs, output_dirs). Without a file it runs the built
 (`share/experiment_manager/config/default_experiment.yaml`), or with --resume the file the run
 directory keeps. --iterations N caps every experiment at N iterations (a quick look at a long
 study; the run directory keeps the file that ran); --adaptive runs each experiment only until
-its decision is settled (sampling.py), at most its iterations.
+its decision is settled (sampling.py), at most its iterations. A board file (`board:` in place
+of `part:`), or --board in the built-in cell, runs as its parts' files, and ends with the
+board's one answer (commands/boards.py, docs/boards.md).
 
 Exit codes: 0 done; 1 the run failed (the message says why; finished iterations are kept);
 2 bad input (the experiment file, an option); 130 interrupted (Ctrl-C: the run is canceled and
@@ -185,11 +188,7 @@ def _goals(args: argparse.Namespace,
     goals = []
     files = args.experiment_files or [os.path.join(args.resume, 'experiment.yaml')
                                       if args.resume else default_file()]
-    if args.board:
-        files = [board_file(args.board, args.models, args.boards_per_hour,
-                            cell_file(get_package_share_directory('experiment_manager')),
-                            os.path.abspath(os.path.expanduser(args.output or 'results')))]
-    for given in expand_boards(files, args, args.boards):
+    for given in expand_boards(_board_given(args) or files, args, args.boards):
         path = os.path.abspath(given)
         try:
             file = experiment_file.load(path)
@@ -211,17 +210,23 @@ def _goals(args: argparse.Namespace,
     return goals
 
 
+def _board_given(args: argparse.Namespace) -> list[str]:
+    """With --board: the board file of the built-in cell with that board, written into the
+    output directory; else []."""
+    if not args.board:
+        return []
+    return [board_file(args.board, args.models, args.boards_per_hour,
+                       cell_file(get_package_share_directory('experiment_manager')),
+                       os.path.abspath(os.path.expanduser(args.output or 'results')))]
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _parse(sys.argv[1:] if argv is None else argv)
     args.boards = []        # the boards run, for their one answer at the end
     if args.check:
         from .check import check  # the sheet's drawing is loaded only to draw it
-        files = args.experiment_files
-        if args.board:
-            files = [board_file(args.board, args.models, args.boards_per_hour,
-                                cell_file(get_package_share_directory('experiment_manager')),
-                                os.path.abspath(os.path.expanduser(args.output or 'results')))]
-        return check(files, args.output, args.iterations, args.adaptive)
+        return check(_board_given(args) or args.experiment_files, args.output,
+                     args.iterations, args.adaptive)
     temporary: list[str] = []
     try:
         return _main(args, temporary)
