@@ -11,12 +11,12 @@ writes it from this module (a test checks that the committed file is current). U
 the names (`_mm`, `_s`, `_h`, `_mm2`); shares are fractions of 1. No rclpy.
 """
 
-import argparse
 import json
 from typing import Annotated, Literal
 
 from pydantic import ConfigDict, Field
 
+from ..experiment_file.schema import json_schema_text, schema_command
 from .migration import migrate, SCHEMA_VERSION
 from .records import _Record, Faults, Fractions, Physics, Sampling, Stats, VERDICT
 
@@ -347,20 +347,11 @@ def read(path: str) -> Summary:
 
 def schema_text() -> str:
     """The JSON Schema of summary.json, as docs/summary.schema.json holds it."""
-    return json.dumps(Summary.model_json_schema(by_alias=True), indent=1, sort_keys=True) + '\n'
+    return json_schema_text(Summary)
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--schema', metavar='PATH', required=True,
-                        help="write summary.json's JSON Schema to PATH ('-': standard output)")
-    args = parser.parse_args(argv)
-    if args.schema == '-':
-        print(schema_text(), end='')
-        return 0
-    with open(args.schema, 'w', encoding='utf-8') as f:
-        f.write(schema_text())
-    return 0
+    return schema_command(Summary, 'summary.json', __doc__.split('\n\n')[0], argv)
 
 
 if __name__ == '__main__':

@@ -7,8 +7,10 @@ requirements.max_dimension_mm, parts that fit, an experiment named by another) i
 the loader (`loading`), and pydantic's errors become the workspace's in `errors`.
 """
 
+import argparse
 from collections.abc import Mapping
 from functools import partial
+import json
 from typing import Annotated, Any
 
 from pick_common.containers import BIN, DROP_HEIGHT, TRAY, TRAY_DEFAULT_SIZE
@@ -288,3 +290,24 @@ class NamedGripper(GripperSection):
 
     grasps: Annotated[list[GraspEntry] | None, WrapValidator(grasp_list)] = \
         Field(default=None, validate_default=False)
+
+
+def json_schema_text(model: type[BaseModel]) -> str:
+    """A results model's JSON Schema as the project publishes it (docs/*.schema.json)."""
+    return json.dumps(model.model_json_schema(by_alias=True), indent=1, sort_keys=True) + '\n'
+
+
+def schema_command(model: type[BaseModel], what: str, description: str,
+                   argv: list[str] | None = None) -> int:
+    """`python -m <module> --schema PATH`: write `model`'s JSON Schema to PATH ('-': standard
+    output); the one command of summary.json's and a board answer's modules."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument('--schema', metavar='PATH', required=True,
+                        help=f"write {what}'s JSON Schema to PATH ('-': standard output)")
+    args = parser.parse_args(argv)
+    if args.schema == '-':
+        print(json_schema_text(model), end='')
+        return 0
+    with open(args.schema, 'w', encoding='utf-8') as f:
+        f.write(json_schema_text(model))
+    return 0

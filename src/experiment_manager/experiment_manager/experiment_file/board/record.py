@@ -5,11 +5,11 @@ Schema published as docs/board.schema.json:
 
 writes it from this module (a test checks that the committed file is current). No rclpy."""
 
-import argparse
-import json
 from typing import Literal
 
 from pydantic import BaseModel, ConfigDict
+
+from ..schema import json_schema_text, schema_command
 
 BOARD_JSON_VERSION = 1
 # decided: its options ran; refused: it cannot be decided (its reason); not through-hole: an
@@ -56,20 +56,11 @@ class BoardRecord(_Record):
 
 def schema_text() -> str:
     """The JSON Schema of <id>_board.json, as docs/board.schema.json holds it."""
-    return json.dumps(BoardRecord.model_json_schema(), indent=1, sort_keys=True) + '\n'
+    return json_schema_text(BoardRecord)
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--schema', metavar='PATH', required=True,
-                        help="write the board answer's JSON Schema to PATH ('-': standard output)")
-    args = parser.parse_args(argv)
-    if args.schema == '-':
-        print(schema_text(), end='')
-        return 0
-    with open(args.schema, 'w', encoding='utf-8') as f:
-        f.write(schema_text())
-    return 0
+    return schema_command(BoardRecord, 'the board answer', __doc__.split('\n\n')[0], argv)
 
 
 if __name__ == '__main__':
