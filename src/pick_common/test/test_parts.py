@@ -220,6 +220,23 @@ def test_a_concave_part_is_cut_into_convex_pieces_that_fit_it():
     assert 'CoACD' in part.collision_note
 
 
+def test_a_part_of_many_bodies_shares_its_pieces_out_rather_than_becoming_one_hull():
+    # The TO-220's concave body (cut alone: more than 4 pieces) beside 28 small boxes: the 28
+    # boxes leave it 4 of the 32 pieces, so it is cut again into at most 4 (a D-sub's shell
+    # beside its other bodies was one hull of the whole part, 81 % over its volume)
+    from pick_common.parts.meshes import load_mesh
+    to220 = load_mesh(STEP, 1.0)
+    alone, _ = pieces.convex_cover(to220, STEP)
+    boxes = [trimesh.creation.box((0.001,) * 3).apply_translation((0.03 + 0.002 * i, 0.03, 0))
+             for i in range(28)]
+    mesh = trimesh.util.concatenate([to220, *boxes])
+    hulls, words = pieces.convex_cover(mesh, 'many.stl')
+    assert len(alone) > 4 and len(hulls) == 28 + 4
+    assert 'at most 4 each' in words and 'one convex hull' not in words
+    together = sum(h.volume for h in hulls) - 28 * 1e-9
+    assert to220.volume < together < trimesh.convex.convex_hull(to220.vertices).volume
+
+
 def test_convex_and_open_bodies_keep_their_hulls_and_say_so(tmp_path):
     trimesh.creation.box((0.006, 0.004, 0.002)).export(tmp_path / 'box.stl')
     box = build_part(PartSpec(model='mesh', mesh_path=str(tmp_path / 'box.stl'), mass=0.001))
@@ -236,7 +253,7 @@ def test_pieces_come_from_the_cache_the_same_as_computed(tmp_path, monkeypatch):
     first = build_part(PartSpec(model='mesh', mesh_path=STEP, mass=0.002))
     assert len(os.listdir(tmp_path / 'pieces')) == 2            # the entry and the lock
 
-    def _no(body):
+    def _no(body, most):
         raise AssertionError('decomposed again: the cache was not read')
     monkeypatch.setattr(pieces, '_decompose', _no)
     again = build_part(PartSpec(model='mesh', mesh_path=STEP, mass=0.002))

@@ -59,22 +59,22 @@ def is_convex(body: trimesh.Trimesh) -> bool:
     return body.convex_hull.volume <= (1.0 + CONVEX_SLACK) * body.volume
 
 
-def _key(body: trimesh.Trimesh) -> str:
+def _key(body: trimesh.Trimesh, most: int) -> str:
     import coacd
     h = hashlib.sha256()
     h.update(np.ascontiguousarray(body.vertices, dtype=np.float64).tobytes())
     h.update(np.ascontiguousarray(body.faces, dtype=np.int64).tobytes())
-    h.update(repr((THRESHOLD, MAX_PIECES, MAX_PIECE_VERTICES, SEED,
+    h.update(repr((THRESHOLD, most, MAX_PIECE_VERTICES, SEED,
                    getattr(coacd, '__version__', ''))).encode())
     return h.hexdigest()
 
 
-def _decompose(body: trimesh.Trimesh) -> list[np.ndarray]:
+def _decompose(body: trimesh.Trimesh, most: int) -> list[np.ndarray]:
     import coacd
     coacd.set_log_level('error')
     pieces = coacd.run_coacd(coacd.Mesh(np.asarray(body.vertices, dtype=np.float64),
                                         np.asarray(body.faces, dtype=np.int64)),
-                             threshold=THRESHOLD, max_convex_hull=MAX_PIECES,
+                             threshold=THRESHOLD, max_convex_hull=most,
                              max_ch_vertex=MAX_PIECE_VERTICES, decimate=True, seed=SEED,
                              preprocess_mode='off')
     # the same pieces in one order, each with its points in one order
@@ -83,9 +83,10 @@ def _decompose(body: trimesh.Trimesh) -> list[np.ndarray]:
     return sorted(points, key=lambda p: tuple(np.round(p.mean(axis=0), 9)))
 
 
-def convex_pieces(body: trimesh.Trimesh) -> list[np.ndarray]:
+def convex_pieces(body: trimesh.Trimesh, most: int = MAX_PIECES) -> list[np.ndarray]:
     """The vertex sets (each (K, 3) float64, in the body's frame) of CoACD's convex pieces of a
-    closed body. CoACD cuts along planes square to the frame's axes, so the body is cut in its
+    closed body, at most `most` of them (CoACD merges its pieces down to that many). CoACD
+    cuts along planes square to the frame's axes, so the body is cut in its
     own principal frame (its mass centre and axes of inertia) and the pieces are turned back:
     where a file puts its origin or how it turns its axes does not change the cut (KiCad's
     TO-220 turned in its file came out in 27 pieces, in its own frame in 9)."""
@@ -93,18 +94,18 @@ def convex_pieces(body: trimesh.Trimesh) -> list[np.ndarray]:
     canonical = body.copy()
     canonical.apply_transform(to_principal)
     back = np.linalg.inv(to_principal)
-    return [p @ back[:3, :3].T + back[:3, 3] for p in _cached_pieces(canonical)]
+    return [p @ back[:3, :3].T + back[:3, 3] for p in _cached_pieces(canonical, most)]
 
 
-def _cached_pieces(body: trimesh.Trimesh) -> list[np.ndarray]:
+def _cached_pieces(body: trimesh.Trimesh, most: int) -> list[np.ndarray]:
     """CoACD's pieces of `body` as it lies, from the cache when it holds them."""
     directory = cache_dir()
     try:
         os.makedirs(directory, exist_ok=True)
         lock = open(os.path.join(directory, 'lock'), 'w')
     except OSError:                     # no cache where none can be written: compute each time
-        return _decompose(body)
-    path = os.path.join(directory, _key(body) + '.npz')
+        return _decompose(body, most)
+    path = os.path.join(directory, _key(body, most) + '.npz')
     with lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         try:
@@ -112,7 +113,7 @@ def _cached_pieces(body: trimesh.Trimesh) -> list[np.ndarray]:
                 return [stored[f'p{i}'] for i in range(len(stored.files))]
         except (OSError, ValueError, KeyError):     # not there yet, or unreadable: compute
             pass
-        points = _decompose(body)
+        points = _decompose(body, most)
         fd, tmp = tempfile.mkstemp(dir=directory, suffix='.npz')
         with os.fdopen(fd, 'wb') as out:
             np.savez(out, **{f'p{i}': p for i, p in enumerate(points)})
@@ -133,48 +134,64 @@ def convex_cover(mesh: trimesh.Trimesh, path: str) -> tuple[list[trimesh.Trimesh
 
     Each connected body: closed and convex (`is_convex`), its hull; closed and concave,
     CoACD's pieces (`convex_pieces`); open, its hull (an open body has no inside to cut,
-    so its concavities stay filled: said in the words). More than MAX_MESH_HULLS pieces in all,
-    or more than MAX_MESH_HULLS bodies: the hull of the whole mesh, said too.
+    so its concavities stay filled: said in the words). Where the pieces number more than
+    MAX_MESH_HULLS in all, the concave bodies are cut again with the hulls left to them
+    shared out (CoACD merges its pieces down to each one's share: a D-sub's shell of 32 pieces
+    beside its one convex body); only where that leaves a concave body no piece, or the mesh
+    has more than MAX_MESH_HULLS bodies, is the part one hull of the whole mesh, said too.
     """
     bodies = mesh.split(only_watertight=False)
     if len(bodies) > MAX_MESH_HULLS:
-        whole = _hull(mesh.vertices)
-        if whole is None:
-            raise MeshError('part.mesh_path', path, 'has zero volume (flat or a line)')
-        return [whole], (f'one convex hull of the whole mesh: it has {len(bodies)} separate '
-                         f'bodies, more than {MAX_MESH_HULLS}')
-    hulls, counts, failed = [], {'convex': 0, 'concave': 0, 'open': 0}, ''
-    for body in bodies:
-        closed = body.is_watertight and body.volume > 0
-        if closed and not is_convex(body):
-            try:
-                cut = [h for h in (_hull(p) for p in convex_pieces(body))
-                       if h is not None]
-            except Exception as exc:    # CoACD's C++ raises what it raises: keep the hull
-                cut, failed = [], f'; CoACD could not cut a body ({exc}): it is its hull'
-            if cut:
-                hulls += cut
-                counts['concave'] += 1
-                continue
-        hull = _hull(body.vertices)
-        if hull is not None:
-            hulls.append(hull)
-            counts['convex' if closed else 'open'] += 1
+        return _whole(mesh, path, f'it has {len(bodies)} separate bodies, more than '
+                      f'{MAX_MESH_HULLS}')
+    concave = [b.is_watertight and b.volume > 0 and not is_convex(b) for b in bodies]
+    hulls = [[] if c else [h for h in [_hull(b.vertices)] if h is not None]
+             for b, c in zip(bodies, concave, strict=True)]
+    failed = _cut(bodies, concave, hulls, MAX_PIECES)
+    shared = ''
+    simple = sum(len(h) for h, c in zip(hulls, concave, strict=True) if not c)
+    if sum(len(h) for h in hulls) > MAX_MESH_HULLS and any(concave):
+        share = (MAX_MESH_HULLS - simple) // sum(concave)
+        if share < 1:
+            return _whole(mesh, path, f'its {simple} convex or open bodies leave '
+                          f'{MAX_MESH_HULLS - simple} pieces for {sum(concave)} concave ones')
+        failed = _cut(bodies, concave, hulls, share)
+        shared = f' (at most {share} each, to keep the part within {MAX_MESH_HULLS} pieces)'
+    hulls = [h for body in hulls for h in body]       # in the bodies' order, as they were
     if not hulls:
-        hull = _hull(mesh.vertices)
-        if hull is None:
-            raise MeshError('part.mesh_path', path, 'has zero volume (flat or a line)')
-        return [hull], 'one convex hull of the whole mesh: no body of it has volume'
-    if len(hulls) > MAX_MESH_HULLS:
-        return [_hull(mesh.vertices)], (f'one convex hull of the whole mesh: its pieces number '
-                                        f'{len(hulls)}, more than {MAX_MESH_HULLS}')
+        return _whole(mesh, path, 'no body of it has volume')
+    counts = {'convex': sum(b.is_watertight and b.volume > 0 for b in bodies) - sum(concave),
+              'open': sum(not (b.is_watertight and b.volume > 0) for b in bodies)}
     words = []
-    if counts['concave']:
-        words.append(f'{counts["concave"]} concave closed body(ies) cut into convex pieces by '
-                     f'CoACD (concavity threshold {THRESHOLD:g})')
+    if any(concave):
+        words.append(f'{sum(concave)} concave closed body(ies) cut into convex pieces by '
+                     f'CoACD (concavity threshold {THRESHOLD:g}){shared}')
     if counts['convex']:
         words.append(f'{counts["convex"]} convex closed body(ies) as its hull')
     if counts['open']:
         words.append(f'{counts["open"]} open body(ies) as its hull (not closed, so not cut: '
                      'its hollows and gaps collide as filled; close the mesh to have it cut)')
     return hulls, '; '.join(words) + failed
+
+
+def _cut(bodies: list[trimesh.Trimesh], concave: list[bool], hulls: list[list], most: int
+         ) -> str:
+    """Put into `hulls` each concave body's pieces (at most `most`), or its hull where CoACD
+    fails on it; what failed, in words."""
+    failed = ''
+    for i, body in enumerate(bodies):
+        if not concave[i]:
+            continue
+        try:
+            pieces = [h for h in (_hull(p) for p in convex_pieces(body, most)) if h is not None]
+        except Exception as exc:    # CoACD's C++ raises what it raises: keep the hull
+            pieces, failed = [], f'; CoACD could not cut a body ({exc}): it is its hull'
+        hulls[i] = pieces or [h for h in [_hull(body.vertices)] if h is not None]
+    return failed
+
+
+def _whole(mesh: trimesh.Trimesh, path: str, why: str) -> tuple[list[trimesh.Trimesh], str]:
+    whole = _hull(mesh.vertices)
+    if whole is None:
+        raise MeshError('part.mesh_path', path, 'has zero volume (flat or a line)')
+    return [whole], f'one convex hull of the whole mesh: {why}'
