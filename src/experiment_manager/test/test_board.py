@@ -232,10 +232,19 @@ def test_the_built_in_cell_leaves_out_for_a_part_what_cannot_run_and_says_why(tm
     path.write_text(yaml.safe_dump(cell))
     board = load_board(str(path))
     files = write_parts(board, str(tmp_path / 'parts'))
-    # 240 terminal blocks do not fit the 100 x 150 x 18 mm bin: its emptying is left out,
+    # a refill of terminal blocks (60 boards an hour x 4 a board x 4 h: 960) does not fit the
+    # 100 x 150 x 18 mm bin: its emptying is left out,
     # with the station's that names it; the table and the cup still run
+    # each part's bins and feeder hold its own refill; a `parts` the file gives stays
+    one = yaml.safe_load(board.files['CP_Radial_D10.0mm_P5.00mm'])         # C1, one a board
+    assert {e['id']: e.get('parts') for e in one['experiments']
+            if e['type'] != 'table_sweep'}['emptying'] == 60 * 1 * 4
+    cell['experiments'][2]['parts'] = 50
+    path.write_text(yaml.safe_dump(cell))
+    given = yaml.safe_load(load_board(str(path)).files['CP_Radial_D10.0mm_P5.00mm'])
+    assert given['experiments'][2]['parts'] == 50 and given['experiments'][1]['parts'] == 240
     file, left = settle(files['Altech_AK300_1x02_P5.00mm_45-Degree'])
-    assert '240 parts do not fit' in left['emptying']
+    assert '960 parts do not fit' in left['emptying']
     assert left['emptying_station'] == 'it names emptying'
     assert {e.id for e in file.experiments} >= {'sweep', 'feeder'}
     assert 'left out for this part' in open(files['Altech_AK300_1x02_P5.00mm_45-Degree']).read()

@@ -3,7 +3,9 @@ experiment file per distinct through-hole part of the KiCad board (`expand`), ea
 ordinary file a user could have written: its part read from the model's STEP file in KiCad's
 frame, its mass from the model's solids (pick_common.parts.solids) unless the board section
 gives it, `grasps: auto` unless given, and its requirement the board's `boards_per_hour`
-times its quantity per board; every other section of the file is the same for every part.
+times its quantity per board; a bin's or a feeder's emptying that leaves out `parts` holds
+the part's refill (that rate times requirements.refill_interval_h: the load it must hold,
+`_loaded`); every other section of the file is the same for every part.
 
 The board section (mm, g as the other sections):
     board:
@@ -35,11 +37,15 @@ import yaml
 from .. import loading
 from ..errors import read as read_keys
 from ..kinds import keys_model
-from ..model import MAX_FILE_BYTES
-from ..schema import NamedGripper
+from ..model import MAX_FILE_BYTES, Requirements
+from ..schema import NamedGripper, RequirementsSection
 from ..values import Number, Text
 from . import kicad
 from .parts import board_parts, BoardPart, DECIDE, NOT_THROUGH_HOLE, REFUSED
+
+# The experiments that hold a refill of the part: their `parts`, left out in a board file, is
+# each part's own refill.
+REFILLED = ('bin_emptying', 'feeder_emptying')
 
 __all__ = ['answer', 'Board', 'BoardPart', 'DECIDE', 'expand', 'is_board', 'load_board',
            'NOT_THROUGH_HOLE', 'placement', 'record', 'REFUSED', 'settle', 'table',
@@ -118,9 +124,11 @@ def expand(data: Mapping, path: str, environ: Mapping[str, str] | None = None) -
     section, errors = read_keys(BoardSection, data['board'], 'board')
     # the keys every part's file shares: an error there is the file's, refused here, not an
     # option one part cannot run (`settle`)
+    refill, more = read_keys(RequirementsSection, requirements, 'requirements')
+    errors += more
     raw = data.get('experiments')
     for i, item in enumerate(raw if isinstance(raw, list) else []):
-        errors += read_keys(keys_model(item), item, f'experiments[{i}]')[1]
+        errors += read_keys(keys_model(item), _loaded(item, 1), f'experiments[{i}]')[1]
     named = data.get('grippers')
     for name, entry in (named.items() if isinstance(named, Mapping) else ()):
         errors += read_keys(NamedGripper, entry, f'grippers.{name}')[1]
@@ -161,16 +169,29 @@ def expand(data: Mapping, path: str, environ: Mapping[str, str] | None = None) -
                 continue
         board.masses[p.name] = (mass.account() if mass is not None else
                                 f'{override.mass_g:g} g, given in board.parts.{p.name}.mass_g')
+        rate = section.boards_per_hour * p.quantity
+        capacity = Requirements(parts_per_hour=rate,
+                                refill_interval=3600.0 * refill.refill_interval_h).capacity
         one = {**rest, 'id': _file_id(board.id, p.name, board.files),
                'part': _part_section(p, override, mass),
-               'requirements': {**requirements,
-                                'parts_per_hour': section.boards_per_hour * p.quantity}}
+               'requirements': {**requirements, 'parts_per_hour': rate}}
+        if isinstance(raw, list):
+            one['experiments'] = [_loaded(item, capacity) for item in raw]
         header = (f'# {os.path.basename(pcb)}: {p.name}, {p.quantity} per board '
                   f'({", ".join(p.references)}), from the board file {path or "given"}\n'
                   f'# mass: {board.masses[p.name]}\n')
         board.files[p.name] = header + yaml.safe_dump(one, sort_keys=False)
         board.parts.append(p)
     return board
+
+
+def _loaded(item: Any, capacity: int) -> Any:
+    """A board's experiment that holds parts (a bin's or a feeder's emptying) and leaves out
+    its `parts`: with `capacity`, the parts of one refill interval of this part (its
+    boards_per_hour x quantity x refill_interval_h), the load its bin or feeder must hold."""
+    if (isinstance(item, Mapping) and item.get('type') in REFILLED and 'parts' not in item):
+        return {**item, 'parts': capacity}
+    return item
 
 
 def _file_id(board_id: str, name: str, taken: Mapping[str, str]) -> str:
