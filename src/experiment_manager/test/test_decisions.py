@@ -70,20 +70,27 @@ def test_the_time_ground_decides_on_the_bound_and_says_which():
     assert said.verdict == decisions.UNDECIDED and said.detail['over'] == 1
 
 
-def test_spills_are_a_rate_or_a_count_that_must_be_zero():
-    clean = [{'time': 1.0, 'spilled': 0}] * 10
-    assert decisions.spills(clean, 0).verdict == decisions.FEASIBLE
-    # no spill in 3 runs is not a rate of 0: runs spilling 63 % of the time show none 5 %
-    assert 'runs may still spill up to 63.2 % of the time' in decisions.spills(clean[:3], 0).reason
-    assert 'up to 25.9 %' in decisions.spills(clean, 0).reason
-    assert decisions.spills(clean[:9] + [{'time': 1.0, 'spilled': 1}], 0).verdict == \
-        decisions.NOT_FEASIBLE
-    # at a limit of 1 per refill: none in 10 runs bounds the rate at 3.0 / 10 (Garwood)
-    rate = decisions.spills(clean, 1)
-    assert rate.verdict == decisions.FEASIBLE and rate.bound == pytest.approx(0.2996, abs=1e-3)
-    assert decisions.spills(clean[:2], 1).verdict == decisions.UNDECIDED   # 1.5 per refill
-    many = [{'time': 1.0, 'spilled': 5}] * 10
-    assert decisions.spills(many, 1).verdict == decisions.NOT_FEASIBLE
+def test_spills_are_a_share_of_refills_decided_on_its_bounds():
+    clean = [{'time': 1.0, 'spilled': 0}] * 30
+    spilled = {'time': 1.0, 'spilled': 2}
+    # none of 3: refills may still spill up to 63.2 % of the time (its 95 % bound)
+    three = decisions.spills(clean[:3], 0, 0.9)
+    assert three.verdict == decisions.UNDECIDED and three.detail['low'] == pytest.approx(
+        0.05 ** (1 / 3))
+    # 1 of 5: the share within lies between 34 % and 99 %: neither side
+    five = decisions.spills(clean[:4] + [spilled], 0, 0.9)
+    assert five.verdict == decisions.UNDECIDED and five.detail['successes'] == 4
+    assert five.detail['spilled'] == 2
+    assert '4 of 5 refills spilling at most 0 part(s)' in five.reason
+    # none of 30: at least 90.5 % of refills spill nothing
+    thirty = decisions.spills(clean, 0, 0.9)
+    assert thirty.verdict == decisions.FEASIBLE and thirty.detail['low'] > 0.9
+    assert decisions.spills(clean[:28], 0, 0.9).verdict == decisions.UNDECIDED
+    # every one of 3 spilling: at most 63.2 % spill nothing
+    assert decisions.spills([spilled] * 3, 0, 0.9).verdict == decisions.NOT_FEASIBLE
+    # a refill may spill 2 parts: those runs are within the limit
+    assert decisions.spills(clean[:28] + [spilled] * 2, 2, 0.9).verdict == decisions.FEASIBLE
+    assert decisions.spills([], 0, 0.9).verdict == decisions.UNDECIDED
 
 
 def test_a_rate_decides_on_its_one_sided_bounds():

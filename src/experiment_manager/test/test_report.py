@@ -101,38 +101,47 @@ def test_the_report_warns_where_the_optimal_range_runs_past_the_counts_tested(ru
 
 
 def _rates(s: dict, emptied: int, accepted: int, n: int, spilled: int = 0,
-           seconds: float = 1000.0) -> None:
+           seconds: float = 1000.0, spilling: int = 1) -> None:
     """Bins emptied, k of n, and feeder runs emptied in about `seconds` (spread by 1 %),
-    `accepted` of n (the others not emptied), `spilled` parts over all, with the decisions
-    metrics gives them."""
+    `accepted` of n (the others not emptied), the first `spilling` runs spilling `spilled`
+    parts each, with the decisions metrics gives them."""
     required = s['requirements']['success_rate']
     s['experiments']['emptying'].update(
         emptied=emptied, iterations=n,
         decision=decisions.rate(emptied, n, required, 'bins emptied').as_dict())
     runs = [{'time': seconds * (1 + 0.01 * (i % 3)) if i < accepted else math.inf,
-             'spilled': spilled if i == 0 else 0} for i in range(n)]
+             'spilled': spilled if i < spilling else 0} for i in range(n)]
     s['experiments']['feeder'].update(
         emptied=accepted, iterations=n,
         decision={'time': decisions.table_time(runs, 4 * 3600.0, required).as_dict(),
-                  'spills': decisions.spills(runs, 0).as_dict()})
-    s['experiments']['feeder']['physics']['spilled'] = spilled
+                  'spills': decisions.spills(runs, 0, required).as_dict()})
+    s['experiments']['feeder']['physics']['spilled'] = spilled * spilling
 
 
 def test_the_table_verdict_rests_on_the_time_to_empty_and_the_spills(run_dir):
     s = _summary(run_dir)
     s['requirements'].update(capacity=10, success_rate=0.9)
-    _rates(s, 3, 3, 3)              # three runs in about 17 min: far inside 4 h
+    _rates(s, 3, 3, 3)              # three runs in about 17 min: far inside 4 h ...
+    table = _verdicts(s)[1]
+    # ... but none spilling in 3 runs does not settle the spills: refills may still spill up
+    # to 63 % of the time; 29 runs without a spill would put it under 10 %
+    assert table.verdict == UNDECIDED, table
+    assert table.reasons[0].startswith("0 part(s) spilled over the tray's walls in 3 runs")
+    assert 'at most 100 %' in table.reasons[0] and 'at least 36.8 %' in table.reasons[0]
+    assert '29 iterations would settle it' in table.reasons[0]
+    assert table.reasons[1].startswith('3 runs emptied in 16.7 min to 17.0 min: 90 % of '
+                                       'refills empty within ')
+    assert 'one-sided 95 % tolerance bound, Gumbel' in table.reasons[1]
+    assert table.reasons[2] == 'grounds settled: time FEASIBLE; not settled: spills'
+    assert table.grounds['time'].interval == 'one-sided 95 % tolerance bound, Gumbel'
+    _rates(s, 3, 30, 30)            # thirty runs, none spilling: both grounds settled
     table = _verdicts(s)[1]
     assert table.verdict == FEASIBLE, table
-    assert table.reasons[0].startswith('3 runs emptied in 16.7 min to 17.0 min: 90 % of '
-                                          'refills empty within ')
-    assert 'one-sided 95 % tolerance bound, Gumbel' in table.reasons[0]
     assert table.reasons[2] == 'grounds settled: time FEASIBLE, spills FEASIBLE'
-    assert table.grounds['time'].interval == 'one-sided 95 % tolerance bound, Gumbel'
     _rates(s, 3, 3, 3, seconds=3.9 * 3600.0)   # just inside the interval: not settled
     table = _verdicts(s)[1]
     assert table.verdict == UNDECIDED
-    assert table.reasons[2] == 'grounds settled: spills FEASIBLE; not settled: time'
+    assert table.reasons[2] == 'grounds settled: none; not settled: time, spills'
     _rates(s, 3, 2, 3)              # a run that did not empty counts as over: distribution-free
     table = _verdicts(s)[1]
     assert table.verdict == UNDECIDED and '1 of 3 runs over the interval or not emptied' \
@@ -140,11 +149,16 @@ def test_the_table_verdict_rests_on_the_time_to_empty_and_the_spills(run_dir):
         table.reasons[0]
     _rates(s, 3, 0, 30)             # none of 30 emptied
     assert _verdicts(s)[1].verdict == NOT_FEASIBLE
-    _rates(s, 3, 3, 3, spilled=1)   # one spilled part, where none may spill: that decides
+    _rates(s, 3, 5, 5, spilled=2)   # 1 of 5 runs spilled: the bounds straddle 90 %
+    table = _verdicts(s)[1]
+    assert table.verdict == UNDECIDED
+    assert '4 of 5 refills spilling at most 0 part(s)' in table.reasons[0]
+    assert 'iterations would settle it if the rate seen held' in table.reasons[0]
+    _rates(s, 3, 3, 3, spilled=1, spilling=3)   # every run spilled: at most 63 % do not
     table = _verdicts(s)[1]
     assert table.verdict == NOT_FEASIBLE
     # the ground that decides is said first (run prints only the first reason)
-    assert table.reasons[0].startswith("1 parts spilled over the tray's walls in 3 runs")
+    assert table.reasons[0].startswith("3 part(s) spilled over the tray's walls in 3 runs")
     assert table.reasons[1].startswith('3 runs emptied in')
     assert table.reasons[2] == 'grounds settled: time FEASIBLE, spills NOT FEASIBLE'
     text = _markdown(s)

@@ -33,8 +33,10 @@ confidence (`table_time`):
   Gumbel's own far tail. A feeder that jams now and then for a reason of its own (a part
   that wedges) is a second mode the fit cannot see in 3 runs that emptied; only the
   distribution-free count shows it, and needs 29 runs to show it below 10 %.
-Spills are a rate: parts spilled per refill, bounded one-sidedly (Poisson, over all the runs)
-against requirements.max_spilled_parts; at a limit of 0 a spill is a count that must be zero.
+Spills are a share, decided as the rates below: the refills that spilled at most
+requirements.max_spilled_parts parts, against requirements.success_rate (a refill that spills
+is not emptied by picking: the paper's stop rule), FEASIBLE or NOT FEASIBLE only where the
+bounds settle it.
 
 Rates of success (bins emptied, `rate`): the exact (Clopper-Pearson) one-sided 95 % bounds:
 FEASIBLE when the lower bound reaches the required rate, NOT FEASIBLE when the upper bound lies
@@ -43,13 +45,12 @@ below it.
 Pure: no rclpy, no files.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 import functools
 import math
 
 import numpy as np
 from pick_common.stats import binomial_bounds
-from scipy import stats
 
 FEASIBLE, NOT_FEASIBLE, UNDECIDED = 'FEASIBLE', 'NOT FEASIBLE', 'UNDECIDED'
 CONFIDENCE = 0.95
@@ -121,33 +122,24 @@ def rate(successes: int, n: int, required: float, what: str,
                     kind, n, said, {'low': low, 'high': high, 'successes': successes})
 
 
-def spills(runs: list[dict], limit: int, confidence: float = CONFIDENCE) -> Decision:
-    """Parts spilled over the tray's walls per refill against `limit`
-    (requirements.max_spilled_parts): a Poisson rate over all the runs, one-sided bounds
-    (Garwood's exact ones); at a limit of 0 a count that must be zero."""
-    n, total = len(runs), int(sum(r['spilled'] for r in runs))
-    quantity = 'parts spilled per refill'
-    if limit == 0:
-        kind = 'a count that must be zero'
-        verdict = NOT_FEASIBLE if total else FEASIBLE if n else UNDECIDED
-        said = (f"{total} parts spilled over the tray's walls in {n} runs; the limit "
-                'is 0 (requirements.max_spilled_parts: a spilled part is lost)')
-        if n and not total:
-            # no spill is not a rate of 0: how often runs may still spill, unseen in n
-            unseen = float(binomial_bounds(0, n, confidence)[1])
-            said += (f'; runs may still spill up to {_pc(unseen)} of the time '
-                     f'({_one_sided(confidence)} Clopper-Pearson bound, 0 of {n})')
-        return Decision(verdict, quantity, float(total), kind, n, said, {'spilled': total})
-    kind = _one_sided(confidence) + ' Poisson bounds (Garwood)'
-    if n == 0:
-        return Decision(UNDECIDED, quantity, None, kind, 0, 'no feeder run yet')
-    upper = stats.chi2.ppf(confidence, 2 * (total + 1)) / (2 * n)
-    lower = stats.chi2.ppf(1 - confidence, 2 * total) / (2 * n) if total else 0.0
-    verdict = FEASIBLE if upper <= limit else NOT_FEASIBLE if lower > limit else UNDECIDED
-    return Decision(verdict, quantity, float(upper if verdict != NOT_FEASIBLE else lower), kind,
-                    n, f'{total} parts spilled in {n} runs: {lower:.2f} to {upper:.2f} per '
-                    f'refill ({kind}); the limit is {limit} (requirements.max_spilled_parts)',
-                    {'spilled': total, 'low': lower, 'high': upper})
+def spills(runs: list[dict], limit: int, required: float,
+           confidence: float = CONFIDENCE) -> Decision:
+    """The share of refills that spilled at most `limit` parts over the tray's walls
+    (requirements.max_spilled_parts) against `required` (requirements.success_rate), on its
+    one-sided exact bounds (`rate`), as every share is decided: the paper's stop rule is the
+    feeder emptied, and a refill that spills a part is not emptied by picking, so it counts
+    against the refills that must succeed. None spilling in 3 runs settles nothing (at 90 %,
+    29 runs without a spill do); 1 of 5 neither."""
+    n = len(runs)
+    within = sum(r['spilled'] <= limit for r in runs)
+    total = int(sum(r['spilled'] for r in runs))
+    what = f'refills spilling at most {limit} part(s)'
+    decided = rate(within, n, required, what, confidence)
+    said = (f"{total} part(s) spilled over the tray's walls in {n} runs (a refill spilling "
+            f'more than requirements.max_spilled_parts, {limit}, is one the picking did not '
+            'empty); ' + decided.reason)
+    return replace(decided, quantity=f'share of {what}', reason=said,
+                   detail={**decided.detail, 'spilled': total})
 
 
 def combined(said: list[str]) -> str:

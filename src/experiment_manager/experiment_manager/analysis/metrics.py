@@ -214,7 +214,7 @@ def table_grounds(file: ExperimentFile, rows: list[dict],
     runs = decisions.feeder_runs(rows, file.cell)
     r = file.requirements
     return {'time': decisions.table_time(runs, r.refill_interval, r.success_rate, confidence),
-            'spills': decisions.spills(runs, r.max_spilled, confidence)}
+            'spills': decisions.spills(runs, r.max_spilled, r.success_rate, confidence)}
 
 
 def throughputs(cell, rows: list[dict]) -> list[float]:

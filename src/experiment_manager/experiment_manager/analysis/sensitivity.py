@@ -200,7 +200,8 @@ def _spills_p(here: dict, there: dict, verdict: str) -> float | None:
     `there` the file's: the file's time ground with the scenario's spills gives `verdict`):
     Fisher's exact p (two-sided) that its runs spilling and the file's are one rate; None for
     a flip its spills do not make, or where a run may spill parts (requirements.
-    max_spilled_parts above 0: the ground is then parts per refill, not runs that spilled)."""
+    max_spilled_parts above 0: the ground then counts the runs spilling more than that, which
+    `runs_spilling`, the runs spilling any, is not)."""
     if (there['limit'] or here['spills'] == there['spills']
             or combined([there['time'], here['spills']]) != verdict):
         return None

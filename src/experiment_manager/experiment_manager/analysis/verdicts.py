@@ -11,8 +11,9 @@ and kept in summary.json as each experiment's `decision`):
 - vibrating table, on two grounds: the cell's time to empty a refill (picks, images, the
   table's simulated feeds and vibrations; a run that did not empty is over) against the
   refill interval, for requirements.success_rate of refills at 95 % confidence (a one-sided
-  tolerance bound, Gumbel, with a distribution-free one beside it); and the parts spilled
-  per refill against requirements.max_spilled_parts; the feeder must hold a refill interval's
+  tolerance bound, Gumbel, with a distribution-free one beside it); and the share of
+  refills spilling at most requirements.max_spilled_parts parts against the same
+  success_rate, on its one-sided exact bounds; the feeder must hold a refill interval's
   parts. FEASIBLE when every ground is, NOT FEASIBLE when one is, else UNDECIDED, saying
   which grounds are settled;
 - gripper (one per gripper_sweep): the smallest gripper of the sweep whose valid parts per
@@ -156,7 +157,8 @@ def _table_verdict(s, option: tuple[str, bool], capacity: int, required: float) 
     v = s.vibrations_to_empty
     # the ground that decides first (run prints only the first reason): NOT FEASIBLE,
     # then UNDECIDED, then FEASIBLE; the time first among equals
-    said = sorted([(time, time.reason + _more(time, required)), (spills, spills.reason)],
+    said = sorted([(time, time.reason + _more(time, required)),
+                   (spills, spills.reason + _more(spills, required))],
                   key=lambda g: [NOT_FEASIBLE, UNDECIDED, FEASIBLE].index(g[0].verdict))
     reasons = [said[0][1], said[1][1],
                'grounds settled: ' + (', '.join(settled) or 'none')
