@@ -134,6 +134,18 @@ def inside(spec: ContainerSpec, points: np.ndarray, tolerance: float = 0.001,
             & (p[:, 2] >= -tolerance) & (p[:, 2] <= top + tolerance))
 
 
+def beside(spec: ContainerSpec, points: np.ndarray, reach: float) -> np.ndarray:
+    """Which points (N, 3) in the instance frame have come down beside the container, (N,)
+    bool: outside its outer footprint and within `reach` m of the cell's table it stands on
+    (the plane of its underside, z = -floor_thickness) or below it. A part's centre there,
+    `reach` its bounding radius, has left the container over a wall and landed."""
+    x, y, _ = spec.inner_size
+    t = spec.wall_thickness
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    out = (np.abs(p[:, 0]) > x / 2 + t) | (np.abs(p[:, 1]) > y / 2 + t)
+    return out & (p[:, 2] < -spec.floor_thickness + reach)
+
+
 def tunnelled(spec: ContainerSpec, points: np.ndarray) -> np.ndarray:
     """Which points (N, 3) in the instance frame lie in or under the floor or inside a wall,
     (N,) bool: where the centre of a solid part can only be if it passed through the container

@@ -225,7 +225,10 @@ def settle_from_msg(msg: SettleReportMsg) -> SettleReport:
                         escaped_ids=list(msg.escaped_ids),
                         tunnelled_ids=list(msg.tunnelled_ids),
                         max_penetration=msg.max_penetration, tray=tray_from_msg(msg.tray),
-                        thrown_ids=list(msg.thrown_ids), max_speed=msg.max_speed)
+                        thrown_ids=list(msg.thrown_ids), max_speed=msg.max_speed,
+                        landed_ids=list(msg.landed_ids),
+                        landed_at=[(p.x, p.y, p.z) for p in msg.landed_at],
+                        landed_speeds=list(msg.landed_speeds))
 
 
 def settle_to_msg(report: SettleReport) -> SettleReportMsg:
@@ -236,7 +239,10 @@ def settle_to_msg(report: SettleReport) -> SettleReportMsg:
                            tunnelled_ids=list(report.tunnelled_ids),
                            max_penetration=report.max_penetration,
                            tray=tray_to_msg(report.tray), thrown_ids=list(report.thrown_ids),
-                           max_speed=report.max_speed)
+                           max_speed=report.max_speed, landed_ids=list(report.landed_ids),
+                           landed_at=[Point(x=float(x), y=float(y), z=float(z))
+                                      for x, y, z in report.landed_at],
+                           landed_speeds=[float(v) for v in report.landed_speeds])
 
 
 def progress_to_msg(progress: Progress) -> PhysicsProgress:

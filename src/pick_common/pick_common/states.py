@@ -57,6 +57,10 @@ class SettleReport:
     max_penetration: the deepest overlap of two bodies at the end, m. max_speed: the fastest
     any part's centre moved during the operation while above its container's floor, m/s.
     tray: for a vibration, the motion the trays delivered (TrayMotion), else None.
+    landed_ids: of the spilled parts, those that came down on the cell's table beside their
+    container (containers.beside) and were taken out of the simulation; landed_at: where each
+    landed, in its instance frame, m (on the table, z = -floor_thickness; found within one
+    settle check of landing); landed_speeds: how fast each was moving then, m/s.
     """
 
     settled: bool
@@ -71,6 +75,9 @@ class SettleReport:
     tray: TrayMotion | None = None
     thrown_ids: list[int] = field(default_factory=list)
     max_speed: float = 0.0
+    landed_ids: list[int] = field(default_factory=list)
+    landed_at: list[tuple[float, float, float]] = field(default_factory=list)
+    landed_speeds: list[float] = field(default_factory=list)
 
     @property
     def spilled_ids(self) -> list[int]:

@@ -6,6 +6,7 @@ Every function takes the Engine (engine.py, SI units) it works on; the World own
 """
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 from pick_common import containers
@@ -23,6 +24,18 @@ from .engine import Engine
 INSTANCE_GAP = 0.05             # m between the outer walls of neighbouring instances
 TRAY_MASS = 3.0                 # kg; the tray is a dynamic body whose motion is prescribed
 
+
+
+@dataclass
+class Instance:
+    """One instance: container body, origin in the world (m), its generator and its parts."""
+
+    id: int
+    seed: int
+    origin: np.ndarray
+    body: int
+    rng: np.random.Generator
+    part_ids: list[int] = field(default_factory=list)
 
 def instance_seed(seed: int, index: int) -> int:
     """The seed of instance `index` derived from the scene's base seed (stable across runs)."""

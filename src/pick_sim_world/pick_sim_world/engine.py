@@ -195,6 +195,12 @@ class Engine:
                           spinningFriction=values.spinning_friction * s,
                           restitution=values.restitution, physicsClientId=self.client, **extra)
 
+    def park(self, body: int) -> None:
+        """Make a body static where it is, at rest: out of the dynamics, never moved again."""
+        pb.resetBaseVelocity(body, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0],
+                             physicsClientId=self.client)
+        pb.changeDynamics(body, -1, mass=0.0, physicsClientId=self.client)
+
     def remove(self, body: int) -> None:
         pb.removeBody(body, physicsClientId=self.client)
 

@@ -6,6 +6,7 @@ contact query, numpy; no rclpy."""
 
 from collections.abc import Sequence
 
+import numpy as np
 from pick_common import containers
 from pick_common.containers import ContainerSpec
 from pick_common.parts.geometry import PartGeometry
@@ -17,16 +18,23 @@ from .engine import Engine
 
 def finished(last: SettleReport, before: Sequence[SettleReport], engine: Engine,
              container: ContainerSpec, part: PartGeometry, state: PartStates,
-             peaks: dict[int, float], tray_speed: float) -> SettleReport:
+             peaks: dict[int, float], tray_speed: float,
+             landed: dict[int, tuple[np.ndarray, float]]) -> SettleReport:
     """`last` (how the operation ended) with the times and steps of its earlier runs `before`
     added in, and its health: `state`, the parts as they ended; `peaks`, each part's peak
     speed in the operation (m/s, removed parts too); `tray_speed`, the tray's peak speed,
-    m/s."""
+    m/s; `landed`, the parts that came down beside their container and were taken out (part
+    id: where, in its instance frame, m, and how fast, m/s): escaped, and so spilled unless
+    thrown."""
     for r in before:
         last.sim_time += r.sim_time
         last.wall_time += r.wall_time
         last.steps += r.steps
-    last.escaped_ids = [int(i) for i in state.ids[~state.inside]]
+    last.landed_ids = sorted(landed)
+    last.landed_at = [(float(landed[i][0][0]), float(landed[i][0][1]),
+                       -container.floor_thickness) for i in last.landed_ids]
+    last.landed_speeds = [float(landed[i][1]) for i in last.landed_ids]
+    last.escaped_ids = last.landed_ids + [int(i) for i in state.ids[~state.inside]]
     if len(state.ids):
         gone = containers.tunnelled(container, bodies.part_centres(state.poses, part))
         last.tunnelled_ids = [int(i) for i in state.ids[gone]]

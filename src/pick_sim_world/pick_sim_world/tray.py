@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 from pick_common.specs import CENTRE, RANDOM, Vibration
-from pick_common.states import TrayMotion
+from pick_common.states import PartStates, TrayMotion
 
 from .config import GRAVITY
 from .engine import Engine
@@ -40,6 +40,15 @@ def vibration_amplitude(vibration: Vibration, rng: np.random.Generator,
         cos, sin = math.cos(angle), math.sin(angle)
         x, y = cos * x - sin * y, sin * x + cos * y
     return np.array([x, y, z])
+
+
+def to_centre_of(states: PartStates) -> np.ndarray | None:
+    """From the centroid of one instance's parts on its tray (`states`, the instance's
+    snapshot) to the tray's centre (its frame origin), x and y, m; None without parts on it (a
+    CENTRE vibration's direction)."""
+    if not states.inside.any():
+        return None
+    return -states.poses[states.inside, :2].mean(axis=0)
 
 
 def centring_share(to_centre: np.ndarray | None, half_extents: tuple[float, float]) -> float:

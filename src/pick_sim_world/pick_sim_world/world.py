@@ -14,7 +14,8 @@ instance frame (origin at the centre of the container's inner floor, +Z up).
 
 from collections.abc import Iterable, Sequence
 from contextlib import nullcontext
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
+from functools import partial
 import math
 import os
 import shutil
@@ -29,24 +30,13 @@ from pick_common.specs import CENTRE, check_scene, check_vibration, SceneSpec, V
 from pick_common.states import PartStates, Progress, SettleReport
 
 from . import bodies, camera, health, selection, spawning, stepping
+from .bodies import Instance
 from .camera import Overlay
 from .config import check_physics, PhysicsConfig
 from .engine import Engine
 from .freezing import Freezer
 from .stepping import ProgressCallback
-from .tray import TrayDrive, vibration_plan
-
-
-@dataclass
-class Instance:
-    """One instance: container body, origin in the world (m), its generator and its parts."""
-
-    id: int
-    seed: int
-    origin: np.ndarray
-    body: int
-    rng: np.random.Generator
-    part_ids: list[int] = field(default_factory=list)
+from .tray import to_centre_of, TrayDrive, vibration_plan
 
 
 class World:
@@ -118,6 +108,9 @@ class World:
         self._next_id, self._sim_time = 0, 0.0
         self._at_rest = True     # the last step run ended settled (the settle criterion)
         self._peaks: dict[int, float] = {}   # part id -> peak speed in this operation, m/s
+        # part id -> (world position, m; speed, m/s) of the parts that landed beside their
+        # container in this operation, parked until its end (stepping.step)
+        self._landed: dict[int, tuple[np.ndarray, float]] = {}
         self._tray_speed = 0.0               # the tray's peak speed in this operation, m/s
         shutil.rmtree(self._tmp, ignore_errors=True)
         os.makedirs(self._tmp)
@@ -171,14 +164,6 @@ class World:
             inside[mask] = containers.inside(self._scene.container, base[mask, :3])
         poses = bodies.part_frame_poses(base, self._part)
         return PartStates(np.array(ids, dtype=np.int64), owners, poses, inside, self._sim_time)
-
-    def _to_centre(self, k: int) -> np.ndarray | None:
-        """From the centroid of instance k's parts on its tray to the tray's centre (its frame
-        origin), x and y, m; None without parts on it (a CENTRE vibration's direction)."""
-        states = self.snapshot([k])
-        if not states.inside.any():
-            return None
-        return -states.poses[states.inside, :2].mean(axis=0)
 
     # ----------------------------------------------------------------------------- drop
     def drop_region(self, instance: int, zone: str) -> tuple[float, float, float, float]:
@@ -266,7 +251,7 @@ class World:
         if self._drive is None:
             raise InvalidArgument('instances', targets[0], f'is a {self._scene.container.kind}'
                                   ': only trays vibrate')
-        to_centre = [self._to_centre(k) if vibration.direction == CENTRE else None
+        to_centre = [to_centre_of(self.snapshot([k])) if vibration.direction == CENTRE else None
                      for k in targets]
         size = self._scene.container.inner_size
         amplitudes, dt, steps, own = vibration_plan(
@@ -309,14 +294,20 @@ class World:
         # comes near (freezing.py).
         local = self._at_rest and self._physics.settle_freeze
         for pid in ids:
-            self._engine.remove(self._bodies.pop(pid))
-            self._instances[self._owner.pop(pid)].part_ids.remove(pid)
+            self._take_out(pid)
         if settle and (touching or not self._at_rest):
             asleep = [b for p, b in self._bodies.items() if p not in touching] if local else []
             return ids, self._finished(self._settle('settling', max_settle_time, progress,
                                                     asleep=asleep))
         self._at_rest = self._at_rest and not touching
         return ids, self._finished(SettleReport(True, 0.0, 0.0, 0))
+
+    def _take_out(self, pid: int) -> np.ndarray:
+        """Take part `pid` out of the simulation; its instance's origin (world frame, m)."""
+        self._engine.remove(self._bodies.pop(pid))
+        inst = self._instances[self._owner.pop(pid)]
+        inst.part_ids.remove(pid)
+        return inst.origin
 
     # ----------------------------------------------------------------------------- settle
     def settle(self, max_settle_time: float | None = None,
@@ -360,9 +351,13 @@ class World:
 
     def _finished(self, last: SettleReport, before: Sequence[SettleReport] = ()) -> SettleReport:
         """The report of a whole operation, once, at its end (health.finished), with the
-        operation's peak speeds: they start again from zero."""
+        operation's peak speeds: they start again from zero. The parts that landed beside
+        their container in it are taken out of the simulation and reported spilled, with where
+        they landed and how fast."""
+        landed = {pid: (at - self._take_out(pid), v) for pid, (at, v) in self._landed.items()}
+        self._landed = {}
         report = health.finished(last, before, self._engine, self._scene.container, self._part,
-                                 self.snapshot(), self._peaks, self._tray_speed)
+                                 self.snapshot(), self._peaks, self._tray_speed, landed)
         self._peaks, self._tray_speed = {}, 0.0
         return report
 
@@ -373,16 +368,20 @@ class World:
         (the physics step when None), freezing and waking parts with `freezer`. A fault
         resets the scene before it is raised. The report has no health yet: an operation made
         of several runs gets it once (`_finished`)."""
-        ids = [pid for inst in self._instances for pid in inst.part_ids]
+        ids = [pid for inst in self._instances for pid in inst.part_ids
+               if pid not in self._landed]
         physics = self._physics
         if time_step is not None and time_step != physics.time_step:
             physics = replace(physics, time_step=time_step)
         c = self._engine
         c.set_time_step(physics.time_step)
+        origins = np.array([self._instances[self._owner[i]].origin for i in ids]).reshape(-1, 3)
         try:
             out = stepping.step(c, ids, [self._bodies[i] for i in ids], physics, phase,
                                 duration, progress, self._drive, stop_when_settled,
-                                floor=-self._scene.container.floor_thickness, freezer=freezer)
+                                floor=-self._scene.container.floor_thickness, freezer=freezer,
+                                beside=partial(stepping.landed, self._scene.container,
+                                               origins, self._part.radius))
         except PhysicsFault:
             if freezer is not None:
                 freezer.abandon()
@@ -390,6 +389,7 @@ class World:
             raise
         finally:
             c.set_time_step(self._physics.time_step)
+        self._landed.update(out.landed)
         self._sim_time += out.steps * physics.time_step
         self._at_rest = out.settled
         for pid, speed in zip(ids, out.peak_speeds, strict=True):
