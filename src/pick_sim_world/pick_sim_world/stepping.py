@@ -63,8 +63,8 @@ def raise_peak_speeds(engine: Engine, bodies: Sequence[int], floor: float,
     """Raise peaks[i] to body i's linear speed (m/s, of its centre of mass) where that is
     higher and the body's origin is at or above `floor` (world z, m), for each i of `indices`
     (a frozen part does not move): a part falling beside or under its container gains speed
-    until it is found on the table (`landed`) or under the floor (tunnelled). The position is read only for a speed that would
-    raise the peak, which most steps' speeds do not."""
+    until it is found on the table (`landed`) or under the floor (tunnelled). The position is
+    read only for a speed that would raise the peak, which most steps' speeds do not."""
     for i in indices:
         b = bodies[i]
         speed = engine.speed(b)
