@@ -93,7 +93,7 @@ def _decide(runs: list[dict], file, refill: float) -> str:
     reads it (its time and spill grounds)."""
     r = file.requirements
     return decisions.combined([decisions.table_time(runs, refill, r.success_rate).verdict,
-                               decisions.spills(runs, r.max_spilled).verdict])
+                               decisions.spills(runs, r.max_spilled, r.success_rate).verdict])
 
 
 def table(run_dirs: list[str], draws: int, seed: int) -> None:
