@@ -160,6 +160,8 @@ def convex_cover(mesh: trimesh.Trimesh, path: str) -> tuple[list[trimesh.Trimesh
     hulls = [h for body in hulls for h in body]       # in the bodies' order, as they were
     if not hulls:
         return _whole(mesh, path, 'no body of it has volume')
+    if len(hulls) > MAX_MESH_HULLS:                   # CoACD did not merge down to its share
+        return _whole(mesh, path, f'its pieces number {len(hulls)}, more than {MAX_MESH_HULLS}')
     counts = {'convex': sum(b.is_watertight and b.volume > 0 for b in bodies) - sum(concave),
               'open': sum(not (b.is_watertight and b.volume > 0) for b in bodies)}
     words = []
