@@ -144,7 +144,8 @@ def convex_cover(mesh: trimesh.Trimesh, path: str) -> tuple[list[trimesh.Trimesh
     if len(bodies) > MAX_MESH_HULLS:
         return _whole(mesh, path, f'it has {len(bodies)} separate bodies, more than '
                       f'{MAX_MESH_HULLS}')
-    concave = [b.is_watertight and b.volume > 0 and not is_convex(b) for b in bodies]
+    closed = [b.is_watertight and b.volume > 0 for b in bodies]
+    concave = [c and not is_convex(b) for b, c in zip(bodies, closed, strict=True)]
     hulls = [[] if c else [h for h in [_hull(b.vertices)] if h is not None]
              for b, c in zip(bodies, concave, strict=True)]
     failed = _cut(bodies, concave, hulls, MAX_PIECES)
@@ -162,8 +163,7 @@ def convex_cover(mesh: trimesh.Trimesh, path: str) -> tuple[list[trimesh.Trimesh
         return _whole(mesh, path, 'no body of it has volume')
     if len(hulls) > MAX_MESH_HULLS:                   # CoACD did not merge down to its share
         return _whole(mesh, path, f'its pieces number {len(hulls)}, more than {MAX_MESH_HULLS}')
-    counts = {'convex': sum(b.is_watertight and b.volume > 0 for b in bodies) - sum(concave),
-              'open': sum(not (b.is_watertight and b.volume > 0) for b in bodies)}
+    counts = {'convex': sum(closed) - sum(concave), 'open': len(bodies) - sum(closed)}
     words = []
     if any(concave):
         words.append(f'{sum(concave)} concave closed body(ies) cut into convex pieces by '
