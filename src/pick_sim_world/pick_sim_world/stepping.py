@@ -112,7 +112,7 @@ def step(engine: Engine, ids: Sequence[int], bodies: Sequence[int], cfg: Physics
     steps = checked = 0
     moving = np.ones(len(ids), dtype=bool)
     peaks = [0.0] * len(ids)
-    landed: dict[int, tuple[np.ndarray, float]] = {}
+    found: dict[int, tuple[np.ndarray, float]] = {}     # the parts that landed
     parked = np.zeros(len(ids), dtype=bool)
     settled = canceled = False
     while steps < total_steps:
@@ -129,7 +129,7 @@ def step(engine: Engine, ids: Sequence[int], bodies: Sequence[int], cfg: Physics
                                f'{steps * dt:.3f} s of {phase}; the scene was reset')
         if beside is not None and len(ids):
             for i in np.flatnonzero(beside(poses) & ~parked):
-                landed[ids[i]] = (poses[i, :3].copy(), engine.speed(bodies[i]))
+                found[ids[i]] = (poses[i, :3].copy(), engine.speed(bodies[i]))
                 engine.park(bodies[i])
                 parked[i] = True
         history.append(poses)
@@ -153,4 +153,4 @@ def step(engine: Engine, ids: Sequence[int], bodies: Sequence[int], cfg: Physics
             awake = freezer.thawed(bodies)
     wall = time.perf_counter() - start
     return Outcome(settled, canceled, steps, wall, [ids[i] for i in np.flatnonzero(moving)],
-                   peaks, landed)
+                   peaks, found)
