@@ -212,8 +212,10 @@ class FeederControllerNode(Node):
                     instances=[goal.instance], count=step.feed,
                     zone=DropParts.Goal.ZONE_FEEDER), 'drop_parts')
                 result.reports.append(dropped.settle)
-                self._policy.fed(step.feed)
-                result.parts_fed = step.feed
+                # the hopper lets out at most the dose, fewer where its outlet was taken
+                result.parts_fed = len(dropped.part_ids)
+                if result.parts_fed:
+                    self._policy.fed(result.parts_fed)
             if step.vibrates:
                 goal_handle.publish_feedback(FeedCycle.Feedback(
                     state=self._state_msg(), phase='vibrating'))

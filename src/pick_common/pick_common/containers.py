@@ -22,11 +22,21 @@ LIMITS = {    # m
     'container.wall_thickness': Limit(0.0005, MAX_WALL),
     'container.floor_thickness': Limit(0.001, MAX_FLOOR),
     'container.drop_height': Limit(0.0, 1.0),
+    'container.hopper_rate': Limit(0.1, 1000.0),     # parts/s
+    'container.hopper_speed': Limit(0.0, 2.0, low_open=True),     # m/s
 }
 # How high over the floor parts arrive from, by kind, m. Assumed: no maker's figure found for
 # either. A bin is filled by pouring from a box held about 100 mm over its floor; a flexible
 # feeder's hopper lip stands about 30 mm over the tray's plate.
 DROP_HEIGHT = {BIN: 0.1, TRAY: 0.03}
+# The hopper that feeds a tray. Its outlet lets parts out at `hopper_rate` parts/s while it runs,
+# and a feed runs it for the time the shortfall sets (hopper.py); assumed, no maker gives a
+# hopper's rate for a part: Asyril and Epson both have it measured on the cell (Epson
+# PF_QtyAdjHopperTime: SupplyQty parts in SupplyTime ms). Parts leave the outlet moving onto the
+# tray at `hopper_speed`, a vibratory track's conveying speed: assumed, within the few ft/min
+# to 30 m/min IQS Directory gives for vibratory feeders ("Vibratory Feeders", chapter 1).
+HOPPER_RATE = 10.0      # parts/s
+HOPPER_SPEED = 0.1      # m/s
 PACKING_LIMIT = 0.4     # largest fraction of a container's inner volume parts may fill
 
 
@@ -38,8 +48,12 @@ class ContainerSpec:
     wall_thickness, floor_thickness: m. The floor is thick so that fast parts cannot tunnel.
     feeder_zone_center, feeder_zone_size: the tray's feeder drop zone on its floor (x, y), m.
     drop_height: how high over the floor parts arrive from, m: the box a bin is poured from,
-    the lip of the hopper that feeds a tray (parts fall from there, or from just above the
-    pile where it stands higher); None takes the kind's DROP_HEIGHT.
+    the outlet of the hopper that feeds a tray (its lip: the lowest point of a part leaving
+    it); None takes the kind's DROP_HEIGHT.
+    hopper_rate, hopper_speed: a tray's hopper: parts it lets out per second while it runs,
+    and their speed onto the tray as they leave it, m/s; None takes HOPPER_RATE, HOPPER_SPEED.
+    The outlet is the feeder zone's edge farther from the tray's centre along x (the hopper
+    stands beyond it), as wide as the zone, and parts leave it moving along x toward the centre.
     """
 
     kind: str = BIN
@@ -49,6 +63,8 @@ class ContainerSpec:
     feeder_zone_center: tuple[float, float] = (0.0, 0.0)
     feeder_zone_size: tuple[float, float] = (0.0, 0.0)
     drop_height: float | None = None
+    hopper_rate: float | None = None
+    hopper_speed: float | None = None
 
     @staticmethod
     def tray(inner_size: tuple[float, float, float] = TRAY_DEFAULT_SIZE) -> 'ContainerSpec':
@@ -64,6 +80,12 @@ def drop_height(spec: ContainerSpec) -> float:
     return DROP_HEIGHT[spec.kind] if spec.drop_height is None else spec.drop_height
 
 
+def hopper(spec: ContainerSpec) -> tuple[float, float]:
+    """A tray's hopper rate, parts/s, and exit speed, m/s (the spec's, or the defaults)."""
+    return (HOPPER_RATE if spec.hopper_rate is None else spec.hopper_rate,
+            HOPPER_SPEED if spec.hopper_speed is None else spec.hopper_speed)
+
+
 def check_container(spec: ContainerSpec) -> ContainerSpec:
     """Check every field; raise InvalidArgument naming the first that is wrong."""
     if spec.kind not in KINDS:
@@ -72,8 +94,9 @@ def check_container(spec: ContainerSpec) -> ContainerSpec:
     LIMITS['container.wall_thickness'].check('container.wall_thickness', spec.wall_thickness)
     LIMITS['container.floor_thickness'].check('container.floor_thickness',
                                               spec.floor_thickness)
-    if spec.drop_height is not None:
-        LIMITS['container.drop_height'].check('container.drop_height', spec.drop_height)
+    for key in ('drop_height', 'hopper_rate', 'hopper_speed'):
+        if getattr(spec, key) is not None:
+            LIMITS[f'container.{key}'].check(f'container.{key}', getattr(spec, key))
     if spec.kind == TRAY:
         cx, cy = check_vector('container.feeder_zone_center', spec.feeder_zone_center, 2)
         sx, sy = check_vector('container.feeder_zone_size', spec.feeder_zone_size, 2,

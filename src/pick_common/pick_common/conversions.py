@@ -108,7 +108,9 @@ def container_from_msg(msg: ContainerGeometry) -> ContainerSpec:
         wall_thickness=msg.wall_thickness, floor_thickness=msg.floor_thickness,
         feeder_zone_center=(msg.feeder_zone_center.x, msg.feeder_zone_center.y),
         feeder_zone_size=(msg.feeder_zone_size.x, msg.feeder_zone_size.y),
-        drop_height=or_default('container.drop_height', msg.drop_height, None))
+        drop_height=or_default('container.drop_height', msg.drop_height, None),
+        hopper_rate=or_default('container.hopper_rate', msg.hopper_rate, None),
+        hopper_speed=or_default('container.hopper_speed', msg.hopper_speed, None))
 
 
 def container_to_msg(spec: ContainerSpec) -> ContainerGeometry:
@@ -118,7 +120,9 @@ def container_to_msg(spec: ContainerSpec) -> ContainerGeometry:
         wall_thickness=spec.wall_thickness, floor_thickness=spec.floor_thickness,
         feeder_zone_center=Point(x=spec.feeder_zone_center[0], y=spec.feeder_zone_center[1]),
         feeder_zone_size=Vector3(x=spec.feeder_zone_size[0], y=spec.feeder_zone_size[1]),
-        drop_height=float(containers.drop_height(spec)))
+        drop_height=float(containers.drop_height(spec)),
+        hopper_rate=float(containers.hopper(spec)[0]),
+        hopper_speed=float(containers.hopper(spec)[1]))
 
 
 # ----------------------------------------------------------------------------- parts

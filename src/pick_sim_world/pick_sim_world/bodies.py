@@ -15,6 +15,7 @@ from pick_common.parts.geometry import PartGeometry
 from pick_common.parts.insets import inset_hull
 from pick_common.parts.materials import BodyValues
 from pick_common.parts.primitives import box, Hull
+from pick_common.specs import SceneSpec
 from pick_common.states import quaternion_multiply, rotate
 import trimesh
 
@@ -89,6 +90,20 @@ def create_container(engine: Engine, spec: ContainerSpec, origin: np.ndarray,
     body = engine.body(mass, shape, origin)
     engine.set_contact(body, surface, damping=0.0)
     return body
+
+
+def create_instances(engine: Engine, scene: SceneSpec, surface: BodyValues) -> list[Instance]:
+    """The scene's instances side by side along x, each with its container body and its own
+    generator (seeded by instance_seed), no parts yet."""
+    pitch = instance_pitch(scene.container)
+    out = []
+    for k in range(scene.instance_count):
+        origin = np.array([k * pitch, 0.0, 0.0])
+        seed = instance_seed(scene.seed, k)
+        out.append(Instance(k, seed, origin, create_container(engine, scene.container, origin,
+                                                              surface),
+                            np.random.default_rng(seed)))
+    return out
 
 
 def create_part(engine: Engine, shape: int, part: PartGeometry, pose: np.ndarray,

@@ -94,6 +94,16 @@ def pile_top(part: PartGeometry, region: tuple[float, float, float, float],
     return max(0.0, float(centres[over, 2].max()) + part.radius) if over.any() else 0.0
 
 
+def layer(rng: np.random.Generator, part: PartGeometry, spec: ContainerSpec, zone: str,
+          centres: np.ndarray, count: int) -> np.ndarray:
+    """The poses (count, 7) of a drop's next spawn layer(s) over `zone` of a container whose
+    parts have bounding-sphere centres `centres` (N, 3): from the container's drop height, or
+    just above the parts over the region where higher (pile_top; spawn_poses)."""
+    region = drop_region(spec, zone)
+    top = max(pile_top(part, region, centres), containers.drop_height(spec))
+    return spawn_poses(rng, part, region, top, count, zone)
+
+
 def spawn_poses(rng: np.random.Generator, part: PartGeometry,
                 region: tuple[float, float, float, float], top: float, count: int,
                 zone: str = 'container') -> np.ndarray:

@@ -4,15 +4,15 @@ It drops and feeds parts, vibrates trays, removes parts, and settles.
 
 Pure core: PyBullet (DIRECT mode, through engine.py, which simulates in centimetres and
 speaks SI), numpy and trimesh; no rclpy. `World` keeps the scene's state and delegates:
-bodies.py builds the scene, selection.py checks what a request names,
-spawning.py places new parts, tray.py moves the trays, stepping.py steps until the parts rest,
+bodies.py builds the scene, selection.py checks what a request names, spawning.py and
+hopper.py place new parts, tray.py moves the trays, stepping.py steps until the parts rest,
 health.py tells how an operation ended, camera.py takes pictures.
 
 Poses are (N, 7) float64 arrays, xyz in metres then an xyzw unit quaternion, expressed in the
 instance frame (origin at the centre of the container's inner floor, +Z up).
 """
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from contextlib import nullcontext
 from dataclasses import replace
 from functools import partial
@@ -29,7 +29,7 @@ from pick_common.parts.materials import body_values
 from pick_common.specs import CENTRE, check_scene, check_vibration, SceneSpec, Vibration
 from pick_common.states import PartStates, Progress, SettleReport
 
-from . import bodies, camera, health, selection, spawning, stepping
+from . import bodies, camera, health, hopper, selection, spawning, stepping
 from .bodies import Instance
 from .camera import Overlay
 from .config import check_physics, PhysicsConfig
@@ -47,11 +47,6 @@ class World:
         self._physics = check_physics(physics or PhysicsConfig())
         self._engine = Engine(self._physics.length_unit)
         self._tmp = tempfile.mkdtemp(prefix='pick_sim_world_')
-        self._instances: list[Instance] = []
-        self._bodies: dict[int, int] = {}        # part id -> body
-        self._owner: dict[int, int] = {}         # part id -> instance id
-        self._next_id = 0
-        self._sim_time = 0.0
         try:
             self.reset(scene or SceneSpec())
         except BaseException:
@@ -91,8 +86,7 @@ class World:
 
     def reset(self, scene: SceneSpec | None = None, seed: int | None = None) -> None:
         """Build `scene` (or rebuild the current one) with no parts; `seed` overrides its seed.
-        Everything is checked before the current world is touched: a bad scene raises and
-        leaves the world as it was."""
+        All is checked first: a bad scene raises and leaves the world as it was."""
         scene = scene or self._scene
         if seed is not None:
             scene = SceneSpec(scene.container, scene.part, scene.instance_count, seed)
@@ -104,12 +98,14 @@ class World:
         c = self._engine
         bodies.configure(c, self._physics, scene.container.kind)
         self._scene, self._part = scene, part
-        self._instances, self._bodies, self._owner = [], {}, {}
+        self._hull = part.visual.convex_hull.vertices     # a part's lowest point (hopper.py)
+        self._bodies: dict[int, int] = {}        # part id -> body
+        self._owner: dict[int, int] = {}         # part id -> instance id
         self._next_id, self._sim_time = 0, 0.0
         self._at_rest = True     # the last step run ended settled (the settle criterion)
         self._peaks: dict[int, float] = {}   # part id -> peak speed in this operation, m/s
-        # part id -> (world position, m; speed, m/s) of the parts that landed beside their
-        # container in this operation, parked until its end (stepping.step)
+        # part id -> (world position, m; speed, m/s): parts landed beside their container in
+        # this operation, parked until its end (stepping.step)
         self._landed: dict[int, tuple[np.ndarray, float]] = {}
         self._tray_speed = 0.0               # the tray's peak speed in this operation, m/s
         shutil.rmtree(self._tmp, ignore_errors=True)
@@ -117,12 +113,7 @@ class World:
         self._part_shape = bodies.create_part_shape(c, part, self._tmp)
         self._part_values, surface = body_values(part.spec.part_on_surface,
                                                  part.spec.part_on_part)
-        pitch = bodies.instance_pitch(scene.container)
-        for k in range(scene.instance_count):
-            origin = np.array([k * pitch, 0.0, 0.0])
-            body = bodies.create_container(c, scene.container, origin, surface)
-            seed = bodies.instance_seed(scene.seed, k)
-            self._instances.append(Instance(k, seed, origin, body, np.random.default_rng(seed)))
+        self._instances = bodies.create_instances(c, scene, surface)
         self._drive = None
         if scene.container.kind == containers.TRAY:
             self._drive = TrayDrive(c, [i.body for i in self._instances],
@@ -150,6 +141,10 @@ class World:
     def _instance_ids(self, instances: Iterable[int] | None) -> list[int]:
         return selection.instance_ids(instances, len(self._instances))
 
+    def _centres(self, k: int) -> np.ndarray:
+        """The bounding-sphere centres (N, 3) of instance k's parts, in its frame, m."""
+        return bodies.part_centres(self.snapshot([k]).poses, self._part)
+
     def snapshot(self, instances: Iterable[int] | None = None) -> PartStates:
         """Poses of the parts of `instances` (all when None), in their instance frames."""
         wanted = self._instance_ids(instances)
@@ -166,86 +161,94 @@ class World:
         return PartStates(np.array(ids, dtype=np.int64), owners, poses, inside, self._sim_time)
 
     # ----------------------------------------------------------------------------- drop
-    def drop_region(self, instance: int, zone: str) -> tuple[float, float, float, float]:
-        """Centre x, y and half extents x, y of where parts spawn, in the instance frame, m."""
-        return spawning.drop_region(self._scene.container, zone, instance)
-
-    def spawn_poses(self, instance: int, count: int, zone: str = 'container') -> np.ndarray:
-        """Random, non-overlapping spawn poses (count, 7) in the instance frame, above the parts
-        already over the region (spawning.spawn_poses)."""
-        region = self.drop_region(instance, zone)
-        state = self.snapshot([instance])
-        top = max(spawning.pile_top(self._part, region,
-                                    bodies.part_centres(state.poses, self._part)),
-                  containers.drop_height(self._scene.container))
-        return spawning.spawn_poses(self._instances[instance].rng, self._part, region, top,
-                                    count, zone)
-
     def drop(self, count: int, instances: Iterable[int] | None = None, zone: str = 'container',
              max_settle_time: float | None = None,
              progress: ProgressCallback | None = None) -> tuple[list[int], SettleReport]:
-        """Drop `count` parts into each instance (or its feeder zone) as a stream, then settle:
-        one spawn layer at a time from the container's drop height (containers.drop_height)
-        or just above the parts there where higher, the next when it has landed
-        (spawning.layer_interval), never a tall column (which sent parts through a 10 mm
-        floor). Returns the new part ids and the report of the whole operation. Raises
-        InvalidArgument when the count is out of range or the parts do not fit,
-        UnknownInstance for a bad instance id."""
+        """Drop `count` parts into each instance as a stream of spawn layers (spawning.layer,
+        each when the last has landed: never a tall column, which sent parts through a 10 mm
+        floor), or feed them from the tray's hopper (zone 'feeder', `_feed`); then settle.
+        The new part ids and the operation's report. Raises InvalidArgument for a count out
+        of range or parts that do not fit, UnknownInstance for a bad instance id."""
         targets = self._instance_ids(instances)
         count = spawning.check_count(count, {k: len(self._instances[k].part_ids)
                                              for k in targets}, self._part, self._scene.container)
-        per_layer = {k: int(np.prod(spawning.grid(self._part, self.drop_region(k, zone), zone)))
-                     for k in targets}
+        if zone == 'feeder':
+            return self._feed(targets, count, max_settle_time, progress)
+        spec = self._scene.container
+        per_layer = {k: int(np.prod(spawning.grid(self._part, spawning.drop_region(spec, zone, k),
+                                                  zone))) for k in targets}
         left = dict.fromkeys(targets, count)
+
+        def layer(_turn: int, new_ids: list[int]) -> bool:
+            for k in targets:
+                if n := min(per_layer[k], left[k]):
+                    inst = self._instances[k]
+                    new_ids += self._add_parts(inst, spawning.layer(
+                        inst.rng, self._part, spec, zone, self._centres(k), n))
+                    left[k] -= n
+            return any(left.values())
+
+        return self._stream(layer, spawning.layer_interval(
+            self._part, containers.drop_height(spec)), max_settle_time, progress)
+
+    def _feed(self, targets: list[int], count: int, max_settle_time: float | None,
+              progress: ProgressCallback | None) -> tuple[list[int], SettleReport]:
+        """Run each tray's hopper for count / rate s (hopper.py), a part leaving its outlet
+        each 1 / rate s where its place is free; what the time did not let out stays in it."""
+        out = hopper.outlet(self._scene.container, targets[0])
+
+        def release(turn: int, new_ids: list[int]) -> bool:
+            for k in targets if turn < count else ():
+                pose = hopper.release(self._instances[k].rng, self._part, self._hull, out,
+                                      self.snapshot([k]).poses)
+                if pose is not None:
+                    new_ids += self._add_parts(self._instances[k], pose[None], out.velocity)
+            return turn < count
+
+        return self._stream(release, 1.0 / out.rate, max_settle_time, progress)
+
+    def _stream(self, add: Callable[[int, list[int]], bool], interval: float, max_settle_time:
+                float | None, progress: ProgressCallback | None) -> tuple[list[int], SettleReport]:
+        """Add parts turn by turn (`add(turn, new_ids)`: true while `interval` s are stepped
+        before the next), landed parts frozen meanwhile; then settle. New ids and report."""
         new_ids: list[int] = []
         stream: list[SettleReport] = []
-        with self._freezer() as freezer:     # parts that landed rest while the next fall
-            while True:
-                for k in targets:
-                    n = min(per_layer[k], left[k])
-                    if n:
-                        new_ids += self._add_parts(self._instances[k],
-                                                   self.spawn_poses(k, n, zone))
-                        left[k] -= n
-                if not any(left.values()):
-                    break
-                stream.append(self._run('dropping', spawning.layer_interval(
-                    self._part, containers.drop_height(self._scene.container)),
-                                        progress, stop_when_settled=False, freezer=freezer))
+        with self._freezer() as freezer:
+            turn = 0
+            while add(turn, new_ids):
+                stream.append(self._run('dropping', interval, progress, stop_when_settled=False,
+                                        freezer=freezer))
                 if stream[-1].canceled:
                     break
+                turn += 1
             if not stream or not stream[-1].canceled:
                 stream.append(self._settle('dropping', max_settle_time, progress, freezer))
         return new_ids, self._finished(stream[-1], stream[:-1])
 
-    def _add_parts(self, inst: Instance, poses: np.ndarray) -> list[int]:
-        ids = []
+    def _add_parts(self, inst: Instance, poses: np.ndarray,
+                   velocity: Sequence[float] | None = None) -> list[int]:
+        """New parts at `poses` (instance frame), moving at `velocity` (m/s) or at rest."""
         self._at_rest = False
-        for pose in poses:
-            world_pose = np.concatenate([pose[:3] + inst.origin, pose[3:]])
-            body = bodies.create_part(self._engine, self._part_shape, self._part, world_pose,
-                                      self._part_values)
-            pid = self._next_id
-            self._next_id += 1
-            self._bodies[pid] = body
+        ids = list(range(self._next_id, self._next_id + len(poses)))
+        self._next_id += len(poses)
+        for pid, pose in zip(ids, poses, strict=True):
+            self._bodies[pid] = bodies.create_part(
+                self._engine, self._part_shape, self._part,
+                np.concatenate([pose[:3] + inst.origin, pose[3:]]), self._part_values)
             self._owner[pid] = inst.id
-            inst.part_ids.append(pid)
-            ids.append(pid)
+            if velocity is not None:
+                self._engine.set_velocity(self._bodies[pid], velocity)
+        inst.part_ids += ids
         return ids
 
     # ----------------------------------------------------------------------------- vibrate
     def vibrate(self, vibration: Vibration, instances: Iterable[int] | None = None,
                 max_settle_time: float | None = None,
                 progress: ProgressCallback | None = None) -> SettleReport:
-        """Move each tray along x(t) = amplitude sin(2 pi f t) for the duration, then settle.
-
-        With direction RANDOM, each tray's horizontal amplitude is first turned about the
-        vertical by an angle drawn from its instance's generator (so a seed gives the same
-        motions); with CENTRE, laid toward the tray's centre from its parts' centroid, for the
-        share of the duration that centroid's farthest normalised coordinate gives
-        (tray.centring_share; a tray whose parts are centred does not move). Raises
-        InvalidArgument for a bad vibration or an instance whose container is a bin.
-        """
+        """Move each tray along x(t) = amplitude sin(2 pi f t) for the duration (turned at
+        random by the instance's generator for RANDOM, toward the tray's centre for CENTRE:
+        tray.vibration_plan), then settle. Raises InvalidArgument for a bad vibration or an
+        instance whose container is a bin."""
         targets = self._instance_ids(instances)
         check_vibration(vibration)
         if self._drive is None:
@@ -258,16 +261,11 @@ class World:
             vibration, [self._instances[k].rng for k in targets], to_centre,
             self._physics.time_step, (size[0] / 2, size[1] / 2))
         self._drive.start(targets, amplitudes, vibration.frequency, dt, own)
-        drive = self._drive
         self._tray_speed = float(np.linalg.norm(amplitudes, axis=1).max()
                                  * 2.0 * math.pi * vibration.frequency)
-
-        def tell(p: Progress) -> bool:
-            return progress(replace(p, tray=drive.motion()))
-
         try:
-            report = self._run('vibrating', steps * dt, tell if progress else None,
-                               stop_when_settled=False, time_step=dt)
+            report = self._run('vibrating', steps * dt, progress and partial(
+                _with_tray, progress, self._drive), stop_when_settled=False, time_step=dt)
         finally:
             delivered = self._drive.stop()
         report.tray = delivered
@@ -289,9 +287,8 @@ class World:
         """
         ids = selection.part_ids(part_ids, self._bodies)
         touching = bodies.parts_touching(self._engine, self._bodies, ids)
-        # From a scene at rest, only the parts the removed ones touched settle at first: no
-        # other part felt a force change. The rest start frozen, and wake when a moving part
-        # comes near (freezing.py).
+        # From a scene at rest only the parts the removed ones touched settle at first; the
+        # rest felt no force change and start frozen, waking when a part nears (freezing.py).
         local = self._at_rest and self._physics.settle_freeze
         for pid in ids:
             self._take_out(pid)
@@ -339,9 +336,8 @@ class World:
             return self._run(phase, cap, progress, freezer=own)
 
     def _freezer(self) -> Freezer | nullcontext:
-        """What holds the parts that rest frozen through one operation's falls and settles
-        (freezing.py; the trays static meanwhile): a Freezer, or with `settle_freeze` off a
-        context of None."""
+        """What holds resting parts frozen through one operation's falls and settles, the trays
+        static meanwhile (freezing.py): a Freezer, or with `settle_freeze` off None's context."""
         p = self._physics
         if not p.settle_freeze:
             return nullcontext()
@@ -398,3 +394,7 @@ class World:
         return SettleReport(settled, out.steps * physics.time_step, out.wall_time, out.steps,
                             out.moving_ids, canceled=out.canceled)
 
+
+def _with_tray(progress: ProgressCallback, drive: TrayDrive, p: Progress) -> bool:
+    """Tell `progress` of a vibration's step with the motion the trays delivered so far."""
+    return progress(replace(p, tray=drive.motion()))

@@ -120,7 +120,13 @@ class WorldNode(Node):
                                        'x, y extent of the tray feeder zone, m')),
             drop_height=get('container.drop_height', containers.DROP_HEIGHT.get(kind, 0.0),
                             "how high over the floor parts arrive from, m (a bin's pour, a "
-                            "tray's hopper lip)", walls['container.drop_height']))
+                            "tray's hopper lip)", walls['container.drop_height']),
+            hopper_rate=get('container.hopper_rate', containers.HOPPER_RATE,
+                            "parts a tray's hopper lets out per second while it runs",
+                            walls['container.hopper_rate']),
+            hopper_speed=get('container.hopper_speed', containers.HOPPER_SPEED,
+                             "speed of the parts leaving a tray's hopper, m/s",
+                             walls['container.hopper_speed']))
         model = get('part.model', 'radial_capacitor',
                     f'built-in model ({", ".join(BUILTIN_MODELS)}) or mesh')
         dims, default_mass = {}, 0.0

@@ -65,14 +65,17 @@ class LocalBackend:
         policy = self._policy
         step = policy.decide(valid, on_table)
         reports = []
-        if step.feed:
-            reports.append(self._world.drop(step.feed, zone='feeder')[1])
-            policy.fed(step.feed)
+        fed = 0
+        if step.feed:       # the hopper may let out fewer than the dose (hopper.py)
+            ids, report = self._world.drop(step.feed, zone='feeder')
+            reports.append(report)
+            if fed := len(ids):
+                policy.fed(fed)
         if step.vibrates:
             reports += [self._world.vibrate(move) for move in self._file.moves]
             policy.vibrated()
         s = policy.state
-        return FeedStep(step.decision, step.feed, s.vibrations, s.feeds, s.in_feeder,
+        return FeedStep(step.decision, fed, s.vibrations, s.feeds, s.in_feeder,
                         tuple(reports))
 
     def rejoin(self, stop) -> bool:
