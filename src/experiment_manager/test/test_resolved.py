@@ -24,7 +24,9 @@ def test_the_record_holds_every_default_and_each_named_gripper(tmp_path):
     assert [g['name'] for g in ran['grasps']] == [g.name for g in file.grasps]
     assert ran['grasps'][0]['jaw_opening_mm'] == 11.0
     assert ran['tray']['hopper_lip_mm'] == 30.0 and ran['tray']['tray_mm'] == [195.0, 150.0, 27.0]
-    assert {'hopper_lip_mm', 'feeder_zone_mm'} <= set(ran['defaulted'])
+    assert (ran['tray']['hopper_rate'], ran['tray']['hopper_speed_mm_s']) == (10.0, 100.0)
+    assert {'hopper_lip_mm', 'hopper_rate', 'hopper_speed_mm_s', 'feeder_zone_mm'} <= set(
+        ran['defaulted'])
     assert ran['doses'] == {'feeder': 0, 'feeder_cup': 0}
     assert [a['name'] for a in ran['part']['aspects']] == [a.name for a in file.aspects]
     assert ran['requirements']['refill_interval_h'] == 4.0

@@ -22,8 +22,8 @@ from .part import GRASP_KEYS
 
 NAME = 'resolved.json'
 # the top keys of the file the report speaks of when the file leaves them out
-TOP_KEYS = ('tray_mm', 'feeder_zone_mm', 'hopper_lip_mm', 'bin_wall_mm', 'bin_drop_mm',
-            'moves')
+TOP_KEYS = ('tray_mm', 'feeder_zone_mm', 'hopper_lip_mm', 'hopper_rate', 'hopper_speed_mm_s',
+            'bin_wall_mm', 'bin_drop_mm', 'moves')
 
 
 def _mm(values) -> list[float]:
@@ -56,7 +56,9 @@ def resolved(file: ExperimentFile) -> dict:
         'auto_grasps': file.auto_grasps,
         'tray': {'tray_mm': _mm(tray.inner_size), 'wall_mm': round(tray.wall_thickness / MM, 6),
                  'feeder_zone_mm': {'center': _mm((cx, cy)), 'size': _mm((sx, sy))},
-                 'hopper_lip_mm': round(tray.drop_height / MM, 6)},
+                 'hopper_lip_mm': round(tray.drop_height / MM, 6),
+                 'hopper_rate': tray.hopper_rate,
+                 'hopper_speed_mm_s': round(tray.hopper_speed / MM, 6)},
         'bin_wall_mm': round(file.bin_wall / MM, 6),
         'doses': {e.id: e.max_feed for e in file.experiments if kind_of(e).feeds},
         'moves': [{'amplitude_mm': _mm(m.amplitude), 'frequency_hz': m.frequency,

@@ -13,7 +13,14 @@ from functools import partial
 import json
 from typing import Annotated, Any
 
-from pick_common.containers import BIN, DROP_HEIGHT, TRAY, TRAY_DEFAULT_SIZE
+from pick_common.containers import (
+    BIN,
+    DROP_HEIGHT,
+    HOPPER_RATE,
+    HOPPER_SPEED,
+    TRAY,
+    TRAY_DEFAULT_SIZE,
+)
 from pick_common.parts import materials
 from pick_common.parts.models import BUILTIN_MODELS
 from pick_common.parts.spec import UNITS
@@ -273,7 +280,12 @@ class FileKeys(Section):
     # how high over the floor parts arrive from: a bin's pour, the tray's hopper lip
     bin_drop_mm: Number(0.0, 1000.0) = DROP_HEIGHT[BIN] / MM
     hopper_lip_mm: Number(0.0, 1000.0) = DROP_HEIGHT[TRAY] / MM
-    # where the hopper drops on the tray; None: ContainerSpec.tray's (assumed)
+    # the tray's hopper (containers.HOPPER_RATE, HOPPER_SPEED, both assumed): the parts it lets
+    # out per second while it runs, and their speed onto the tray leaving its outlet, mm/s
+    hopper_rate: Number(0.1, 1000.0) = HOPPER_RATE
+    hopper_speed_mm_s: Number(0.0, 2000.0, low_open=True) = HOPPER_SPEED / MM
+    # where the hopper drops on the tray, its outlet the edge farther from the tray's centre
+    # along x; None: ContainerSpec.tray's (assumed)
     feeder_zone_mm: FeederZone | None = None
     experiments: Annotated[list[Any], BeforeValidator(partial(
         list_of, low=1, high=MAX_EXPERIMENTS, what=f'1..{MAX_EXPERIMENTS} experiments'))]

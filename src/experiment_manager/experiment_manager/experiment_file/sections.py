@@ -41,7 +41,8 @@ def requirements(r: schema.RequirementsSection) -> Requirements:
 
 def tray(top: schema.FileKeys) -> ContainerSpec:
     tray = replace(ContainerSpec.tray(tuple(MM * s for s in top.tray_mm)),
-                   drop_height=MM * top.hopper_lip_mm)
+                   drop_height=MM * top.hopper_lip_mm, hopper_rate=top.hopper_rate,
+                   hopper_speed=MM * top.hopper_speed_mm_s)
     checked_as(check_container, tray, 'tray_mm')
     zone = top.feeder_zone_mm
     if zone is not None:

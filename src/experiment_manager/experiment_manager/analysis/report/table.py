@@ -88,21 +88,30 @@ class Feeder(Section):
 
 
 # the file keys the feeding words give (report.read: those the file does not set)
-FEEDING = ('hopper_lip_mm', 'feeder_zone_mm', 'tray_mm')
+FEEDING = ('hopper_lip_mm', 'hopper_rate', 'hopper_speed_mm_s', 'feeder_zone_mm', 'tray_mm')
 
 
 def feeding(tray: dict, dose: int, unset: tuple[str, ...] = ()) -> str:
     """How the parts reached the tray, in words, from what the run ran with (resolved.json's
-    `tray`, mm); `unset`: those of FEEDING the file left to their defaults."""
+    `tray`, mm); `unset`: those of FEEDING the file left to their defaults. A run from before
+    the hopper metered (no `hopper_rate`) had its parts dropped from the lip or the pile."""
     (cx, cy), (sx, sy) = tray['feeder_zone_mm']['center'], tray['feeder_zone_mm']['size']
     x, y, z = tray['tray_mm']
-    return (f'The hopper fed the parts from {fmt(tray["hopper_lip_mm"])} mm over the plate '
-            f'(`hopper_lip_mm`), or from just above the pile where it stood higher, onto the '
-            f'feeder zone x {fmt(cx - sx / 2, 4)} to {fmt(cx + sx / 2, 4)} mm, '
-            f'y {fmt(cy - sy / 2, 4)} to {fmt(cy + sy / 2, 4)} mm (`feeder_zone_mm`) '
-            f'of the {fmt(x)} x {fmt(y)} mm tray with {fmt(z)} mm walls (`tray_mm`), '
+    lip = cx - sx / 2 if cx <= 0 else cx + sx / 2
+    how = (f'The hopper let the parts out of its outlet {fmt(tray["hopper_lip_mm"])} mm over '
+           f'the plate (`hopper_lip_mm`), at x {fmt(lip, 4)} mm across y {fmt(cy - sy / 2, 4)} '
+           f'to {fmt(cy + sy / 2, 4)} mm (the outer edge of `feeder_zone_mm`), '
+           f'{fmt(tray["hopper_rate"])} parts a second (`hopper_rate`) moving onto the tray at '
+           f'{fmt(tray["hopper_speed_mm_s"])} mm/s (`hopper_speed_mm_s`), for the time a dose '
+           'takes at that rate, a part waiting where the pile stood at the outlet, '
+           if 'hopper_rate' in tray else
+           f'The hopper fed the parts from {fmt(tray["hopper_lip_mm"])} mm over the plate '
+           f'(`hopper_lip_mm`), or from just above the pile where it stood higher, onto the '
+           f'feeder zone x {fmt(cx - sx / 2, 4)} to {fmt(cx + sx / 2, 4)} mm, '
+           f'y {fmt(cy - sy / 2, 4)} to {fmt(cy + sy / 2, 4)} mm (`feeder_zone_mm`) ')
+    return (how + f'of the {fmt(x)} x {fmt(y)} mm tray with {fmt(z)} mm walls (`tray_mm`), '
             + (f'at most {dose} parts a feed, the fill to max* going on over several '
                'vibrations (`max_feed`).' if dose else
-               'the whole shortfall to max* at once (`max_feed` would dose it).')
+               'a dose of the whole shortfall to max* (`max_feed` would limit it).')
             + (f' The file sets no {", ".join(f"`{k}`" for k in unset)}: the run took '
                + ('its default.' if len(unset) == 1 else 'their defaults.') if unset else ''))
