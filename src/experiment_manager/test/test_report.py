@@ -61,16 +61,23 @@ def test_a_run_gets_its_report_files(run_dir):
     assert re.search(r'The cell would pick [\d.]+ parts per hour \(mean of 1 run; required '
                      r'60\): 4 s per pick', text)
     # how the parts reached the tray, from the file's keys (the default tray, no dose)
-    assert ('The hopper fed the parts from 30 mm over the plate (`hopper_lip_mm`), or from just '
-            'above the pile where it stood higher, onto the feeder zone x -97.5 to -48.75 mm, '
-            'y -60 to 60 mm (`feeder_zone_mm`) of the 195 x 150 mm tray with 27 mm walls '
-            '(`tray_mm`), the whole shortfall to max* at once (`max_feed` would dose it). The '
-            'file sets no `hopper_lip_mm`, `feeder_zone_mm`, `tray_mm`: the run took their '
-            'defaults.') in text
+    assert ('The hopper let the parts out of its outlet 30 mm over the plate (`hopper_lip_mm`), '
+            'at x -97.5 mm across y -60 to 60 mm (the outer edge of `feeder_zone_mm`), 10 parts '
+            'a second (`hopper_rate`) moving onto the tray at 100 mm/s (`hopper_speed_mm_s`), '
+            'for the time a dose takes at that rate, a part waiting where the pile stood at the '
+            'outlet, of the 195 x 150 mm tray with 27 mm walls (`tray_mm`), a dose of the whole '
+            'shortfall to max* (`max_feed` would limit it). The file sets no `hopper_lip_mm`, '
+            '`hopper_rate`, `hopper_speed_mm_s`, `feeder_zone_mm`, `tray_mm`: the run took '
+            'their defaults.') in text
     tray = resolved.read(run_dir)['tray']
     dosed = feeding(tray, 12)
     assert dosed.endswith('at most 12 parts a feed, the fill to max* going on over several '
                           'vibrations (`max_feed`).')
+    old = {k: v for k, v in tray.items() if not k.startswith('hopper_') or k == 'hopper_lip_mm'}
+    assert feeding(old, 0).startswith(     # a run's record from before the hopper metered
+        'The hopper fed the parts from 30 mm over the plate (`hopper_lip_mm`), or from just '
+        'above the pile where it stood higher, onto the feeder zone x -97.5 to -48.75 mm, '
+        'y -60 to 60 mm (`feeder_zone_mm`) of the 195 x 150 mm tray')
     assert feeding(tray, 0, ('hopper_lip_mm',)).endswith(
         'The file sets no `hopper_lip_mm`: the run took its default.')
     # a header people read, and each verdict coloured by what it says
@@ -351,7 +358,7 @@ def test_pictures_re_simulate_the_recorded_iteration(run_dir):
                 if r['check'] == '0' and int(r['grasp']) >= 0
                 and (group is None or int(r['group']) == group)}
     drawn = stops('emptying') | stops('sweep', int(captions['tray.png'].split()[0]))
-    expected = {'bin.png', 'tray.png'} | {
+    expected = {'bin.png', 'tray.png', 'feed.png'} | {
         f'stopped_{name}.png' for stage, (name, _) in pictures.STOPPED.items()
         if stage in drawn and stage != STAGE_PLACEABILITY}
     if any(STAGE_PLACEABILITY in stops(e.id) for e in file.experiments):
@@ -364,6 +371,9 @@ def test_pictures_re_simulate_the_recorded_iteration(run_dir):
             assert 'poses identical to the recorded ones' in caption, caption
         with open(os.path.join(run_dir, name), 'rb') as f:
             assert f.read(8) == b'\x89PNG\r\n\x1a\n'
+    # the first feed drawn as it left the tray, then after the cycle, as recorded
+    assert 'poses identical to the recorded first check' in captions['feed.png']
+    assert 'the tray after the first feed of `feeder`' in captions['feed.png']
     if 'stopped_placeability.png' in captions:
         assert 'mm past the placing surface' in captions['stopped_placeability.png']
     assert 'green: the first pick' in captions['bin.png']

@@ -6,6 +6,8 @@ settled poses are identical to the recorded ones, which is checked and said in t
   (green, a valid grasp) and the gripper of a rejected part at the tilt nearest 0, the most
   vertical approach (red: it hits the bin or a neighbour);
 - `tray.png`: the first table_sweep iteration at the count nearest the optimum n*;
+- `feed.png`: the first feeder_emptying iteration's tray after its first feed (the pile by the
+  hopper's outlet) and after the moves that follow it;
 - `stopped_container.png`, `stopped_neighbour.png`: in the bin (else the tray) above, the first
   part the stage stopped, its gripper in red at the most vertical approach;
 - `stopped_placeability.png`: the first part placeability stopped, in its place orientation on
@@ -16,17 +18,19 @@ import csv
 import json
 import os
 
+from feeder_controller.policy import FeederPolicy
 import matplotlib.image
 import matplotlib.pyplot as plt
 import numpy as np
 from pick_common.specs import SceneSpec
+from pick_sim_world import hopper
 from pick_sim_world.world import Overlay, World
 from pick_validity.geometry import BoxShape, Shape
 from pick_validity.results import STAGE_CONTAINER, STAGE_NEIGHBOUR, STAGE_PLACEABILITY
 from pick_validity.validity import Validator
 from scipy.spatial.transform import Rotation
 
-from ..experiment_file import BIN_EMPTYING, ExperimentFile, TABLE_SWEEP
+from ..experiment_file import BIN_EMPTYING, ExperimentFile, FEEDER_EMPTYING, TABLE_SWEEP
 from ..experiment_file.plan import plan, Unit
 from . import part_sheet
 from . import summary as summary_model
@@ -225,6 +229,40 @@ def tray_picture(file: ExperimentFile, summary: dict, run_dir: str,
             f'{"identical to" if same else "DIFFERENT from"} the recorded ones).')
 
 
+def feed_picture(file: ExperimentFile, summary: dict, run_dir: str,
+                 captions: dict[str, str]) -> str | None:
+    """feed.png: the tray of the first feeder_emptying iteration as its first feed left it,
+    the pile by the hopper's outlet, before the vibrations that centre it, beside the tray
+    after them; the latter checked against the recorded poses of its first check. Returns
+    its caption (None: nothing to draw)."""
+    exp = file.first_of(FEEDER_EMPTYING)
+    if exp is None or exp.id not in summary['experiments']:
+        return None
+    unit = plan(file, exp, summary['experiments'])[0]
+    rows = _rows(run_dir, 'parts', exp.id)
+    dose = FeederPolicy(unit.feeder).decide(0, 0).feed
+    with World(SceneSpec(unit.container, file.part, 1, unit.seed)) as world:
+        ids, report = world.drop(dose, zone='feeder')
+        fed = world.render(*SIZE, **_camera(unit))
+        for move in file.moves:
+            world.vibrate(move)
+        after = world.render(*SIZE, **_camera(unit))
+        recorded = {int(r['part_id']) for r in rows if r['check'] == '0'}
+        same = bool(rows) and _same_as_recorded(
+            world, [r for r in rows if int(r['part_id']) in recorded], 0)
+    _save(os.path.join(run_dir, 'feed.png'), np.hstack([fed, after]))
+    out = hopper.outlet(unit.container)
+    came = ('all came out' if len(ids) == dose else
+            f'{len(ids)} came out (the rest waited where the pile stood at the outlet)')
+    end = '-x' if out.inward > 0 else '+x'
+    return (f'Left: the tray after the first feed of `{exp.id}` iteration 1 (seed {unit.seed}): '
+            f'a dose of {dose} let out of the hopper over {dose / out.rate:g} s, {came}, '
+            f"{len(report.landed_ids)} spilled; the outlet is the {end} end's edge, "
+            f'{out.height * 1000:g} mm up. Right: after the {len(file.moves)} moves of the '
+            f'cycle (`moves`); re-simulated: poses '
+            f'{"identical to" if same else "DIFFERENT from"} the recorded first check.')
+
+
 def write(file: ExperimentFile, run_dir: str) -> dict[str, str]:
     """Render the pictures of a finished run; returns {file name: caption}, also written to
     pictures.json for the report."""
@@ -233,7 +271,8 @@ def write(file: ExperimentFile, run_dir: str) -> dict[str, str]:
     summary = {'experiments': {k: v.model_dump(by_alias=True, exclude_unset=True)
                                for k, v in typed.experiments.items()}}
     captions: dict[str, str] = {}
-    for name, draw in (('bin.png', bin_picture), ('tray.png', tray_picture)):
+    for name, draw in (('bin.png', bin_picture), ('tray.png', tray_picture),
+                       ('feed.png', feed_picture)):
         caption = draw(file, summary, run_dir, captions)
         if caption:
             captions[name] = caption
