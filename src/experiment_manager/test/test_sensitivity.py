@@ -159,8 +159,12 @@ def test_the_repeats_ran_with_their_scenario_and_the_summary_compares_them(sens)
     assert len({r['seed'] for r in by_id.values()}) == 1
     base = by_id['feeder']
     moved = [k for k, r in by_id.items() if k != 'feeder' and _run(r) != _run(base)]
-    assert set(moved) >= {'feeder@materials_part_on_surface_lateral_friction_low',
-                          'feeder@gripper_body_diameter_mm_high'}, moved
+    assert 'feeder@materials_part_on_surface_lateral_friction_low' in moved, moved
+    # the gripper reached the checks: on the same scenes, a wider body finds fewer valid
+    checks = read_csv(os.path.join(directory, 'checks.csv'))
+    valid = {k: [int(c['valid']) for c in checks if c['experiment'] == k]
+             for k in ('feeder', 'feeder@gripper_body_diameter_mm_high')}
+    assert sum(valid['feeder@gripper_body_diameter_mm_high']) < sum(valid['feeder']), valid
     s = summary['experiments']['robust']
     assert set(summary['repeats']) == {f'feeder@{x["name"]}' for x in s['scenarios']}
     assert [x['name'] for x in s['inputs']] == ['materials.part_on_surface.lateral_friction',
