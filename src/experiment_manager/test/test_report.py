@@ -382,6 +382,38 @@ def test_pictures_re_simulate_the_recorded_iteration(run_dir):
     assert '## Pictures' in text and '![bin.png](bin.png)' in text
 
 
+SPILLING = """
+id: spilling
+seed: 7
+part: {model: radial_capacitor}
+tray_mm: [195, 150, 6]        # walls lower than a capacitor is long: a throw spills
+moves: [spread]
+experiments:
+  - {id: feeder, type: feeder_emptying, iterations: 1, parts: 30, optimal_range: [10, 20],
+     max_vibrations: 10}
+"""
+
+
+def test_a_run_that_spilled_is_drawn_before_and_after_the_move_that_spilled(tmp_path):
+    from experiment_manager.analysis.results import read_csv, ResultsWriter
+    from experiment_manager.running import resimulate
+    from experiment_manager.running.local_backend import LocalBackend
+    from experiment_manager.running.scheduler import Runner
+    file = experiment_file.parse(SPILLING)
+    with LocalBackend() as backend, ResultsWriter(str(tmp_path), file.text) as writer:
+        Runner(file, [backend], writer).run()
+    spilled = int(read_csv(str(tmp_path / 'iterations.csv'))[0]['spilled'])
+    assert spilled > 0
+    captions = pictures.write(file, str(tmp_path), {'spill.png': resimulate.spill_picture})
+    caption = captions['spill.png']
+    move = int(re.search(r're-simulated to move (\d+) of the run', caption)[1])
+    over = int(re.search(r'(\d+) part\(s\) went over', caption)[1])
+    assert f'it spilled {spilled} parts' in caption and 1 <= over <= spilled
+    assert 1 <= move <= 10 and 'landing beside the tray: part ' in caption
+    with open(tmp_path / 'spill.png', 'rb') as f:
+        assert f.read(8) == b'\x89PNG\r\n\x1a\n'
+
+
 def test_why_parts_were_turned_down_is_counted_per_stage():
     from experiment_manager.analysis import stages
     rows = [{'experiment': 'sweep', 'checked': 10, 'outside': 1, 'candidates': 8,

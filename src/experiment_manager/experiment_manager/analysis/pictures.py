@@ -8,15 +8,19 @@ settled poses are identical to the recorded ones, which is checked and said in t
 - `tray.png`: the first table_sweep iteration at the count nearest the optimum n*;
 - `feed.png`: the first feeder_emptying iteration's tray after its first feed (the pile by the
   hopper's outlet) and after the moves that follow it;
+- `spill.png` (drawn by running/resimulate.py, passed in): the first feeder run that spilled,
+  re-simulated to the move that spilled, the tray before and after it;
 - `stopped_container.png`, `stopped_neighbour.png`: in the bin (else the tray) above, the first
   part the stage stopped, its gripper in red at the most vertical approach;
 - `stopped_placeability.png`: the first part placeability stopped, in its place orientation on
   the placing surface with the gripper at its best tilt (drawn as the part sheet draws it).
 """
 
+from collections.abc import Callable, Mapping
 import csv
 import json
 import os
+from types import MappingProxyType
 
 from feeder_controller.policy import FeederPolicy
 import matplotlib.image
@@ -40,6 +44,9 @@ SIZE = (800, 600)
 STOPPED = {STAGE_PLACEABILITY: ('placeability', 'the placing surface'),
            STAGE_CONTAINER: ('container', 'the bin'), STAGE_NEIGHBOUR: ('neighbour', 'a neighbour')}
 GREEN, RED = (0.1, 0.8, 0.1, 0.55), (0.9, 0.1, 0.1, 0.55)
+# a picture's drawer: (file, the summary's experiments as plan reads them, run directory, the
+# captions so far) -> its caption, None when it has nothing to draw
+Drawer = Callable[['ExperimentFile', dict, str, dict[str, str]], str | None]
 
 
 def gripper_overlays(shapes: tuple[Shape, ...], pose, rgba) -> list[Overlay]:
@@ -79,12 +86,14 @@ def _same_as_recorded(world: World, rows: list[dict], group: int) -> bool:
                                              strict=True)}
 
 
-def _camera(unit: Unit) -> dict:
+def camera(unit: Unit) -> dict:
+    """The camera that shows a unit's whole container (World.render's keywords)."""
     x, y, z = unit.container.inner_size
     return {'distance': 1.7 * max(x, y), 'target': (0.0, 0.0, z / 2)}
 
 
-def _save(path: str, image: np.ndarray) -> None:
+def save(path: str, image: np.ndarray) -> None:
+    """A picture (H, W, 3) as a PNG file."""
     matplotlib.image.imsave(path, image)
 
 
@@ -121,9 +130,8 @@ def stopped_in_world(world: World, validator: Validator, unit: Unit, rows: list[
         row = _first_stopped(rows, stage)
         if f'stopped_{name}.png' in captions or row is None:
             continue
-        camera = _camera(unit)
-        image = world.render(*SIZE, overlays=_stopped_gripper(validator, row), **camera)
-        _save(os.path.join(run_dir, f'stopped_{name}.png'), image)
+        image = world.render(*SIZE, overlays=_stopped_gripper(validator, row), **camera(unit))
+        save(os.path.join(run_dir, f'stopped_{name}.png'), image)
         captions[f'stopped_{name}.png'] = (
             f'Stopped at {name} collision: part {row["part_id"]} of `{exp_id}` iteration 1 '
             f'(grasp {validator.geometry.grasps[int(row["grasp"])].name}), its gripper in red at '
@@ -197,8 +205,8 @@ def bin_picture(file: ExperimentFile, summary: dict, run_dir: str,
                          f'{grasps[int(rejected["grasp"])].name}) at the most vertical '
                          f'approach, rejected: it hits {STOPPED[int(rejected["stage"])][1]}')
         stopped_in_world(world, validator, unit, parts, exp.id, run_dir, captions)
-        image = world.render(*SIZE, overlays=overlays, **_camera(unit))
-    _save(os.path.join(run_dir, 'bin.png'), image)
+        image = world.render(*SIZE, overlays=overlays, **camera(unit))
+    save(os.path.join(run_dir, 'bin.png'), image)
     size = ' x '.join(f'{s * 1000:g}' for s in unit.container.inner_size)
     return (f'The settled {size} mm bin of `{exp.id}` iteration 1 ({unit.parts} parts, seed '
             f'{unit.seed}; re-simulated: poses '
@@ -220,10 +228,10 @@ def tray_picture(file: ExperimentFile, summary: dict, run_dir: str,
     rows = [r for r in _rows(run_dir, 'parts', exp.id) if int(r['group']) == n]
     with _settle(file, unit) as world:
         same = _same_as_recorded(world, rows, n)
-        image = world.render(*SIZE, **_camera(unit))
+        image = world.render(*SIZE, **camera(unit))
         stopped_in_world(world, Validator(file.for_experiment(exp).setup, world.part), unit,
                          rows, exp.id, run_dir, captions)
-    _save(os.path.join(run_dir, 'tray.png'), image)
+    save(os.path.join(run_dir, 'tray.png'), image)
     return (f'{n} parts settled on the tray (`{exp.id}`, the tested count nearest n* = '
             f'{n_star}, iteration 1, seed {unit.seed}; re-simulated: poses '
             f'{"identical to" if same else "DIFFERENT from"} the recorded ones).')
@@ -243,14 +251,14 @@ def feed_picture(file: ExperimentFile, summary: dict, run_dir: str,
     dose = FeederPolicy(unit.feeder).decide(0, 0).feed
     with World(SceneSpec(unit.container, file.part, 1, unit.seed)) as world:
         ids, report = world.drop(dose, zone='feeder')
-        fed = world.render(*SIZE, **_camera(unit))
+        fed = world.render(*SIZE, **camera(unit))
         for move in file.moves:
             world.vibrate(move)
-        after = world.render(*SIZE, **_camera(unit))
+        after = world.render(*SIZE, **camera(unit))
         recorded = {int(r['part_id']) for r in rows if r['check'] == '0'}
         same = bool(rows) and _same_as_recorded(
             world, [r for r in rows if int(r['part_id']) in recorded], 0)
-    _save(os.path.join(run_dir, 'feed.png'), np.hstack([fed, after]))
+    save(os.path.join(run_dir, 'feed.png'), np.hstack([fed, after]))
     out = hopper.outlet(unit.container)
     came = ('all came out' if len(ids) == dose else
             f'{len(ids)} came out (the rest waited where the pile stood at the outlet)')
@@ -263,16 +271,18 @@ def feed_picture(file: ExperimentFile, summary: dict, run_dir: str,
             f'{"identical to" if same else "DIFFERENT from"} the recorded first check.')
 
 
-def write(file: ExperimentFile, run_dir: str) -> dict[str, str]:
-    """Render the pictures of a finished run; returns {file name: caption}, also written to
-    pictures.json for the report."""
+def write(file: ExperimentFile, run_dir: str, more: Mapping[str, Drawer] = MappingProxyType({})
+          ) -> dict[str, str]:
+    """Render the pictures of a finished run, and `more` ({file name: its drawer}, drawn by a
+    later room: running.resimulate's run again to the move that spilled); returns {file name:
+    caption}, also written to pictures.json for the report."""
     typed = summary_model.read(os.path.join(run_dir, 'summary.json'))
     # the experiments' summaries as the scheduler keeps them, which plan() reads
     summary = {'experiments': {k: v.model_dump(by_alias=True, exclude_unset=True)
                                for k, v in typed.experiments.items()}}
     captions: dict[str, str] = {}
     for name, draw in (('bin.png', bin_picture), ('tray.png', tray_picture),
-                       ('feed.png', feed_picture)):
+                       ('feed.png', feed_picture), *more.items()):
         caption = draw(file, summary, run_dir, captions)
         if caption:
             captions[name] = caption

@@ -102,10 +102,12 @@ class RunSession:
         try:
             try:
                 from ..analysis import pictures  # imports PyBullet: only here, when made
+                from ..running import resimulate
             except ImportError as exc:
                 self._logger.warning(f'no pictures: {exc}')
             else:
-                pictures.write(self.file, self.run_dir)
+                pictures.write(self.file, self.run_dir,
+                               {'spill.png': resimulate.spill_picture})
             part_sheet.write_account(self.file, self.run_dir)
             return report.write(self.run_dir)
         except Exception as exc:  # the results stand without their report
