@@ -414,3 +414,40 @@ def test_run_check_says_what_the_scenarios_add(tmp_path, capsys):
     assert run_main(['--check', '--adaptive', SENSITIVITY, '--output', str(tmp_path)]) == 0
     assert 'plan: 2 experiment(s), at most 9 iterations (sampling adaptive' \
         in capsys.readouterr().out
+
+
+def test_the_trays_hopper_and_walls_are_inputs_of_the_repeats_on_the_tray():
+    f = experiment_file.parse(sensitivity(
+        'iterations: 1, of: [sweep, emptying], inputs: {'
+        'tray.hopper_rate: {low: 5, high: 40, source: a}, '
+        'tray.wall_mm: {low: 20, high: 40, source: b}, '
+        'tray.hopper_speed_mm_s: {low: 50, high: 300, source: c}, '
+        'tray.hopper_lip_mm: {low: 15, high: 50, source: d}}'))
+    robust = f.experiment('robust')
+    assert [(x.name, x.base) for x in robust.inputs] == [
+        ('tray.hopper_rate', 10.0), ('tray.wall_mm', 27.0), ('tray.hopper_speed_mm_s', 100.0),
+        ('tray.hopper_lip_mm', 30.0)]
+
+    def tray(exp_id):
+        return plan(f, f.experiment(exp_id), {})[0].container
+    assert tray('sweep') == f.tray
+    assert tray('sweep@tray_hopper_rate_low').hopper_rate == 5.0
+    assert tray('sweep@tray_wall_mm_high').inner_size == (0.195, 0.15, 0.04)
+    assert tray('sweep@tray_hopper_speed_mm_s_high').hopper_speed == pytest.approx(0.3)
+    assert tray('sweep@tray_hopper_lip_mm_low').drop_height == pytest.approx(0.015)
+    # the bin's emptying runs in its bin whatever the tray
+    assert f.experiment('emptying@tray_wall_mm_high').bin_from == 'bins'
+
+
+@pytest.mark.parametrize('text, field, rule', [
+    ('iterations: 1, of: [emptying], inputs: {tray.hopper_rate: {low: 5, high: 40, '
+     'source: x}}', r'experiments\[3\]\.inputs\.tray\.hopper_rate',
+     'none of the experiments of `of` runs on it'),
+    ('iterations: 1, of: [sweep], inputs: {tray.wall_mm: {low: 2, high: 40, source: x}}',
+     r'experiments\[3\]\.inputs\.tray\.wall_mm\.low', 'must be >= 5'),
+    ('iterations: 1, of: [sweep], inputs: {tray.hopper_speed_mm_s: {low: 0, high: 40, '
+     'source: x}}', r'experiments\[3\]\.inputs\.tray\.hopper_speed_mm_s\.low', 'must be > 0'),
+])
+def test_a_tray_input_that_cannot_apply_is_named(text, field, rule):
+    with pytest.raises(InvalidArgument, match=field + '.*' + rule):
+        experiment_file.parse(sensitivity(text))

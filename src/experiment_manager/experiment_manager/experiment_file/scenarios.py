@@ -6,9 +6,12 @@ The inputs (`INPUTS`), in the file's units: each contact pair's friction, rollin
 spinning arms and restitution (materials.part_on_surface.*, materials.part_on_part.*), the
 part's mass (part.mass_g), the gripper's dimensions (gripper.*), and the table moves'
 amplitude, frequency and duration as factors on every move of the cycle (moves.*_scale: the
-cycle may mix moves, so one number in Hz or s would not say which), and the height drop tests
+cycle may mix moves, so one number in Hz or s would not say which), the height drop tests
 drop from (drop_test.height_mm: of a sensitivity whose experiments are all drop tests of one
-height; a calibration fits it as the effective height of the user's drops). The design:
+height; a calibration fits it as the effective height of the user's drops), and the tray's
+hopper and walls (tray.hopper_lip_mm, tray.hopper_rate, tray.hopper_speed_mm_s,
+tray.wall_mm: the repeats of the experiments that run on the tray run on the tray they make,
+tray_of). The design:
 - one at a time: a scenario at each input's low and one at its high, the others at the file's
   values (`<input>_low`, `<input>_high`, dots as underscores);
 - joint (`joint: K`): K scenarios of a Latin hypercube over all the inputs' ranges (McKay,
@@ -30,6 +33,8 @@ import itertools
 import zlib
 
 import numpy as np
+from pick_common import containers
+from pick_common.containers import check_container, ContainerSpec
 from pick_common.errors import check_number, InvalidArgument
 from pick_common.parts.materials import body_values
 from pick_common.specs import check_vibration, Vibration
@@ -56,6 +61,11 @@ INPUTS = {
     'moves.frequency_scale': ('moves', 'frequency', 1.0, 0.0, None, True),
     'moves.duration_scale': ('moves', 'duration', 1.0, 0.0, None, True),
     'drop_test.height_mm': ('drop_test', 'height', MM, 0.0, 1000.0, False),
+    # the tray's hopper and walls: the repeats that run on the tray run on the tray they make
+    'tray.hopper_lip_mm': ('tray', 'drop_height', MM, 0.0, 1000.0, False),
+    'tray.hopper_rate': ('tray', 'hopper_rate', 1.0, 0.1, 1000.0, False),
+    'tray.hopper_speed_mm_s': ('tray', 'hopper_speed', MM, 0.0, 2000.0, True),
+    'tray.wall_mm': ('tray', 'wall', MM, 5.0, 2000.0, False),
 }
 DROP_HEIGHT = 'drop_test.height_mm'     # the drop tests' height: of `of`'s drop tests only
 MAX_REPEATS = 200    # scenarios x experiments repeated, per sensitivity experiment
@@ -67,11 +77,33 @@ def drop_height(scenario: Scenario) -> float | None:
     return None if value is None else value * INPUTS[DROP_HEIGHT][2]
 
 
-def base_value(name: str, setup: Setup, mass: float, where: str = '') -> float:
+def tray_of(scenario: Scenario, tray: ContainerSpec) -> ContainerSpec | None:
+    """The tray a scenario makes of the file's `tray` (None: it sets no tray input)."""
+    values = {INPUTS[k][1]: v * INPUTS[k][2] for k, v in scenario.values
+              if INPUTS[k][0] == 'tray'}
+    if not values:
+        return None
+    x, y, z = tray.inner_size
+    return replace(tray, inner_size=(x, y, values.pop('wall', z)), **values)
+
+
+def _tray_value(attr: str, tray: ContainerSpec) -> float:
+    """The tray's value of a tray input's attribute, SI."""
+    if attr == 'wall':
+        return tray.inner_size[2]
+    if attr == 'drop_height':
+        return containers.drop_height(tray)
+    return dict(zip(('hopper_rate', 'hopper_speed'), containers.hopper(tray), strict=True))[attr]
+
+
+def base_value(name: str, setup: Setup, mass: float, tray: ContainerSpec,
+               where: str = '') -> float:
     """The file's value of input `name`, in the file's units (`mass`: the part's mass, kg,
-    which the file may leave to the model); InvalidArgument named `where` for a key of the
-    other kind of gripper."""
+    which the file may leave to the model; `tray`: the file's); InvalidArgument named `where`
+    for a key of the other kind of gripper."""
     section, attr, unit = INPUTS[name][:3]
+    if section == 'tray':
+        return _tray_value(attr, tray) / unit
     if section == 'gripper' and attr not in setup.gripper.values():
         raise InvalidArgument(where or name, name, f"is not a key of the file's gripper, "
                               f'{setup.gripper.description} (gripper.type)')
@@ -99,7 +131,7 @@ def apply(values: dict[str, float], setup: Setup, moves: tuple[Vibration, ...], 
     pairs = {'part_on_surface': {}, 'part_on_part': {}}
     for name, value in values.items():
         section, attr, unit = INPUTS[name][:3]
-        if section == 'drop_test':      # the repeats' plates: drop_height
+        if section in ('drop_test', 'tray'):    # the repeats' containers (tray_of)
             continue
         if section == 'materials':
             pair, attr = attr.split('.')
@@ -156,7 +188,7 @@ def point_key(inputs: tuple[Input, ...], values: dict[str, float]) -> tuple[floa
 
 def scenarios(inputs: tuple[Input, ...], joint: int, setup: Setup,
               moves: tuple[Vibration, ...], seed: int, experiment_id: str, where: str,
-              levels: int = 0) -> tuple[Scenario, ...]:
+              levels: int = 0, tray: ContainerSpec | None = None) -> tuple[Scenario, ...]:
     """The scenarios of a sensitivity experiment (module docstring), each checked. A point
     whose inputs are all the file's or an earlier scenario's is left out: on the same seeds it
     would give the same answers (an input's low at the file's value; a grid holds each input's
@@ -176,4 +208,6 @@ def scenarios(inputs: tuple[Input, ...], joint: int, setup: Setup,
         seen.add(key)
         s, m = apply(values, setup, moves, f'{where}.inputs ({name})')
         out.append(Scenario(name, tuple(values.items()), s, m))
+        if tray is not None:
+            checked(check_container, tray_of(out[-1], tray) or tray, f'{where}.inputs ({name})')
     return tuple(out)

@@ -31,6 +31,11 @@ class Sensitivity(ExperimentKind):
         return []
 
 
+def _on_tray(exp: Experiment) -> bool:
+    """Whether an experiment runs on the file's tray (no bin of its own or of another's)."""
+    return exp.bin is None and not exp.bin_from and not exp.bins
+
+
 def read(e: experiment_keys.SensitivityKeys, where: str, c: Context) -> list[Experiment]:
     """A sensitivity experiment and, before it, its repeats of the experiments it names, one
     per scenario (scenarios.py); a repeat takes its bin or range from the same scenario's
@@ -64,10 +69,15 @@ def read(e: experiment_keys.SensitivityKeys, where: str, c: Context) -> list[Exp
                                   'out of `of`')
         low = scenario_inputs.check_input(name, r.low, f'{at}.low')
         high = scenario_inputs.check_input(name, r.high, f'{at}.high')
+        on_tray = [x for x in e.of if _on_tray(c.earlier[x])]
+        if name.startswith('tray.') and not on_tray:
+            raise InvalidArgument(at, name, 'changes the tray, and none of the experiments of '
+                                  '`of` runs on it (a table_sweep, a feeder_emptying, or a '
+                                  'gripper_sweep with no bin)')
         if name == scenario_inputs.DROP_HEIGHT:
             base = drop_test_height(e.of, at, c.earlier)
         else:
-            base = scenario_inputs.base_value(name, c.setup, c.geometry.mass, at)
+            base = scenario_inputs.base_value(name, c.setup, c.geometry.mass, c.tray, at)
         inputs.append(Input(name, round(base, 9), low, high, r.source.strip()))
     inputs = tuple(inputs)
     repeats = (2 * len(inputs) + e.joint + (e.grid ** len(inputs) if e.grid else 0)) * len(e.of)
@@ -77,7 +87,7 @@ def read(e: experiment_keys.SensitivityKeys, where: str, c: Context) -> list[Exp
                               'scenarios per input, plus joint, plus grid ** inputs, times the '
                               'experiments of `of`)')
     found = scenario_inputs.scenarios(inputs, e.joint, c.setup, c.moves, c.seed, e.id, where,
-                                      e.grid)
+                                      e.grid, c.tray)
     repeats = []
     for scenario in found:
         for exp_id in e.of:
@@ -87,6 +97,8 @@ def read(e: experiment_keys.SensitivityKeys, where: str, c: Context) -> list[Exp
                        if (value := getattr(source, key))}
             if (height := scenario_inputs.drop_height(scenario)) is not None:
                 renamed['bin'] = replace(source.bin, drop_height=height)
+            elif _on_tray(source) and (tray := scenario_inputs.tray_of(scenario, c.tray)):
+                renamed['bin'] = tray      # its one container (base.scene_container)
             repeats.append(replace(source, id=f'{exp_id}@{scenario.name}',
                                    iterations=min(source.iterations, e.iterations),
                                    scenario=scenario, **renamed))

@@ -11,7 +11,7 @@ from pick_common.containers import check_fits
 from .. import experiment_keys
 from ..errors import checked as checked_as
 from ..model import Experiment, ExperimentFile, FEEDER_EMPTYING, TABLE_SWEEP
-from .base import ExperimentKind, Scene
+from .base import ExperimentKind, Scene, scene_container
 from .context import earlier
 
 
@@ -33,7 +33,7 @@ class TableSweep(ExperimentKind):
         return list(exp.counts)
 
     def scenes(self, file: ExperimentFile, exp: Experiment, summary: dict) -> list[Scene]:
-        return [(n, file.tray, n, None) for n in exp.counts]
+        return [(n, scene_container(file, exp, summary), n, None) for n in exp.counts]
 
     def label(self, exp: Experiment, group: int, iteration: int) -> str:
         return f'{group} parts, iteration {iteration + 1}'
@@ -68,4 +68,4 @@ class FeederEmptying(ExperimentKind):
     def scenes(self, file: ExperimentFile, exp: Experiment, summary: dict) -> list[Scene]:
         low, high = exp.optimal_range or summary[exp.range_from]['optimal_range']
         feeder = FeederConfig(exp.parts, low, high, exp.max_vibrations, exp.max_feed)
-        return [(0, file.tray, exp.parts, feeder)]
+        return [(0, scene_container(file, exp, summary), exp.parts, feeder)]
