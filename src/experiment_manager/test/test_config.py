@@ -265,7 +265,8 @@ def test_the_installed_share_holds_the_paper_test_case():
     for name in ('pth0.yaml', 'pth1.yaml', 'pth2.yaml', 'grippers_pth0.yaml',
                  'pth0_robustness.yaml', 'pth1_robustness.yaml', 'pth2_robustness.yaml',
                  'pth0_gripper_map.yaml', 'pth0_options.yaml', 'pth1_options.yaml',
-                 'pth2_options.yaml', 'pth0_spills.yaml', 'pth2_spills.yaml'):
+                 'pth2_options.yaml', 'pth0_spills.yaml', 'pth2_spills.yaml',
+                 'pth1_feed.yaml'):
         assert experiment_file.load(os.path.join(share, 'test_case', name)).experiments
 
 
@@ -301,6 +302,21 @@ def test_the_spill_files_are_their_part_and_its_feeder_runs_on_the_same_seeds(na
         theirs.type, theirs.parts, theirs.max_vibrations)
     assert [x.name for x in spills.experiment('spills').inputs] == [
         'materials.part_on_surface.restitution', 'moves.amplitude_scale']
+
+
+def test_the_feed_file_is_pth1_and_its_feeder_runs_with_the_hoppers_inputs():
+    case = os.path.join(HERE, '..', 'config', 'test_case')
+    part = experiment_file.load(os.path.join(case, 'pth1.yaml'))
+    feed = experiment_file.load(os.path.join(case, 'pth1_feed.yaml'))
+    assert (feed.id, feed.seed, feed.part, feed.gripper, feed.setup, feed.moves,
+            feed.requirements, feed.cell, feed.tray) == (
+        part.id, part.seed, part.part, part.gripper, part.setup, part.moves,
+        part.requirements, part.cell, part.tray)
+    feeder, theirs = feed.experiment('feeder'), part.experiment('feeder')
+    assert (feeder.type, feeder.parts, feeder.max_vibrations) == (
+        theirs.type, theirs.parts, theirs.max_vibrations)
+    assert [x.name for x in feed.experiment('feed').inputs] == [
+        'tray.hopper_lip_mm', 'tray.hopper_rate', 'tray.hopper_speed_mm_s', 'tray.wall_mm']
 
 
 @pytest.mark.parametrize('name', ['pth0_options.yaml', 'pth1_options.yaml',
