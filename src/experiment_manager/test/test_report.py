@@ -406,7 +406,7 @@ def test_a_run_that_spilled_is_drawn_before_and_after_the_move_that_spilled(tmp_
     assert spilled > 0
     captions = pictures.write(file, str(tmp_path), {'spill.png': resimulate.spill_picture})
     caption = captions['spill.png']
-    move = int(re.search(r're-simulated to move (\d+) of the run', caption)[1])
+    move = int(re.search(r're-simulated to (?:move|feed) (\d+) of the run', caption)[1])
     over = int(re.search(r'(\d+) part\(s\) went over', caption)[1])
     assert f'it spilled {spilled} parts' in caption and 1 <= over <= spilled
     assert 1 <= move <= 10 and 'landing beside the tray: part ' in caption
