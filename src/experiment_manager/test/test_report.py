@@ -157,6 +157,11 @@ def test_the_table_verdict_rests_on_the_time_to_empty_and_the_spills(run_dir):
     _rates(s, 3, 0, 30)             # none of 30 emptied
     assert _verdicts(s)[1].verdict == NOT_FEASIBLE
     _rates(s, 3, 5, 5, spilled=2)   # 1 of 5 runs spilled: the bounds straddle 90 %
+    feeder = s['experiments']['feeder']
+    refills = s['requirements']['parts_per_hour'] / feeder['parts']
+    assert (f"Spilled per refill of {feeder['parts']}: 0.4; per hour at the required "
+            f"{s['requirements']['parts_per_hour']:g} parts per hour: {0.4 * refills:.3g}.") \
+        in _markdown(s)
     table = _verdicts(s)[1]
     assert table.verdict == UNDECIDED
     assert '4 of 5 refills spilling at most 0 part(s)' in table.reasons[0]

@@ -68,10 +68,15 @@ class Feeder(Section):
                         'av. vibrations to empty'], rows)
         if run.tray is not None:
             lines += ['', feeding(run.tray, run.max_feed.get(exp_id, 0), run.unset)]
+        per_refill = s.physics.spilled / s.iterations if s.iterations else 0.0
+        hourly = run.summary.requirements.parts_per_hour / s.parts     # refills an hour
         lines += ['', f'Time per vibration the refill interval allows: '
                   f'{fmt(s.minutes_per_vibration_allowed)} min. Parts spilled over the '
                   f'walls: {s.physics.spilled} (in {s.runs_spilling} runs; a run may '
-                  f'spill {s.max_spilled}); runs emptied within that: {s.accepted}.']
+                  f'spill {s.max_spilled}); runs emptied within that: {s.accepted}. Spilled '
+                  f'per refill of {s.parts}: {fmt(per_refill, 3)}; per hour at the required '
+                  f'{fmt(run.summary.requirements.parts_per_hour)} parts per hour: '
+                  f'{fmt(per_refill * hourly, 3)}.']
         rate = s.parts_per_hour
         if rate.mean is not None:
             low, high = s.parts_per_hour_ci95
