@@ -6,6 +6,7 @@ runs of the same seeds); the physics studies at their small size (`--small`)."""
 
 import ast
 import os
+import re
 import subprocess
 import sys
 
@@ -98,11 +99,13 @@ def test_drop_tests_set_published_drops_beside_the_simulation(tmp_path):
 def test_feeder_landing_measures_the_pile_after_every_feed():
     out = _study('studies.feeder_landing', '--part', 'pth0.yaml', '--runs', '1', '--parts',
                  '30', '--range', '10,20', '--set-back-mm', '10', '--max-feed', '8')
-    assert "pth0.yaml: at most 8 parts a feed, the file's cycle, lip 30 mm" in out
+    assert ("pth0.yaml: at most 8 parts a feed, the file's cycle, hopper lip 30 mm, 10 parts/s "
+            'at 100 mm/s') in out
     # the zone moved 10 mm off the -X wall, its far edge kept
-    assert 'feeder zone centred at -68.12, 0.00 mm, 38.75 x 120.00 mm, walls 27 mm' in out
+    assert 'feeder zone at -68.12, 0.00 mm, 38.75 x 120.00 mm, walls 27 mm' in out
+    assert re.search(r'feeds let out \d+ of the \d+ parts asked', out)
     assert ' feeds: pile top median ' in out and "parts over a wall's top after a feed" in out
-    assert 'spilled per run: ' in out
+    assert 'spilled per run: ' in out and '  spills: ' in out and '  time: ' in out
 
 
 # The physics studies docs/physics.md cites, each at its small size (`--small`: a few parts and
