@@ -67,3 +67,21 @@ def test_a_settle_report_tells_spilled_from_tunnelled_and_thrown_and_round_trips
     assert again == report
     assert conversions.settle_from_msg(conversions.settle_to_msg(
         SettleReport(True, 0.0, 0.0, 0))).tray is None
+
+
+def test_a_trays_hopper_round_trips_and_zero_takes_its_default():
+    from dataclasses import replace
+    tray = replace(ContainerSpec.tray(), drop_height=0.05, hopper_rate=4.0, hopper_speed=0.3)
+    back = conversions.container_from_msg(conversions.container_to_msg(tray))
+    assert back == tray
+    msg = conversions.container_to_msg(ContainerSpec.tray())
+    assert (msg.hopper_rate, msg.hopper_speed) == (containers.HOPPER_RATE,
+                                                   containers.HOPPER_SPEED)
+    msg.hopper_rate = msg.hopper_speed = 0.0      # ROS cannot leave a field unset
+    assert containers.hopper(conversions.container_from_msg(msg)) == (
+        containers.HOPPER_RATE, containers.HOPPER_SPEED)
+    msg.hopper_speed = float('nan')
+    with pytest.raises(InvalidArgument, match='container.hopper_speed'):
+        conversions.container_from_msg(msg)
+    with pytest.raises(InvalidArgument, match=r'container.hopper_rate: 2000.0 must be <= 1000'):
+        containers.check_container(replace(tray, hopper_rate=2000.0))
