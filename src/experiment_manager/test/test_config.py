@@ -287,8 +287,15 @@ def test_the_robustness_files_are_their_part_with_a_sensitivity_experiment(name)
     assert sensitivity.type == 'sensitivity' and all(x.source for x in sensitivity.inputs)
 
 
-@pytest.mark.parametrize('name', ['pth0_spills.yaml', 'pth2_spills.yaml'])
-def test_the_spill_files_are_their_part_and_its_feeder_runs_on_the_same_seeds(name):
+SPILLS = ['materials.part_on_surface.restitution', 'moves.amplitude_scale']
+FEED = ['tray.hopper_lip_mm', 'tray.hopper_rate', 'tray.hopper_speed_mm_s', 'tray.wall_mm']
+
+
+@pytest.mark.parametrize('name, sensitivity, inputs', [
+    ('pth0_spills.yaml', 'spills', SPILLS), ('pth2_spills.yaml', 'spills', SPILLS),
+    ('pth1_feed.yaml', 'feed', FEED)])
+def test_the_feeder_files_are_their_part_and_its_feeder_runs_on_the_same_seeds(
+        name, sensitivity, inputs):
     # the first runs must be the sensitivity's own (the same part, cell, seeds and range)
     case = os.path.join(HERE, '..', 'config', 'test_case')
     part = experiment_file.load(os.path.join(case, name.split('_')[0] + '.yaml'))
@@ -300,23 +307,7 @@ def test_the_spill_files_are_their_part_and_its_feeder_runs_on_the_same_seeds(na
     feeder, theirs = spills.experiment('feeder'), part.experiment('feeder')
     assert (feeder.type, feeder.parts, feeder.max_vibrations) == (
         theirs.type, theirs.parts, theirs.max_vibrations)
-    assert [x.name for x in spills.experiment('spills').inputs] == [
-        'materials.part_on_surface.restitution', 'moves.amplitude_scale']
-
-
-def test_the_feed_file_is_pth1_and_its_feeder_runs_with_the_hoppers_inputs():
-    case = os.path.join(HERE, '..', 'config', 'test_case')
-    part = experiment_file.load(os.path.join(case, 'pth1.yaml'))
-    feed = experiment_file.load(os.path.join(case, 'pth1_feed.yaml'))
-    assert (feed.id, feed.seed, feed.part, feed.gripper, feed.setup, feed.moves,
-            feed.requirements, feed.cell, feed.tray) == (
-        part.id, part.seed, part.part, part.gripper, part.setup, part.moves,
-        part.requirements, part.cell, part.tray)
-    feeder, theirs = feed.experiment('feeder'), part.experiment('feeder')
-    assert (feeder.type, feeder.parts, feeder.max_vibrations) == (
-        theirs.type, theirs.parts, theirs.max_vibrations)
-    assert [x.name for x in feed.experiment('feed').inputs] == [
-        'tray.hopper_lip_mm', 'tray.hopper_rate', 'tray.hopper_speed_mm_s', 'tray.wall_mm']
+    assert [x.name for x in spills.experiment(sensitivity).inputs] == inputs
 
 
 @pytest.mark.parametrize('name', ['pth0_options.yaml', 'pth1_options.yaml',

@@ -52,6 +52,7 @@ def read(e: experiment_keys.SensitivityKeys, where: str, c: Context) -> list[Exp
                                   "file's grippers or a regrasp station; a sensitivity varies "
                                   "the file's own cell")
     inputs = []
+    on_tray = [x for x in e.of if _on_tray(c.earlier[x])]
     for name, r in e.inputs.items():
         at = f'{where}.inputs.{name}'
         moved = name.removeprefix('part.')
@@ -69,7 +70,6 @@ def read(e: experiment_keys.SensitivityKeys, where: str, c: Context) -> list[Exp
                                   'out of `of`')
         low = scenario_inputs.check_input(name, r.low, f'{at}.low')
         high = scenario_inputs.check_input(name, r.high, f'{at}.high')
-        on_tray = [x for x in e.of if _on_tray(c.earlier[x])]
         if name.startswith('tray.') and not on_tray:
             raise InvalidArgument(at, name, 'changes the tray, and none of the experiments of '
                                   '`of` runs on it (a table_sweep, a feeder_emptying, or a '
