@@ -114,6 +114,14 @@ def quaternion_angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return 2.0 * np.arccos(np.clip(dot, 0.0, 1.0))
 
 
+def perpendicular(up: np.ndarray) -> np.ndarray:
+    """A unit vector at right angles to `up` (a unit vector): the frame axis least along it,
+    made square."""
+    axis = np.eye(3)[int(np.argmin(np.abs(up)))]
+    axis = axis - (axis @ up) * up
+    return axis / np.linalg.norm(axis)
+
+
 def rotate(quaternions: np.ndarray, vector: np.ndarray) -> np.ndarray:
     """Rotate one vector (3,) by each quaternion (n, 4) xyzw; returns (n, 3)."""
     xyz, w = quaternions[:, :3], quaternions[:, 3:4]

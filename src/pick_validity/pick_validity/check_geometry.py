@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import fcl
 import numpy as np
+from pick_common.parts.aspects import RestingFace
 from pick_common.parts.geometry import build_part, PartGeometry
 
 from .config import check_place, CheckConfig, Setup, tilts
@@ -18,7 +19,7 @@ from .geometry import part_shapes, rotations_about_x, Shape
 from .grasp_fit import GraspFit
 from .grasps import CupGrasp, Grasp
 from .grippers import check_grasps, GripperKind
-from .regrasp import Placement, placements
+from .regrasp import placements
 from .suction import Holding, Seal
 
 
@@ -54,7 +55,7 @@ class CheckGeometry:
     # with a regrasp station (config.regrasp_station): the placements the part rests on
     # there, and from which of them a grasp picks it and places it as required (set by the
     # Validator, which owns the stages); None without a station
-    placements: tuple[Placement, ...] = ()
+    placements: tuple[RestingFace, ...] = ()
     station_ok: np.ndarray | None = None
 
 

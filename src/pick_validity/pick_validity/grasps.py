@@ -108,12 +108,5 @@ def unit(field_name: str, values) -> np.ndarray:
     return v / norm
 
 
-def perpendicular(up: np.ndarray) -> np.ndarray:
-    """A unit vector at right angles to `up`: the part axis least along it, made square."""
-    axis = np.eye(3)[int(np.argmin(np.abs(up)))]
-    axis = axis - (axis @ up) * up
-    return axis / np.linalg.norm(axis)
-
-
 def grasp_point(where: str, point) -> np.ndarray:
     return np.array(check_vector(f'{where}.grasp_point', point, 3, low=-1.0, high=1.0))

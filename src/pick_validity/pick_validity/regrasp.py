@@ -8,58 +8,19 @@ the face's support polygon, with a stability margin d / h of at least `check.sta
 centre's height above the face: the tilt d / h (as a tangent) a part tips over at, the
 quasi-static rule of stable placements that Wan and Harada's regrasp planners use; the 0.1
 default is the margin the issue proposing the station names, not a value we found in a
-paper). Which placements a grasp can then pick from and place as required is decided by the
-validator, which owns the stages (`Validator.station_ok`).
+paper). The faces and their margins are the part's resting faces
+(pick_common.parts.aspects.resting_faces, the one owner of how a part rests); which placements
+a grasp can then pick from and place as required is decided by the validator, which owns the
+stages (`Validator.station_ok`).
 
 Pure: no rclpy, no simulator. Units: m; the part frame.
 """
 
-from dataclasses import dataclass
-
-import numpy as np
+from pick_common.parts.aspects import resting_faces, RestingFace
 from pick_common.parts.geometry import PartGeometry
-from scipy.spatial import ConvexHull, QhullError
-
-from .grasps import perpendicular
-
-PLANE_TOLERANCE = 1e-7      # m: hull vertices this near a face's plane touch the station
 
 
-@dataclass(frozen=True)
-class Placement:
-    """The part resting on the station on a hull face: `normal` the face's outward unit
-    normal (it points down into the station), `offset` the face's plane (normal . x =
-    offset), `ratio` d / h (module docstring)."""
-
-    normal: np.ndarray
-    offset: float
-    ratio: float
-
-
-def placements(part: PartGeometry, margin: float) -> tuple[Placement, ...]:
-    """The hull faces the part rests on with d / h of at least `margin`, steadiest first."""
-    hull = part.visual.convex_hull
-    vertices = np.asarray(hull.vertices)
-    centre = part.mass_centre
-    found = []
-    for n in np.unique(np.round(hull.face_normals, 6), axis=0):
-        n = n / np.linalg.norm(n)
-        offset = float((vertices @ n).max())
-        height = offset - float(centre @ n)
-        touching = vertices[vertices @ n >= offset - PLANE_TOLERANCE]
-        if height <= 0 or len(touching) < 3:
-            continue
-        e1 = perpendicular(n)
-        e2 = np.cross(n, e1)
-        flat = np.column_stack([touching @ e1, touching @ e2])
-        try:
-            polygon = ConvexHull(flat)
-        except QhullError:                  # the touching points lie on a line: an edge
-            continue
-        c = np.array([centre @ e1, centre @ e2])
-        # Qhull's facet equations: a . p + b <= 0 inside; -(a . c + b) is c's distance inside
-        distance = float(-(polygon.equations[:, :2] @ c + polygon.equations[:, 2]).max())
-        ratio = distance / height
-        if ratio >= margin:
-            found.append(Placement(n, offset, ratio))
-    return tuple(sorted(found, key=lambda p: -p.ratio))
+def placements(part: PartGeometry, margin: float) -> tuple[RestingFace, ...]:
+    """The hull faces the part rests on with d / h of at least `margin`, steadiest first
+    (aspects.resting_faces, which owns the part's resting faces)."""
+    return resting_faces(part.visual, part.mass_centre, margin)

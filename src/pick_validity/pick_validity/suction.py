@@ -33,9 +33,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from pick_common.parts.geometry import PartGeometry
+from pick_common.states import perpendicular
 
 from .grasp_fit import crossings, surface
-from .grasps import CupGrasp, perpendicular
+from .grasps import CupGrasp
 
 if TYPE_CHECKING:
     from .grippers import SuctionCup

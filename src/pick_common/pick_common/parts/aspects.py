@@ -36,9 +36,10 @@ import math
 
 import numpy as np
 from scipy import stats
+from scipy.spatial import ConvexHull, QhullError
 import trimesh
 
-from ..states import rotate
+from ..states import perpendicular, rotate
 from .geometry import PartGeometry
 from .spec import geometry_key
 
@@ -223,6 +224,56 @@ def stable_aspects(mesh: trimesh.Trimesh, centre: Sequence[float]) -> list[Aspec
             counts[kind] += 1
             aspects[k] = replace(a, name=f'{kind}_{counts[kind]}')
     return aspects
+
+
+PLANE_TOLERANCE = 1e-7      # m: hull vertices this near a face's plane touch the floor
+
+
+@dataclass(frozen=True)
+class RestingFace:
+    """The part resting on a flat surface on a face of its convex hull: `normal` the face's
+    outward unit normal (it points down into the surface), `offset` the face's plane (normal .
+    x = offset), `ratio` its stability margin d / h: d the distance from the projected mass
+    centre to the face's support polygon's nearest edge, h the mass centre's height above
+    the face, so the tilt (as a tangent) the part tips over at."""
+
+    normal: np.ndarray
+    offset: float
+    ratio: float
+
+
+def resting_faces(mesh: trimesh.Trimesh, centre: Sequence[float], margin: float = 0.0
+                  ) -> tuple[RestingFace, ...]:
+    """The faces of `mesh`'s convex hull (its frame, m) a part with its mass centre at
+    `centre` rests on with a stability margin d / h of at least `margin`, steadiest first:
+    the quasi-static rule of stable placements Wan and Harada's regrasp planners use. Beside
+    stable_aspects (the same faces, grouped, with their quasi-static shares) for what needs
+    each face's margin: the regrasp station's placements."""
+    hull = mesh.convex_hull
+    vertices = np.asarray(hull.vertices)
+    centre = np.asarray(centre, dtype=float)
+    found = []
+    for n in np.unique(np.round(hull.face_normals, 6), axis=0):
+        n = n / np.linalg.norm(n)
+        offset = float((vertices @ n).max())
+        height = offset - float(centre @ n)
+        touching = vertices[vertices @ n >= offset - PLANE_TOLERANCE]
+        if height <= 0 or len(touching) < 3:
+            continue
+        e1 = perpendicular(n)
+        e2 = np.cross(n, e1)
+        flat = np.column_stack([touching @ e1, touching @ e2])
+        try:
+            polygon = ConvexHull(flat)
+        except QhullError:                  # the touching points lie on a line: an edge
+            continue
+        c = np.array([centre @ e1, centre @ e2])
+        # Qhull's facet equations: a . p + b <= 0 inside; -(a . c + b) is c's distance inside
+        distance = float(-(polygon.equations[:, :2] @ c + polygon.equations[:, 2]).max())
+        ratio = distance / height
+        if ratio >= margin:
+            found.append(RestingFace(n, offset, ratio))
+    return tuple(sorted(found, key=lambda p: -p.ratio))
 
 
 _BY_GEOMETRY: dict[tuple, tuple[Aspect, ...]] = {}

@@ -11,8 +11,9 @@ from typing import ClassVar, TYPE_CHECKING
 
 import numpy as np
 from pick_common.errors import InvalidArgument, Limit
+from pick_common.states import perpendicular
 
-from ..grasps import CupGrasp, grasp_point, perpendicular, SuctionGrasp, unit
+from ..grasps import CupGrasp, grasp_point, SuctionGrasp, unit
 from .base import Grip, Key, Kind
 
 if TYPE_CHECKING:
