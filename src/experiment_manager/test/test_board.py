@@ -248,14 +248,18 @@ def test_the_built_in_cell_leaves_out_for_a_part_what_cannot_run_and_says_why(tm
     assert left['emptying_station'] == 'it names emptying'
     assert {e.id for e in file.experiments} >= {'sweep', 'feeder'}
     assert 'left out for this part' in open(files['Altech_AK300_1x02_P5.00mm_45-Degree']).read()
+    # its run's verdicts: the bin its refill does not fit was not analysed, so it reads as
+    # left out (with why below the table), not as a verdict
     lines = answer(board, {}, {'Altech_AK300_1x02_P5.00mm_45-Degree': [
+        ('static bin', 'not analysed', 'no bin_emptying experiment in the file'),
         ('vibrating table', 'FEASIBLE', 'ok'), ('vibrating table, gripper cup', 'UNDECIDED',
                                                 'runs straddle')]},
         {'Altech_AK300_1x02_P5.00mm_45-Degree': left})
     row = next(line for line in lines if line.startswith('  Altech'))
-    assert row.split()[-3:] == ['yes', '?', '[1]']          # the best: the first feasible
+    assert row.split()[-4:] == ['out', 'yes', '?', '[2]']          # the best: the first feasible
     assert any('emptying left out: ' in line for line in lines)
-    assert any('[2] UNDECIDED: runs straddle' in line for line in lines)
+    assert any('[3] UNDECIDED: runs straddle' in line for line in lines)
+    assert not any('not analysed' in line for line in lines[1:])
 
 
 # Datasheet weights of three families, each of a part as supplied, with its leads' count,
@@ -366,3 +370,20 @@ def test_an_error_in_the_keys_every_part_shares_is_the_files_not_a_part_option_l
         expand(data, str(tmp_path / 'b.yaml'))
     assert {e.field for e in err.value.errors} == {'experiments[0].iterations',
                                                    'grippers.cup.cup_colour'}
+
+
+def test_the_board_page_says_an_option_left_out_for_a_part_and_why():
+    from experiment_manager.analysis.report.board import board_markdown
+    part = {'name': 'TB', 'quantity': 4, 'references': ['J1'], 'status': 'decided',
+            'reason': '', 'model': 'tb.step', 'mass': '0.9 g', 'run': '', 'best': '',
+            'left_out': {'emptying': '960 parts do not fit the bin'},
+            'options': [{'option': 'static bin', 'verdict': 'not analysed',
+                         'reason': 'no bin_emptying experiment in the file'},
+                        {'option': 'vibrating table', 'verdict': 'UNDECIDED',
+                         'reason': 'runs straddle'}]}
+    page = board_markdown({'board': 'b.kicad_pcb', 'boards_per_hour': 60, 'parts': [part]},
+                          '.')
+    assert '| TB | 4 | J1 | **left out** | **UNDECIDED** | none |' in page
+    assert '- static bin: **left out** (below)' in page
+    assert '- emptying left out: 960 parts do not fit the bin' in page
+    assert 'not analysed' not in page and 'no bin_emptying' not in page

@@ -4,6 +4,7 @@ part.png of its run) beside what decided each option, and the parts not decided 
 
 import os
 
+from ...experiment_file.board import shown
 from .page import to_html
 
 
@@ -21,7 +22,7 @@ def board_markdown(record: dict, directory: str) -> str:
         for p in parts:
             if p['status'] != 'decided':
                 continue
-            got = {o['option']: o['verdict'] for o in p['options']}
+            got = {o['option']: shown(o['verdict'], p['left_out']) for o in p['options']}
             lines.append(f"| {p['name']} | {p['quantity']} | "
                          f"{' '.join(p['references'])} | "
                          + ' | '.join(f'**{got[o]}**' if o in got else '-' for o in options)
@@ -38,7 +39,10 @@ def board_markdown(record: dict, directory: str) -> str:
             rel = os.path.relpath(run, directory)
             lines += [f'![the part, its pieces and its grasps]({rel}/part.png)', '',
                       f'Its run: [{os.path.basename(run)}]({rel}/report.html).', '']
-        lines += [f"- {o['option']}: **{o['verdict']}**: {o['reason']}" for o in p['options']]
+        for o in p['options']:
+            verdict = shown(o['verdict'], p['left_out'])
+            lines.append(f"- {o['option']}: **{verdict}**"
+                         + (' (below)' if verdict != o['verdict'] else f": {o['reason']}"))
         lines += [f'- {what} left out: {why}' for what, why in p['left_out'].items()]
         lines.append('')
     others = [p for p in parts if p['status'] != 'decided']

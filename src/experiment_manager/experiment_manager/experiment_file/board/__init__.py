@@ -315,7 +315,14 @@ def settle(path: str) -> tuple[Any, dict[str, str]]:
                     + yaml.safe_dump(data, sort_keys=False))
 
 
-SHORT = {'FEASIBLE': 'yes', 'NOT FEASIBLE': 'no', 'UNDECIDED': '?', 'not analysed': '-'}
+SHORT = {'FEASIBLE': 'yes', 'NOT FEASIBLE': 'no', 'UNDECIDED': '?', 'not analysed': '-',
+         'left out': 'out'}
+
+
+def shown(verdict: str, left_out: Mapping[str, str]) -> str:
+    """An option's verdict as the board says it: an option a part's run did not analyse
+    because its experiment was left out for the part (`left_out`, settle's) is 'left out'."""
+    return 'left out' if verdict == 'not analysed' and left_out else verdict
 
 
 def answer(board: Board, said: Mapping[str, str],
@@ -333,7 +340,8 @@ def answer(board: Board, said: Mapping[str, str],
     head = ['part', 'qty', 'references', *[f'[{i + 1}]' for i in range(len(options))], 'best']
     rows, notes = [], []
     for p in board.parts:
-        got = {o: (v, why) for o, v, why in decided.get(p.name, [])}
+        gone = (left or {}).get(p.name, {})
+        got = {o: (shown(v, gone), why) for o, v, why in decided.get(p.name, [])}
         cells = [SHORT.get(got[o][0], got[o][0]) if o in got else '' for o in options]
         best = next((f'[{i + 1}]' for i, o in enumerate(options)
                      if got.get(o, ('',))[0] == 'FEASIBLE'), '')
@@ -343,12 +351,12 @@ def answer(board: Board, said: Mapping[str, str],
         rows.append([p.name, str(p.quantity), refs if len(refs) <= 28 else refs[:25] + '...',
                      *cells, best or 'none'])
         notes += [f'  {p.name} [{options.index(o) + 1}] {v}: {why}'
-                  for o, (v, why) in got.items() if v != 'FEASIBLE']
-        notes += [f'  {p.name}: {what} left out: {why}'
-                  for what, why in (left or {}).get(p.name, {}).items()]
+                  for o, (v, why) in got.items() if v not in ('FEASIBLE', 'left out')]
+        notes += [f'  {p.name}: {what} left out: {why}' for what, why in gone.items()]
     width = [max(len(r[i]) for r in [head, *rows]) for i in range(len(head) - 1)]
     lines = [f'board {os.path.basename(board.path)}: {board.boards_per_hour:g} boards per '
-             'hour; verdicts yes, no, ? (undecided), - (not analysed)']
+             'hour; verdicts yes, no, ? (undecided), - (not analysed), out (left out for the '
+             'part, said below)']
     lines += ['  ' + '  '.join(c.ljust(w) for c, w in zip(r[:-1], width, strict=True))
               + '  ' + r[-1] for r in [head, *rows]]
     lines += [f'  [{i + 1}] {o}' for i, o in enumerate(options)]
