@@ -68,7 +68,7 @@ def job(args: tuple[str, str, int]) -> tuple[str, str, list[dict], dict, float]:
     setting, workload, seeds = args
     part_file, experiments, _ = WORKLOADS[workload]
     rows, summary, wall = summarise_on_cores(part_file, experiments(seeds), SETTINGS[setting])
-    return setting, workload, rows, summary['experiments'], wall
+    return setting, workload, rows, summary.experiments, wall
 
 
 def mean_interval(values: list[float]) -> tuple[float, float, float]:
@@ -89,12 +89,11 @@ def sweep_table(results: dict, settings: list[str], finest: str) -> list[str]:
     out = ['| setting | n* (95 % interval) | valid at n* (fit) | '
            + ' | '.join(f'valid at {n}' for n in counts) + ' | wall (s) |',
            '| --- |' + ' --- |' * (len(counts) + 3)]
-    ref = results[finest][1]['sweep']
-    ref_ci = ref.get('n_star_ci95')
+    ref_ci = results[finest][1]['sweep'].n_star_ci95
     for s in settings:
         rows, summary, wall = results[s]
         sw = summary['sweep']
-        ci = sw.get('n_star_ci95')
+        ci = sw.n_star_ci95
         apart = ci and ref_ci and (ci[1] < ref_ci[0] or ci[0] > ref_ci[1])
         cells = []
         for n in counts:
@@ -103,8 +102,8 @@ def sweep_table(results: dict, settings: list[str], finest: str) -> list[str]:
             cells.append(cell([float(r['valid']) for r in rows if int(r['group']) == n],
                               finest_n))
         interval_text = f' ({ci[0]}-{ci[1]})' if ci else ''      # none from one seed
-        out.append(f'| {s} | {sw["n_star"]}{interval_text}' + (' *' if apart else '')
-                   + f' | {sw["fit_max"]:.1f} | ' + ' | '.join(cells) + f' | {wall:.0f} |')
+        out.append(f'| {s} | {sw.n_star}{interval_text}' + (' *' if apart else '')
+                   + f' | {sw.fit_max:.1f} | ' + ' | '.join(cells) + f' | {wall:.0f} |')
     return out
 
 
@@ -115,26 +114,26 @@ def feeder_table(results: dict, settings: list[str], finest: str) -> list[str]:
     def series(s: str) -> tuple[list[float], list[float]]:
         rows = results[s][0]
         return ([float(r['vibrations']) for r in rows if r['emptied'] in (True, 'True')],
-                results[s][1]['feeder']['decision']['time']['times_s'])
+                results[s][1]['feeder'].decision.time.times_s)
 
     ref_v, ref_t = series(finest)
     for s in settings:
         rows, summary, wall = results[s]
         vib, times = series(s)
-        time_ground = summary['feeder']['decision']['time']
-        bound = time_ground.get('bound')
+        time_ground = summary['feeder'].decision.time
+        bound = time_ground.bound
         emptied = sum(r['emptied'] in (True, 'True') for r in rows)
         spilled = sum(int(r['spilled']) for r in rows)
         thrown = sum(int(r.get('thrown') or 0) for r in rows)
         out.append(f'| {s} | {cell(vib, mean_interval(ref_v))} | '
                    f'{cell([t / 60 for t in times], mean_interval([t / 60 for t in ref_t]))} | '
-                   + (f'{bound / 60:.1f}' if bound else '-') + f', {time_ground["verdict"]} | '
+                   + (f'{bound / 60:.1f}' if bound else '-') + f', {time_ground.verdict} | '
                    f'{emptied} of {len(rows)} / {spilled} / {thrown} | {wall:.0f} |')
     return out
 
 
 def bins_table(results: dict, settings: list[str], finest: str) -> list[str]:
-    sizes = [b['size_mm'] for b in results[finest][1]['bins']['bins']]
+    sizes = [b.size_mm for b in results[finest][1]['bins'].bins]
     names = ['x'.join(f'{v:g}' for v in size) for size in sizes]
     out = ['| setting | ' + ' | '.join(f'container-free, {n}' for n in names)
            + ' | ranking (best first) | wall (s) |', '| --- |' + ' --- |' * (len(names) + 2)]

@@ -10,6 +10,7 @@ import time
 
 from experiment_manager import experiment_file
 from experiment_manager.analysis.results import read_csv, ResultsWriter
+from experiment_manager.analysis.summary import Summary
 from experiment_manager.running.local_backend import LocalBackend
 from experiment_manager.running.scheduler import Runner
 from pick_sim_world.config import PhysicsConfig
@@ -42,9 +43,9 @@ def run_on_cores(part_file: str, experiments: list[dict], physics: PhysicsConfig
 
 def summarise_on_cores(part_file: str, experiments: list[dict],
                        physics: PhysicsConfig | None = None,
-                       **sections) -> tuple[list[dict], dict, float]:
-    """run_on_cores with the run's summary too (summary.json's, per experiment id): the rows,
-    the summary and the wall time, s."""
+                       **sections) -> tuple[list[dict], Summary, float]:
+    """run_on_cores with the run's summary too: the rows, the summary and the wall time,
+    s."""
     file = variant(part_file, experiments, **sections)
     with tempfile.TemporaryDirectory() as out:
         start = time.perf_counter()

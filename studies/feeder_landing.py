@@ -133,8 +133,9 @@ def main() -> None:
           f"than the walls; {int(feeds[:, 3].sum())} parts over a wall's top after a feed")
     print('  spilled per run: ' + ', '.join(str(r['spilled']) for r in rows)
           + '; vibrations: ' + ', '.join(str(r['vibrations']) for r in rows))
-    for ground, d in summary['experiments']['feeder']['decision'].items():
-        print(f'  {ground}: {d["verdict"]}: {d["reason"]}')
+    grounds = summary.experiments['feeder'].decision
+    for ground, d in (('time', grounds.time), ('spills', grounds.spills)):
+        print(f'  {ground}: {d.verdict}: {d.reason}')
 
 
 if __name__ == '__main__':

@@ -60,13 +60,13 @@ def replay(file, exp, rows: list[dict], batch: int) -> tuple[list[dict], int, st
 def decision(file, exp, taken: list[dict]) -> str:
     if exp.type == BIN_STATIC:
         racing, tie = sampling.ended(file, exp, taken)
-        best = metrics.bin_static(exp, taken)['best_bin_mm']
+        best = metrics.bin_static(exp, taken).best_bin_mm
         return f'best bin {dims(best)} mm' + (f', a tie of bins {tie}' if tie else '') + \
             (f', bins {racing} not told apart' if racing else '')
     if exp.type == TABLE_SWEEP:
         fitted = metrics.fit_optimum([r['group'] for r in taken], [r['valid'] for r in taken],
                                      exp.counts[0], exp.counts[-1], exp.margin)
-        return f'n* {fitted["n_star"]}'
+        return f'n* {fitted.n_star}'
     if exp.type in (FEEDER_EMPTYING, BIN_EMPTYING) and metrics.left_out(taken):
         return 'NOT FEASIBLE: an iteration left out of the figures (a physics fault)'
     if exp.type == FEEDER_EMPTYING:

@@ -69,21 +69,21 @@ def main() -> None:
     fixed = metrics.table_sweep(file, exp, rows)
     minutes = sum(r['wall_time'] for r in rows) / 60.0
     print(f'{file.id} {exp.id}: {len(exp.counts)} counts x {exp.iterations}, {minutes:.1f} '
-          f'worker-min; fixed counts n* {fixed["n_star"]}, 95 % interval '
-          f'{fixed.get("n_star_ci95")}; batch {args.batch}, {args.orders} orderings')
+          f'worker-min; fixed counts n* {fixed.n_star}, 95 % interval '
+          f'{fixed.n_star_ci95}; batch {args.batch}, {args.orders} orderings')
     results = {'a batch at every count': [], 'placed where n* narrows most': []}
     for k in range(args.orders):
         rng = np.random.default_rng([file.seed, k])
         by_count = {n: [v[i] for i in rng.permutation(len(v))] for n, v in recorded.items()}
         for way, everywhere in zip(results, (True, False), strict=True):
             settled, looks, taken = replay(file, exp, by_count, everywhere)
-            star = metrics.table_sweep(file, exp, taken)['n_star']
+            star = metrics.table_sweep(file, exp, taken).n_star
             results[way].append((settled, looks, len(taken),
                                  sum(r['wall_time'] for r in taken) / 60.0, star))
     baseline = np.median([r[3] for r in results['a batch at every count']])
     for way, got in results.items():
         settled, looks, taken, spent, stars = (np.array(c) for c in zip(*got, strict=True))
-        low, high = fixed.get('n_star_ci95', (None, None))
+        low, high = fixed.n_star_ci95 or (None, None)
         inside = int(np.sum((stars >= low) & (stars <= high))) if low is not None else '-'
         print(f'  {way}: settled {settled.sum()} of {len(got)}, looks median '
               f'{np.median(looks):g} (max {looks.max()}), iterations median '

@@ -58,7 +58,7 @@ def graph_and_cores(path: str, tmp_path, label: str, workers: int
                     ) -> tuple[subprocess.CompletedProcess, str, str, dict]:
     """The file at `path` run through the graph (`run`, `workers` workers, a namespace of its
     own) and on the cores in this process: run's output, the graph's run directory, the cores'
-    directory and the cores' summary."""
+    directory and the cores' summary as its JSON."""
     done = run_command(path, '--output', str(tmp_path / 'out'), '--namespace',
                        unique_namespace(label), '--workers', str(workers))
     assert done.returncode == 0, done.stderr
@@ -66,7 +66,7 @@ def graph_and_cores(path: str, tmp_path, label: str, workers: int
     file = experiment_file.load(path)
     cores = str(tmp_path / 'cores')
     with LocalBackend() as backend, ResultsWriter(cores, file.text) as writer:
-        expected = Runner(file, [backend], writer).run()
+        expected = json.loads(Runner(file, [backend], writer).run().json_text())
     return done, run_dir, cores, expected
 
 

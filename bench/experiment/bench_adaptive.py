@@ -18,7 +18,6 @@ import tempfile
 import time
 
 from experiment_manager.analysis.results import ResultsWriter
-from experiment_manager.analysis.summary import validate
 from experiment_manager.analysis.verdicts import verdicts
 from experiment_manager.running.local_backend import LocalBackend
 from experiment_manager.running.scheduler import Runner
@@ -37,17 +36,17 @@ def run(args: tuple[str, list[dict], dict]) -> tuple[dict, float]:
         return summary, time.perf_counter() - start
 
 
-def decision(s: dict) -> str:
-    kind = s['type']
+def decision(s) -> str:
+    kind = s.type
     if kind == 'bin_static':
-        return f'best bin {s["best_bin_mm"]} mm'
+        return f'best bin {s.best_bin_mm} mm'
     if kind == 'table_sweep':
-        return f'n* {s.get("n_star")}, range {s.get("optimal_range")}'
+        return f'n* {s.n_star}, range {s.optimal_range}'
     if kind == 'gripper_sweep':
-        return f'smallest meeting: variant {s["smallest"]}'
-    rate = 'accepted' if kind == 'feeder_emptying' else 'emptied'
-    low, high = s[f'{rate}_ci95']
-    return f'{s[rate]} of {s["iterations"]} succeeded, 95 % interval [{low:.3f}, {high:.3f}]'
+        return f'smallest meeting: variant {s.smallest}'
+    done, (low, high) = ((s.accepted, s.accepted_ci95) if kind == 'feeder_emptying'
+                         else (s.emptied, s.emptied_ci95))
+    return f'{done} of {s.iterations} succeeded, 95 % interval [{low:.3f}, {high:.3f}]'
 
 
 def main() -> None:
@@ -71,15 +70,15 @@ def main() -> None:
     print(f'{args.file}, experiments {args.experiments}, batch {args.batch}: fixed counts '
           f'{fixed_wall / 60:.1f} min, adaptive {adaptive_wall / 60:.1f} min '
           f'(ratio {adaptive_wall / fixed_wall:.2f}), a core each, side by side')
-    for exp_id, s in fixed['experiments'].items():
-        a = adaptive['experiments'][exp_id]
+    for exp_id, s in fixed.experiments.items():
+        a = adaptive.experiments[exp_id]
         same = 'same' if decision(a).split(',')[0] == decision(s).split(',')[0] else 'DIFFERS'
-        if s['type'] in ('feeder_emptying', 'bin_emptying'):
+        if s.type in ('feeder_emptying', 'bin_emptying'):
             same = 'see verdicts'
         print(f'  {exp_id}: fixed {decision(s)} | adaptive {decision(a)}, '
-              f'{a["sampling"]["iterations_run"]} of {a["sampling"]["most"]} iterations, '
-              f'{"settled" if a["sampling"]["settled"] else "not settled"} | {same}')
-    for f, a in zip(verdicts(validate(fixed)), verdicts(validate(adaptive)), strict=True):
+              f'{a.sampling.iterations_run} of {a.sampling.most} iterations, '
+              f'{"settled" if a.sampling.settled else "not settled"} | {same}')
+    for f, a in zip(verdicts(fixed), verdicts(adaptive), strict=True):
         print(f'  verdict {f.option}: fixed {f.verdict} | adaptive {a.verdict}')
 
 

@@ -4,6 +4,7 @@ import os
 
 from experiment_manager import experiment_file
 from experiment_manager.analysis.results import ResultsWriter
+from experiment_manager.analysis.summary import Summary
 from experiment_manager.running.local_backend import LocalBackend
 from experiment_manager.running.scheduler import Runner
 import pytest
@@ -11,7 +12,7 @@ import pytest
 SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
 
 
-def run_small(directory: str, resume: bool = False) -> dict:
+def run_small(directory: str, resume: bool = False) -> Summary:
     """Run the small file on the cores (LocalBackend) into `directory`; returns the summary."""
     file = experiment_file.load(SMALL)
     with LocalBackend() as backend, ResultsWriter(directory, file.text, resume) as writer:
@@ -24,7 +25,7 @@ def run_file():
 
 
 @pytest.fixture(scope='session')
-def small(tmp_path_factory) -> tuple[str, dict]:
+def small(tmp_path_factory) -> tuple[str, Summary]:
     """The small file run once: (run directory, summary)."""
     directory = str(tmp_path_factory.mktemp('small'))
     return directory, run_small(directory)

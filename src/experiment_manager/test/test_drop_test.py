@@ -32,7 +32,7 @@ experiments:
 """
 
 
-def _run(text: str, directory: str) -> dict:
+def _run(text: str, directory: str) -> summary_model.Summary:
     file = experiment_file.parse(text)
     with LocalBackend() as backend, ResultsWriter(directory, file.text) as writer:
         return Runner(file, [backend], writer).run()
@@ -40,16 +40,16 @@ def _run(text: str, directory: str) -> dict:
 
 def test_a_drop_test_counts_the_aspects_its_parts_rest_on_beside_the_measured(tmp_path):
     summary = _run(FILE, str(tmp_path))
-    s = summary['experiments']['drop']
-    assert s['height_mm'] == 80.0 and s['drops'] + s['other'] == 30
-    names = [a['name'] for a in s['aspects']]
+    s = summary.experiments['drop']
+    assert s.height_mm == 80.0 and s.drops + s.other == 30
+    names = [a.name for a in s.aspects]
     assert names[:2] == ['+y', '-y']        # a TO-220 lies on its broad faces most often
-    counts = {a['name']: a['count'] for a in s['aspects']}
-    for a in s['aspects']:
-        assert a['ci95'][0] <= a['share'] <= a['ci95'][1]
-        assert a['measured'] == {'+y': 11, '-y': 12, '+x': 3, '-x': 4}.get(a['name'])
-    assert sum(counts.values()) == s['drops']
-    assert s['measured']['drops'] == 30 and 0.0 <= s['measured']['p'] <= 1.0
+    counts = {a.name: a.count for a in s.aspects}
+    for a in s.aspects:
+        assert a.ci95[0] <= a.share <= a.ci95[1]
+        assert a.measured == {'+y': 11, '-y': 12, '+x': 3, '-x': 4}.get(a.name)
+    assert sum(counts.values()) == s.drops
+    assert s.measured.drops == 30 and 0.0 <= s.measured.p <= 1.0
     # each iteration's row names the aspect its part came to rest on
     rows = read_csv(os.path.join(str(tmp_path), 'iterations.csv'))
     assert sorted(r['aspect'] for r in rows if r['aspect'] != 'other') == sorted(
@@ -61,8 +61,8 @@ def test_a_drop_test_counts_the_aspects_its_parts_rest_on_beside_the_measured(tm
     assert '(aspects.png)' in text and os.path.getsize(os.path.join(str(tmp_path),
                                                                     'aspects.png')) > 10_000
     assert os.path.exists(os.path.join(str(tmp_path), 'drop_drop.png'))
-    (line,) = headlines(summary_model.validate(summary))
-    assert line.startswith(f'  drop (drop_test): {s["drops"]} drops at rest on +y ')
+    (line,) = headlines(summary)
+    assert line.startswith(f'  drop (drop_test): {s.drops} drops at rest on +y ')
     assert 'against 30 measured: G-test p' in line
 
 
@@ -78,11 +78,11 @@ def test_calibration_picks_the_scenario_whose_shares_made_the_counts():
     points = [({'e': 0.1}, {'a': 20, 'b': 40, 'c': 40}), ({'e': 0.3}, {'a': 58, 'b': 32, 'c': 10}),
               ({'e': 0.5}, {'a': 62, 'b': 28, 'c': 10}), ({'e': 0.7}, {'a': 90, 'b': 10, 'c': 0})]
     fit = calibrate('drop', made, points)
-    assert fit['best'] == {'e': 0.3} or fit['best'] == {'e': 0.5}
+    assert fit.best == {'e': 0.3} or fit.best == {'e': 0.5}
     # the far scenarios lie outside the interval; the two alike ones inside it
-    assert fit['intervals']['e'] == [0.3, 0.5]
+    assert fit.intervals['e'] == [0.3, 0.5]
     assert log_likelihood(made, points[3][1]) > float('-inf')     # smoothed: 0 counts allowed
-    assert fit['p'] > 0.5
+    assert fit.p > 0.5
 
 
 def test_file_keys_nest_as_the_file_does():
@@ -103,22 +103,22 @@ def test_a_sensitivity_grid_over_a_measured_drop_test_calibrates_it(tmp_path):
       materials.part_on_surface.restitution: {low: 0.1, high: 0.6, source: to fit}
 """
     summary = _run(text, str(tmp_path))
-    (fit,) = summary['experiments']['fit']['calibration']
-    values = [p['values']['materials.part_on_surface.restitution'] for p in fit['points']]
+    (fit,) = summary.experiments['fit'].calibration
+    values = [p.values['materials.part_on_surface.restitution'] for p in fit.points]
     assert sorted(values) == [0.1, 0.3, 0.6]     # the file's 0.3 and the grid's ends
-    low, high = fit['intervals']['materials.part_on_surface.restitution']
-    assert low <= fit['best']['materials.part_on_surface.restitution'] <= high
-    assert fit['keys'][:2] == ['materials:', '  part_on_surface:']
-    printed = headlines(summary_model.validate(summary))
+    low, high = fit.intervals['materials.part_on_surface.restitution']
+    assert low <= fit.best['materials.part_on_surface.restitution'] <= high
+    assert fit.keys[:2] == ['materials:', '  part_on_surface:']
+    printed = headlines(summary)
     assert '    calibrated on drop (G-test p' in '\n'.join(printed)
     assert any(line.startswith('          restitution: ') for line in printed)
     # 30 simulated drops a point: the noise alone reorders points often, and it is said
-    assert fit['noise_sd'] > 0 and 0 < fit['noise_outside'] <= 1
+    assert fit.noise_sd > 0 and 0 < fit.noise_outside <= 1
     assert any(line.startswith("    the simulation's own noise: two points") for line in printed)
-    page = report.markdown(Run(summary_model.validate(summary)))
+    page = report.markdown(Run(summary))
     assert "\nThe simulation's own noise: two points of the likeliest's shares" in page
     # the keys pasted into the file give its values and say they were calibrated, and where
-    pasted = experiment_file.parse(FILE.replace('experiments:', '\n'.join(fit['keys'])
+    pasted = experiment_file.parse(FILE.replace('experiments:', '\n'.join(fit.keys)
                                                 + '\nexperiments:'))
     (pair, bases, said), _ = pasted.material_account
     assert pair == 'part_on_surface' and dict(bases)['restitution'] == 'calibrated'
@@ -180,7 +180,7 @@ def test_the_noise_of_a_ranking_is_measured_and_falls_with_more_simulated_drops(
     assert sd == noise(made, dict(few))                 # seeded: the same counts, the same
     assert sd > CHI2_HALF                               # the interval is the noise's
     assert noise(made, {k: 16 * v for k, v in few.items()}) < 0.5 * sd
-    outside = calibrate('drop', made, [({'e': 0.1}, few)])['noise_outside']
+    outside = calibrate('drop', made, [({'e': 0.1}, few)]).noise_outside
     assert outside == pytest.approx(math.erfc(CHI2_HALF / (sd * math.sqrt(2))))
     assert noise(made, {}) == 0.0
 
@@ -190,11 +190,11 @@ def test_a_fitted_drop_height_is_said_beside_the_keys_not_as_one():
     points = [({'drop_test.height_mm': h, 'materials.part_on_surface.restitution': 0.3},
                {'a': a, 'b': 100 - a}) for h, a in ((40, 30), (80, 59), (120, 90))]
     fit = calibrate('drop', made, points)
-    assert fit['best']['drop_test.height_mm'] == 80
-    assert not any(line.startswith('drop_test') for line in fit['keys'])
-    assert fit['keys'][-1] == ('# drop_test.height_mm: 80    # 95 %: 80 to 80 (the height the '
+    assert fit.best['drop_test.height_mm'] == 80
+    assert not any(line.startswith('drop_test') for line in fit.keys)
+    assert fit.keys[-1] == ('# drop_test.height_mm: 80    # 95 %: 80 to 80 (the height the '
                                "simulated drops fit yours best from; no key of the cell's)")
-    pasted = experiment_file.parse(FILE.replace('experiments:', '\n'.join(fit['keys'])
+    pasted = experiment_file.parse(FILE.replace('experiments:', '\n'.join(fit.keys)
                                                 + '\nexperiments:'))
     assert pasted.setup.part.part_on_surface.restitution == pytest.approx(0.3)
 

@@ -12,6 +12,7 @@ import time
 from experiment_manager import experiment_file
 from experiment_manager.analysis import metrics
 from experiment_manager.analysis.headlines import headlines
+from experiment_manager.analysis.records import Faults, Flagged
 from experiment_manager.analysis.results import read_text_rows, ResultsWriter
 from experiment_manager.analysis.rows import FILES, POSE
 from experiment_manager.analysis.summary import validate
@@ -49,12 +50,12 @@ def test_every_type_records_its_rows_and_metrics(small):
         # At the default step piles overlap up to about 1 mm (docs/physics.md, "Convergence":
         # 0.9-1.0 mm deepest in the benchmark's piles; 2.8 mm at the former solver settings).
         assert float(r['max_penetration']) < 0.002
-    s = summary['experiments']
-    assert s['bins']['best_bin'] in (0, 1)
-    best = s['bins']['bins'][s['bins']['best_bin']]
-    assert best['fractions']['container_free']['mean'] == max(
-        b['fractions']['container_free']['mean'] for b in s['bins']['bins'])
-    assert s['emptying']['bin_mm'] == best['size_mm']
+    s = summary.experiments
+    assert s['bins'].best_bin in (0, 1)
+    best = s['bins'].bins[s['bins'].best_bin]
+    assert best.fractions.container_free.mean == max(
+        b.fractions.container_free.mean for b in s['bins'].bins)
+    assert s['emptying'].bin_mm == best.size_mm
     # bin_emptying: one pick per check but the last, each the first valid in search order.
     picks = [p for p in read(directory, 'picks') if p['experiment'] == 'emptying']
     checks = [c for c in read(directory, 'checks') if c['experiment'] == 'emptying']
@@ -68,16 +69,16 @@ def test_every_type_records_its_rows_and_metrics(small):
         assert np.isfinite([float(p[k]) for k in p if k.startswith('gripper_')]).all()
     # table_sweep: the fit's optimum lies in the tested range, the range is n* +- margin.
     sweep = s['sweep']
-    assert [x['n'] for x in sweep['per_n']] == [2, 6, 10, 14]
-    assert 2 <= sweep['n_star'] <= 14 and sweep['order'] == 3
-    assert sweep['optimal_range'] == [max(1, sweep['n_star'] - 2), sweep['n_star'] + 2]
-    low, high = sweep['n_star_ci95']        # two iterations a count: a bootstrap interval
-    assert 2 <= low <= sweep['n_star'] <= high <= 14
-    assert (f'  sweep (table_sweep): optimum {sweep["n_star"]} parts (95 % interval {low}-'
-            f'{high}), range {sweep["optimal_range"]}') in headlines(validate(summary))
+    assert [x.n for x in sweep.per_n] == [2, 6, 10, 14]
+    assert 2 <= sweep.n_star <= 14 and sweep.order == 3
+    assert sweep.optimal_range == [max(1, sweep.n_star - 2), sweep.n_star + 2]
+    low, high = sweep.n_star_ci95        # two iterations a count: a bootstrap interval
+    assert 2 <= low <= sweep.n_star <= high <= 14
+    assert (f'  sweep (table_sweep): optimum {sweep.n_star} parts (95 % interval {low}-'
+            f'{high}), range {sweep.optimal_range}') in headlines(summary)
     # feeder_emptying: the range came from the sweep; the run stopped by the policy.
     feeder = by_type['feeder_emptying'][0]
-    assert s['feeder']['optimal_range'] == sweep['optimal_range']
+    assert s['feeder'].optimal_range == sweep.optimal_range
     assert feeder['stop'] in NAMES and int(feeder['vibrations']) <= 15
     assert int(feeder['picks']) + int(feeder['spilled']) <= 12
     assert 0 < float(feeder['tray_error']) < 0.05    # the tray moved as commanded
@@ -90,9 +91,9 @@ def test_every_type_records_its_rows_and_metrics(small):
     assert {float(r['table_time']) for r in rows if r['type'] != 'feeder_emptying'} == {0.0}
     hourly = 3600.0 * int(feeder['picks']) / (int(feeder['picks']) * file.cell.pick_time
                                               + float(feeder['table_time']))
-    assert s['feeder']['parts_per_hour']['mean'] == pytest.approx(hourly)
+    assert s['feeder'].parts_per_hour.mean == pytest.approx(hourly)
     with open(os.path.join(directory, 'summary.json')) as f:
-        assert json.load(f) == summary
+        assert validate(json.load(f)) == summary
 
 
 def test_a_gripper_sweep_checks_every_gripper_on_the_same_scenes(small):
@@ -124,12 +125,12 @@ def test_a_gripper_sweep_checks_every_gripper_on_the_same_scenes(small):
                     assert valid[i, a] >= valid[i, b], (i, va, vb)
     assert pairs == 19      # of the 8 x 7 ordered pairs
     # ... and the sweep tells them apart: the narrow gripper reaches more than the wide one.
-    s = summary['experiments']['grippers']
-    means = [v['valid']['mean'] for v in s['variants']]
+    s = summary.experiments['grippers']
+    means = [v.valid.mean for v in s.variants]
     assert means == [sum(len(valid[i, k]) for i in range(2)) / 2 for k in range(8)]
     assert means[0] > means[6]      # D 8 W 3 against D 20 W 6, every grasp
-    assert [v['gripper_mm']['body_diameter_mm'] for v in s['variants']] == [8] * 4 + [20] * 4
-    assert [v['grasp_set'] for v in s['variants']] == ['all', 'upright'] * 4
+    assert [v.gripper_mm['body_diameter_mm'] for v in s.variants] == [8] * 4 + [20] * 4
+    assert [v.grasp_set for v in s.variants] == ['all', 'upright'] * 4
 
 
 def test_the_smallest_gripper_meeting_the_yield_is_chosen_by_size_then_order():
@@ -141,8 +142,10 @@ def test_the_smallest_gripper_meeting_the_yield_is_chosen_by_size_then_order():
 
     def summary(min_valid):
         e = replace(exp, min_valid=min_valid)
+        healthy = dict.fromkeys(('spilled', 'tunnelled', 'thrown', 'max_speed', 'unsettled',
+                                 'max_penetration', 'tray_error'), 0)
         iterations = [{'group': 0, 'iteration': i, 'container_x': 0.195, 'container_y': 0.15,
-                       'container_z': 0.027, 'fault': ''} for i in range(8)]
+                       'container_z': 0.027, 'fault': '', **healthy} for i in range(8)]
         checks = [{'group': 0, 'iteration': i, 'check': k, 'checked': 30, 'candidates': 30,
                    'placeable': 30, 'container_free': 30, 'valid': v[i]}
                   for k, v in per_variant.items() for i in range(8)]
@@ -152,18 +155,17 @@ def test_the_smallest_gripper_meeting_the_yield_is_chosen_by_size_then_order():
     # Counts spread at least as a Poisson count's: 8 scenes of 4 valid parts give 4 +- t *
     # sqrt(4 / 8), not 4 +- 0.
     t = scipy_stats.t.ppf(0.975, 7)
-    assert s['variants'][2]['valid_ci95'] == pytest.approx([4 - t * 0.5 ** 0.5,
-                                                            4 + t * 0.5 ** 0.5])
-    assert [v['meets'] for v in s['variants']] == [True, False, True, True, True, False,
-                                                   False, False]
+    assert s.variants[2].valid_ci95 == pytest.approx([4 - t * 0.5 ** 0.5, 4 + t * 0.5 ** 0.5])
+    assert [v.meets for v in s.variants] == [True, False, True, True, True, False, False,
+                                             False]
     # D 8 W 3 'all' (0) and D 8 W 6 'all' (2) both meet; W 3 is smaller.
-    assert s['smallest'] == 0 and s['scene_mm'] == [195, 150, 27]
-    low, high = s['variants'][6]['valid_ci95']
-    assert low < 1.25 < high and s['variants'][1]['scenes_with_valid'] == 4
-    assert summary(10.0)['smallest'] == 3       # D 8 W 6 upright (16) before D 20 W 3 (25)
-    assert summary(30.0)['smallest'] is None
+    assert s.smallest == 0 and s.scene_mm == [195, 150, 27]
+    low, high = s.variants[6].valid_ci95
+    assert low < 1.25 < high and s.variants[1].scenes_with_valid == 4
+    assert summary(10.0).smallest == 3       # D 8 W 6 upright (16) before D 20 W 3 (25)
+    assert summary(30.0).smallest is None
     # An interval reaching below 0 does not meet even min_valid 0.
-    assert not summary(0.0)['variants'][1]['meets']
+    assert not summary(0.0).variants[1].meets
     assert interval([4.0]) == (None, None)
     assert interval([4.0, 4.0]) == (4.0, 4.0)
 
@@ -174,10 +176,10 @@ def test_runs_are_deterministic_and_independent_of_order(small, tmp_path):
     summary: dict = {}
     units = []
     with open(os.path.join(directory, 'summary.json')) as f:
-        written = json.load(f)
+        written = validate(json.load(f))
     for exp in file.experiments:   # planned as the run plans them, then run backwards
         units += plan(file, exp, summary)
-        summary[exp.id] = written['experiments'][exp.id]
+        summary[exp.id] = written.experiments[exp.id]
     records = {}
     with LocalBackend() as backend:
         backend.start(file)
@@ -362,13 +364,12 @@ def test_a_physics_fault_is_marked_left_out_of_the_figures_and_the_run_goes_on(s
     # that takes its bin from it may take another: the faulted iteration is left out)
     assert [r for r in rows if r['experiment'] == 'bins'] == [
         r for r in expected[:1] + expected[2:] if r['experiment'] == 'bins']
-    bins = got['experiments']['bins']
-    assert bins['faults']['physics_fault'] == 1
-    assert bins['faults']['flagged'] == [{'group': 0, 'iteration': 1,
-                                          'fault': 'physics_fault'}]
-    assert [b['iterations'] for b in bins['bins']] == [1, 2]
-    assert summary['experiments']['bins']['faults'] == {
-        'physics_fault': 0, 'tunnelled': 0, 'thrown': 0, 'unsettled': 0, 'flagged': []}
+    bins = got.experiments['bins']
+    assert bins.faults.physics_fault == 1
+    assert bins.faults.flagged == [Flagged(group=0, iteration=1, fault='physics_fault')]
+    assert [b.iterations for b in bins.bins] == [1, 2]
+    assert summary.experiments['bins'].faults == Faults(
+        physics_fault=0, tunnelled=0, thrown=0, unsettled=0, flagged=[])
 
 
 def test_parts_fallen_far_from_the_container_are_not_sent_to_the_check():
@@ -401,7 +402,7 @@ def test_tunnelled_thrown_and_unsettled_iterations_are_flagged_and_a_spill_is_no
     assert faults({**row, 'thrown': 1}) == 'thrown'
     counts = metrics.fault_counts([{'group': 0, 'iteration': i, 'fault': f} for i, f in
                                    enumerate(['', 'tunnelled+unsettled', 'tunnelled'])])
-    assert (counts['unsettled'], counts['tunnelled'], len(counts['flagged'])) == (1, 2, 2)
+    assert (counts.unsettled, counts.tunnelled, len(counts.flagged)) == (1, 2, 2)
 
 
 def test_the_health_of_an_iteration_counts_spilled_tunnelled_and_thrown_parts_apart():
@@ -438,11 +439,11 @@ def test_the_health_of_an_iteration_counts_spilled_tunnelled_and_thrown_parts_ap
             {'group': 0, 'iteration': 1, **health, 'tunnelled': 0, 'thrown': 0, 'fault': '',
              'emptied': True, 'vibrations': 7, 'feeds': 1, 'stop': 'stop: empty',
              'picks': 7, 'checks': 14, 'table_time': 20.0}]
-    s = metrics.summarise(file, exp, rows, [], {'sweep': {'optimal_range': [2, 4]}})
-    assert s['faults']['tunnelled'] == 1 and s['iterations'] == 1    # left out
-    assert s['physics']['spilled'] == 2 and s['accepted'] == 0       # counted, not accepted
+    s = metrics.summarise(file, replace(exp, optimal_range=(2, 4)), rows, [])
+    assert s.faults.tunnelled == 1 and s.iterations == 1    # left out
+    assert s.physics.spilled == 2 and s.accepted == 0       # counted, not accepted
     # the kept run's throughput: 7 picks of 4 s and 20 s of the table's, no image time
-    assert s['parts_per_hour']['mean'] == pytest.approx(3600 * 7 / (7 * 4 + 20))
+    assert s.parts_per_hour.mean == pytest.approx(3600 * 7 / (7 * 4 + 20))
 
 
 def test_an_unwritable_output_directory_is_named(tmp_path):
@@ -499,11 +500,11 @@ def test_the_fit_finds_the_maximum_of_a_known_curve():
     n = np.repeat(np.arange(1, 61), 3)
     valid = 20.0 - 0.02 * (n - 37.0) ** 2 + 1e-6 * (n - 37.0) ** 4
     fit = metrics.fit_optimum(n, valid, 1, 60, 5)
-    assert fit['order'] == 4 and fit['n_star'] == 37 and fit['optimal_range'] == [32, 42]
-    assert metrics.fit_optimum([4, 4], [1, 3], 4, 4, 5)['optimal_range'] == [1, 9]
+    assert fit.order == 4 and fit.n_star == 37 and fit.optimal_range == [32, 42]
+    assert metrics.fit_optimum([4, 4], [1, 3], 4, 4, 5).optimal_range == [1, 9]
     # Every count weighs the same, however many iterations it had (an adaptive sweep's).
     uneven = metrics.fit_optimum([1, 1, 1, 1, 2, 3], [0, 0, 0, 4, 3, 1], 1, 3, 1)
-    assert np.allclose(uneven['coefficients'], np.polyfit([1, 2, 3], [1, 3, 1], 2))
+    assert np.allclose(uneven.coefficients, np.polyfit([1, 2, 3], [1, 3, 1], 2))
     assert stats([1, 2, 3]) == {'n': 3, 'mean': 2.0, 'min': 1.0, 'max': 3.0,
                                         'std': 1.0}
     assert stats([])['mean'] is None
@@ -566,15 +567,15 @@ def test_a_sweep_still_rising_at_its_last_count_sweeps_on_until_its_peak_is_insi
     text = EXTENDING + f'sampling: {{mode: {mode}, batch: 1}}\n'
     with LocalBackend() as backend, ResultsWriter(str(tmp_path), text) as writer:
         summary = Runner(experiment_file.parse(text), [backend], writer).run()
-    s = summary['experiments']['sweep']
-    counts = [p['n'] for p in s['per_n']]
+    s = summary.experiments['sweep']
+    counts = [p.n for p in s.per_n]
     assert counts[:3] == [1, 2, 3] and len(counts) > 3
     assert counts == list(range(1, counts[-1] + 1))        # on at the sweep's step
-    assert s['n_star'] < counts[-1], 'the fitted peak lies inside the counts swept'
+    assert s.n_star < counts[-1], 'the fitted peak lies inside the counts swept'
     rows = read(str(tmp_path), 'iterations')
     assert [int(r['group']) for r in rows] == counts        # written in the plan's order
     # told not to, it stops at its last count
     text = text.replace('margin: 1}', 'margin: 1, extend: false}')
     with LocalBackend() as backend, ResultsWriter(str(tmp_path / 'no'), text) as writer:
         summary = Runner(experiment_file.parse(text), [backend], writer).run()
-    assert [p['n'] for p in summary['experiments']['sweep']['per_n']] == [1, 2, 3]
+    assert [p.n for p in summary.experiments['sweep'].per_n] == [1, 2, 3]

@@ -3,6 +3,7 @@ per kind (the rooms' import order keeps the class from reaching them) holds ever
 runs iterations, so that a kind added to the registry and missing from one fails here."""
 
 import os
+from types import SimpleNamespace
 
 from experiment_manager import experiment_file
 from experiment_manager.analysis import headlines, metrics
@@ -29,7 +30,8 @@ def test_every_type_is_one_kind_and_every_table_holds_every_kind_that_runs():
 
 def test_a_kind_plans_its_groups_and_names_its_iterations():
     file = experiment_file.load(os.path.join(CONFIG, 'default_experiment.yaml'))
-    summary = {'bins': {'best_bin': 1}, 'sweep': {'optimal_range': [3, 9]}}
+    # the fields plan reads of the summaries before (analysis.summary's records)
+    summary = {'bins': SimpleNamespace(best_bin=1), 'sweep': SimpleNamespace(optimal_range=[3, 9])}
     seen = set()
     for exp in file.experiments:
         kind = kind_of(exp)

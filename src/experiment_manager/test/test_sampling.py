@@ -11,7 +11,7 @@ from experiment_manager.analysis import metrics, report
 from experiment_manager.analysis.headlines import headlines
 from experiment_manager.analysis.report import Run
 from experiment_manager.analysis.results import read_text_rows, ResultsWriter
-from experiment_manager.analysis.summary import Sampling, validate
+from experiment_manager.analysis.summary import Sampling, Summary
 from experiment_manager.analysis.verdicts import NOT_FEASIBLE, verdicts
 from experiment_manager.analysis.wording import sampling_end
 from experiment_manager.running import sampling
@@ -33,8 +33,13 @@ def small(**sampling_section) -> experiment_file.ExperimentFile:
     return experiment_file.parse(text, SMALL)
 
 
+HEALTHY = dict.fromkeys(('spilled', 'tunnelled', 'thrown', 'max_speed', 'unsettled',
+                         'max_penetration', 'tray_error'), 0)
+
+
 def row(group: int, i: int, **values) -> dict:
-    return {'group': group, 'iteration': i, 'fault': '', **values}
+    """An iteration's row as iterations.csv reads, healthy: no part spilled or moving."""
+    return {'group': group, 'iteration': i, 'fault': '', **HEALTHY, **values}
 
 
 def test_the_sampling_section_is_read_and_checked():
@@ -185,7 +190,7 @@ def test_a_sweep_with_a_flat_top_is_settled_when_any_n_star_of_its_interval_yiel
                                  10, 100, 5)
     low, high = metrics.n_star_interval(exp.counts, [[r['valid'] for r in flat
                                                       if r['group'] == c] for c in exp.counts],
-                                        fitted['order'], 10, 100, sampling.INTERIM_CONFIDENCE,
+                                        fitted.order, 10, 100, sampling.INTERIM_CONFIDENCE,
                                         np.random.default_rng([file.seed, len(flat)]))
     assert high - low > 2 * exp.margin          # the margin alone would not settle it
     assert sampling.unsettled(file, exp, flat) == []
@@ -212,7 +217,7 @@ def test_a_sweep_places_its_next_drops_where_they_narrow_n_star_most():
             rows = [row(c, i, valid=drawn[c][i]) for c in exp.counts for i in range(taken[c])]
             wanted = sampling.unsettled(file, exp, rows)
             if not wanted:
-                return metrics.table_sweep(file, exp, rows)['n_star'], sum(
+                return metrics.table_sweep(file, exp, rows).n_star, sum(
                     c * k for c, k in taken.items())
             if everywhere:
                 wanted = [c for c in exp.counts if taken[c] < 40]
@@ -256,7 +261,7 @@ HOPELESS = ('id: stop_early\nseed: 3\npart: {model: radial_capacitor}\n'
 
 
 def run(mode: str, directory: str, writer=ResultsWriter, resume: bool = False,
-        progress=None, required: float = 0.9) -> dict:
+        progress=None, required: float = 0.9) -> Summary:
     file = experiment_file.parse(HOPELESS + f'sampling: {{mode: {mode}, batch: 2}}\n'
                         f'requirements: {{success_rate: {required}}}\n', SMALL)
     with LocalBackend() as backend, writer(directory, file.text, resume) as sink:
@@ -273,18 +278,18 @@ def test_an_adaptive_run_stops_a_feeder_study_that_settled_and_keeps_the_fixed_c
     summary, rows = runs['adaptive']
     # the progress line ends full: the iterations not needed leave its total
     assert (shown[-1].done, shown[-1].total, shown[-1].eta) == (4, 4, 0)
-    s = summary['experiments']['feeder']
-    assert s['sampling'] == {'mode': 'adaptive', 'batch': 2, 'batches': 2,
-                             'iterations_run': 4, 'most': 6, 'settled': True}
-    assert s['iterations'] == 4 and s['accepted'] == 0
+    s = summary.experiments['feeder']
+    assert s.sampling == Sampling(mode='adaptive', batch=2, batches=2, iterations_run=4, most=6,
+                                  settled=True)
+    assert s.iterations == 4 and s.accepted == 0
     assert rows == runs['fixed'][1][:4]
-    assert 'sampling' not in runs['fixed'][0]['experiments']['feeder']
-    assert verdicts(validate(summary))[1].verdict == NOT_FEASIBLE
+    assert runs['fixed'][0].experiments['feeder'].sampling is None
+    assert verdicts(summary)[1].verdict == NOT_FEASIBLE
     assert rate_interval(0, 4)[1] < 0.9
     # The terminal and the report say how many iterations ran and why they stopped.
-    assert '[adaptive: 4 of 6 iterations, settled]' in headlines(validate(summary))[0]
-    assert '| `feeder` | 4 | 6 | 2 | settled |' in report.markdown(Run(validate(summary)))
-    assert '## Sampling' not in report.markdown(Run(validate(runs['fixed'][0])))
+    assert '[adaptive: 4 of 6 iterations, settled]' in headlines(summary)[0]
+    assert '| `feeder` | 4 | 6 | 2 | settled |' in report.markdown(Run(summary))
+    assert '## Sampling' not in report.markdown(Run(runs['fixed'][0]))
 
 
 def test_an_interrupted_adaptive_run_resumes_to_the_same_batches_and_results(tmp_path):
@@ -321,7 +326,7 @@ def test_a_resumed_adaptive_run_looks_only_at_the_batches_it_released(tmp_path):
 
     assert not sampling.rate_settled(0, 2, 0.95) and sampling.rate_settled(0, 3, 0.95)
     whole = run('adaptive', str(tmp_path / 'whole'), required=0.95)
-    assert whole['experiments']['feeder']['iterations'] == 4
+    assert whole.experiments['feeder'].iterations == 4
     out = str(tmp_path / 'cut')
     with pytest.raises(Interrupt):
         run('adaptive', out, StopAtTheFourth, required=0.95)
@@ -340,11 +345,11 @@ def test_an_adaptive_race_that_runs_out_names_the_bins_it_could_not_tell_apart(t
     assert [e.id for e in file.experiments] == ['bins']
     with LocalBackend() as backend, ResultsWriter(str(tmp_path), file.text) as sink:
         summary = Runner(file, [backend], sink).run()
-    s = summary['experiments']['bins']
-    assert s['sampling']['settled'] is False and s['sampling']['tied_bins'] == [0, 1]
+    s = summary.experiments['bins']
+    assert s.sampling.settled is False and s.sampling.tied_bins == [0, 1]
     said = 'not settled: bins 100 x 100 x 20 and 120 x 80 x 20 mm could not be told apart'
-    assert said in headlines(validate(summary))[0]
-    assert f'at the most iterations, {said}' in report.markdown(Run(validate(summary)))
+    assert said in headlines(summary)[0]
+    assert f'at the most iterations, {said}' in report.markdown(Run(summary))
 
 
 def test_a_tie_is_said_with_its_bins():

@@ -3,7 +3,9 @@ and (sensitivity_experiment.yaml run on the cores) what its repeats ran with and
 summary, verdicts and report say. tests/test_experiment_graph.py runs the same file through
 the graph."""
 
+from dataclasses import replace
 import os
+from types import SimpleNamespace
 
 from experiment_manager import experiment_file
 from experiment_manager.analysis import metrics, report
@@ -11,9 +13,9 @@ from experiment_manager.analysis.headlines import headlines
 from experiment_manager.analysis.report import Run
 from experiment_manager.analysis.report.sensitivity import section as sensitivity_section
 from experiment_manager.analysis.results import read_csv, read_text_rows, ResultsWriter
-from experiment_manager.analysis.sensitivity import _held_said, _map, _robustness
+from experiment_manager.analysis.sensitivity import _held_said, _map, _robustness, SpillRuns
 from experiment_manager.analysis.sensitivity import summarise as sensitivity_summary
-from experiment_manager.analysis.summary import Sensitivity, validate
+from experiment_manager.analysis.summary import Flip, Held, Said, Scenario, Sensitivity, Summary
 from experiment_manager.analysis.verdicts import verdicts
 from experiment_manager.commands.run import main as run_main
 from experiment_manager.experiment_file.plan import plan
@@ -43,11 +45,11 @@ def _typed(said: dict) -> Sensitivity:
     return Sensitivity.model_validate({
         'type': 'sensitivity', 'held': {}, 'tornado': {},
         'faults': {**dict.fromkeys(metrics.FAULTS, 0), 'flagged': []},
-        'physics': metrics.physics([]), **said})
+        'physics': metrics.physics([]).model_dump(), **said})
 
 
 @pytest.fixture(scope='module')
-def sens(tmp_path_factory) -> tuple[str, dict]:
+def sens(tmp_path_factory) -> tuple[str, Summary]:
     """sensitivity_experiment.yaml run on the cores: (run directory, summary)."""
     directory = str(tmp_path_factory.mktemp('sens'))
     file = experiment_file.load(SENSITIVITY)
@@ -91,7 +93,7 @@ def test_each_input_gets_a_low_and_a_high_scenario_and_the_repeats_keep_their_so
     assert [m.duration for m in slow.moves] == pytest.approx([2 * m.duration for m in f.moves])
     assert [m.amplitude for m in slow.moves] == [m.amplitude for m in f.moves]
     # common random numbers: a repeat's iterations have the seeds of the experiment's own
-    summary = {'bins': {'best_bin': 0}}
+    summary = {'bins': SimpleNamespace(best_bin=0)}      # plan reads the best bin's field
     assert [u.seed for u in plan(f, low, summary)] == [
         u.seed for u in plan(f, f.experiment('emptying'), summary)][:2]
 
@@ -165,36 +167,34 @@ def test_the_repeats_ran_with_their_scenario_and_the_summary_compares_them(sens)
     valid = {k: [int(c['valid']) for c in checks if c['experiment'] == k]
              for k in ('feeder', 'feeder@gripper_body_diameter_mm_high')}
     assert sum(valid['feeder@gripper_body_diameter_mm_high']) < sum(valid['feeder']), valid
-    s = summary['experiments']['robust']
-    assert set(summary['repeats']) == {f'feeder@{x["name"]}' for x in s['scenarios']}
-    assert [x['name'] for x in s['inputs']] == ['materials.part_on_surface.lateral_friction',
-                                                'gripper.body_diameter_mm',
-                                                'moves.amplitude_scale']
-    assert s['inputs'][1]['base'] == 8.0 and s['inputs'][0]['source'] == 'a guess, for the tests'
+    s = summary.experiments['robust']
+    assert set(summary.repeats) == {f'feeder@{x.name}' for x in s.scenarios}
+    assert [x.name for x in s.inputs] == ['materials.part_on_surface.lateral_friction',
+                                          'gripper.body_diameter_mm', 'moves.amplitude_scale']
+    assert s.inputs[1].base == 8.0 and s.inputs[0].source == 'a guess, for the tests'
     # the answers are the repeats' own; the tornado's bars are the low and high scenarios'
-    for x in s['scenarios']:
-        repeat = summary['repeats'][f'feeder@{x["name"]}']
-        assert x['answers']['vibrations'] == repeat['vibrations_to_empty']['mean']
-    scenario = {x['name']: x['answers'] for x in s['scenarios']}
-    assert s['tornado']['vibrations']['materials.part_on_surface.lateral_friction'] == {
+    for x in s.scenarios:
+        repeat = summary.repeats[f'feeder@{x.name}']
+        assert x.answers['vibrations'] == repeat.vibrations_to_empty.mean
+    scenario = {x.name: x.answers for x in s.scenarios}
+    assert s.tornado['vibrations']['materials.part_on_surface.lateral_friction'] == {
         'low': scenario['materials_part_on_surface_lateral_friction_low']['vibrations'],
         'high': scenario['materials_part_on_surface_lateral_friction_high']['vibrations']}
-    seen = [x['answers']['vibrations'] for x in [s['base'], *s['scenarios']]]
-    assert s['ranges']['vibrations'] == [min(v for v in seen if v is not None),
-                                         max(v for v in seen if v is not None)]
+    seen = [x.answers['vibrations'] for x in [s.base, *s.scenarios]]
+    assert s.ranges['vibrations'] == [min(v for v in seen if v is not None),
+                                      max(v for v in seen if v is not None)]
     # the table's verdict in each scenario, and said with the file's verdict
-    table = next(r for r in s['robustness'] if r['option'] == 'vibrating table')
-    said = {x['verdicts']['vibrating table'] for x in s['scenarios']}
-    assert table['holds'] == (said == {table['verdict']})
-    reasons = next(v for v in verdicts(validate(summary))
-                   if v.option == 'vibrating table').reasons
-    assert reasons[-1] == f'over the ranges of `robust`: {table["said"]}'
-    assert f'    {table["line"]}' in headlines(validate(summary))
+    table = next(r for r in s.robustness if r.option == 'vibrating table')
+    said = {x.verdicts['vibrating table'] for x in s.scenarios}
+    assert table.holds == (said == {table.verdict})
+    reasons = next(v for v in verdicts(summary) if v.option == 'vibrating table').reasons
+    assert reasons[-1] == f'over the ranges of `robust`: {table.said}'
+    assert f'    {table.line}' in headlines(summary)
 
 
 def test_the_report_draws_the_tornado_and_lists_the_scenarios(sens, tmp_path):
     directory, summary = sens
-    text = report.markdown(Run(validate(summary), figures={'sensitivity_robust': True}))
+    text = report.markdown(Run(summary, figures={'sensitivity_robust': True}))
     section = text.split('## How far the answers move (`robust`)')[1].split('\n## ')[0]
     assert '![tornado chart of robust](sensitivity_robust.png)' in section
     assert ('| `materials.part_on_surface.lateral_friction` | 0.35 | 0.3 | 0.8 | a guess, for '
@@ -202,7 +202,7 @@ def test_the_report_draws_the_tornado_and_lists_the_scenarios(sens, tmp_path):
     assert ('| materials_part_on_surface_lateral_friction_low | '
             'materials.part_on_surface.lateral_friction 0.3 |') in section
     path = str(tmp_path / 'tornado.png')
-    assert report.plot_tornado('robust', validate(summary).experiments['robust'], path)
+    assert report.plot_tornado('robust', summary.experiments['robust'], path)
     with open(path, 'rb') as f:
         assert f.read(8) == b'\x89PNG\r\n\x1a\n'
 
@@ -253,21 +253,22 @@ def test_a_flip_names_the_scenario_and_its_values_and_undecided_is_not_called_a_
     robust = experiment_file.parse(sensitivity(
         'iterations: 1, of: [emptying], inputs: {'
         'gripper.jaw_depth_mm: {low: 2, high: 6, source: catalogue}}')).experiment('robust')
-    base = {'verdicts': {'static bin': 'FEASIBLE', 'vibrating table': 'FEASIBLE'}}
+    base = Said(answers={}, verdicts={'static bin': 'FEASIBLE', 'vibrating table': 'FEASIBLE'})
     scenarios = [
-        {'name': 'gripper_jaw_depth_mm_low', 'values': {'gripper.jaw_depth_mm': 2.0},
-         'verdicts': {'static bin': 'FEASIBLE', 'vibrating table': 'FEASIBLE'}},
-        {'name': 'gripper_jaw_depth_mm_high', 'values': {'gripper.jaw_depth_mm': 6.0},
-         'verdicts': {'static bin': 'NOT FEASIBLE', 'vibrating table': 'UNDECIDED'}}]
+        Scenario(name='gripper_jaw_depth_mm_low', values={'gripper.jaw_depth_mm': 2.0},
+                 answers={}, verdicts={'static bin': 'FEASIBLE', 'vibrating table': 'FEASIBLE'}),
+        Scenario(name='gripper_jaw_depth_mm_high', values={'gripper.jaw_depth_mm': 6.0},
+                 answers={},
+                 verdicts={'static bin': 'NOT FEASIBLE', 'vibrating table': 'UNDECIDED'})]
     bin_, table = _robustness(robust, base, scenarios)
-    assert not bin_['holds'] and bin_['flips'][0]['scenario'] == 'gripper_jaw_depth_mm_high'
-    assert bin_['line'] == ('static bin FEASIBLE here, but NOT FEASIBLE at gripper.jaw_depth_mm '
-                            '6 (1 of 2 scenarios)')
-    assert bin_['sources'] == {'gripper.jaw_depth_mm': 'catalogue'}
-    assert table['line'].endswith('the runs there do not settle it, which is not a flip to '
-                                  'the other side')
-    same = [dict(s, verdicts=base['verdicts']) for s in scenarios]
-    assert [r['line'] for r in _robustness(robust, base, same)] == [
+    assert not bin_.holds and bin_.flips[0].scenario == 'gripper_jaw_depth_mm_high'
+    assert bin_.line == ('static bin FEASIBLE here, but NOT FEASIBLE at gripper.jaw_depth_mm '
+                         '6 (1 of 2 scenarios)')
+    assert bin_.sources == {'gripper.jaw_depth_mm': 'catalogue'}
+    assert table.line.endswith('the runs there do not settle it, which is not a flip to '
+                               'the other side')
+    same = [s.model_copy(update={'verdicts': base.verdicts}) for s in scenarios]
+    assert [r.line for r in _robustness(robust, base, same)] == [
         'static bin FEASIBLE over all ranges (2 scenarios: gripper.jaw_depth_mm)',
         'vibrating table FEASIBLE over all ranges (2 scenarios: gripper.jaw_depth_mm)']
 
@@ -278,36 +279,36 @@ def test_a_table_flip_its_spills_make_says_whether_its_runs_tell_it_from_the_fil
         'gripper.jaw_depth_mm: {low: 2, high: 6, source: catalogue}}')).experiment('robust')
 
     def runs(spilling, n=3, spills='FEASIBLE', time='FEASIBLE', limit=0):
-        return {'runs': n, 'spilling': spilling, 'spills': spills, 'time': time, 'limit': limit}
+        return SpillRuns(n, spilling, limit, spills, time)
 
     def scenarios(low, high):
-        return [{'name': f'gripper_jaw_depth_mm_{end}', 'values': {'gripper.jaw_depth_mm': v},
-                 'verdicts': {'vibrating table': verdict}}
+        return [Scenario(name=f'gripper_jaw_depth_mm_{end}', values={'gripper.jaw_depth_mm': v},
+                         answers={}, verdicts={'vibrating table': verdict})
                 for end, v, verdict in (('low', 2.0, low), ('high', 6.0, high))]
     # none of 3 runs spilled at the file's values; 1 of 3 at the low end, whose time ground is
     # UNDECIDED too (its spills make the NOT FEASIBLE: p = 1); the high end UNDECIDED by its
     # time alone
-    base = {'verdicts': {'vibrating table': 'FEASIBLE'}}
+    base = Said(answers={}, verdicts={'vibrating table': 'FEASIBLE'})
     spill_runs = {None: runs(0),
                   'gripper_jaw_depth_mm_low': runs(1, spills='NOT FEASIBLE', time='UNDECIDED'),
                   'gripper_jaw_depth_mm_high': runs(0, time='UNDECIDED')}
     (table,) = _robustness(robust, base, scenarios('NOT FEASIBLE', 'UNDECIDED'), spill_runs)
-    low, high = table['flips']
-    assert low['spills_p'] == pytest.approx(1.0) and 'spills_p' not in high
+    low, high = table.flips
+    assert low.spills_p == pytest.approx(1.0) and high.spills_p is None
     assert ("1 of these flip on their spills, with runs spilling 1 of 3 there against 0 of 3 "
-            "at the file's values" in table['line'])
-    assert 'the least p they allow is 0.10' in table['line']
+            "at the file's values" in table.line)
+    assert 'the least p they allow is 0.10' in table.line
     # 30 runs a side tell 15 spilling from none: the flips are said, not called a draw
-    base = {'verdicts': {'vibrating table': 'NOT FEASIBLE'}}
+    base = Said(answers={}, verdicts={'vibrating table': 'NOT FEASIBLE'})
     spill_runs = {None: runs(15, 30, spills='NOT FEASIBLE'),
                   'gripper_jaw_depth_mm_low': runs(0, 30), 'gripper_jaw_depth_mm_high': runs(0, 30)}
     (table,) = _robustness(robust, base, scenarios('FEASIBLE', 'FEASIBLE'), spill_runs)
-    assert all(f['spills_p'] < 1e-4 for f in table['flips'])
-    assert 'flip on their spills' not in table['line']
+    assert all(f.spills_p < 1e-4 for f in table.flips)
+    assert 'flip on their spills' not in table.line
     # where a run may spill parts, the ground is parts per refill: no runs' test is said
-    spill_runs = {k: {**v, 'limit': 2} for k, v in spill_runs.items()}
+    spill_runs = {k: replace(v, limit=2) for k, v in spill_runs.items()}
     (table,) = _robustness(robust, base, scenarios('FEASIBLE', 'FEASIBLE'), spill_runs)
-    assert not any('spills_p' in f for f in table['flips'])
+    assert all(f.spills_p is None for f in table.flips)
 
 
 def test_a_grid_maps_the_verdicts_over_two_inputs():
@@ -323,19 +324,18 @@ def test_a_grid_maps_the_verdicts_over_two_inputs():
                      if (d, w) not in {(12.0, 3.0), (30.0, 3.0)}]
     assert len(robust.scenarios) == 3 + 7          # the jaws' low is the file's 3 mm
     said = {(12.0, 3.0): 'FEASIBLE', (30.0, 6.0): 'NOT FEASIBLE'}
-    scenarios = [{'name': s.name, 'values': dict(s.values),
-                  'verdicts': {'static bin': said.get(point_key(robust.inputs, dict(s.values)),
-                                                      'UNDECIDED')}}
-                 for s in robust.scenarios]
-    m = _map(robust, {'verdicts': {'static bin': 'UNDECIDED'}}, scenarios)
-    assert m['rows'] == {'input': 'gripper.body_diameter_mm', 'values': [12.0, 21.0, 30.0]}
-    assert m['columns']['values'] == [3.0, 4.5, 6.0]
-    assert m['verdicts']['static bin'][0][0] == 'FEASIBLE'      # the body's low scenario
-    assert m['verdicts']['static bin'][2][2] == 'NOT FEASIBLE'
-    assert m['verdicts']['static bin'][1][1] == 'UNDECIDED'
+    scenarios = [Scenario(name=s.name, values=dict(s.values), answers={}, verdicts={
+        'static bin': said.get(point_key(robust.inputs, dict(s.values)), 'UNDECIDED')})
+        for s in robust.scenarios]
+    m = _map(robust, Said(answers={}, verdicts={'static bin': 'UNDECIDED'}), scenarios)
+    assert (m.rows.input, m.rows.values) == ('gripper.body_diameter_mm', [12.0, 21.0, 30.0])
+    assert m.columns.values == [3.0, 4.5, 6.0]
+    assert m.verdicts['static bin'][0][0] == 'FEASIBLE'      # the body's low scenario
+    assert m.verdicts['static bin'][2][2] == 'NOT FEASIBLE'
+    assert m.verdicts['static bin'][1][1] == 'UNDECIDED'
     text = sensitivity_section('robust', _typed({
         'of': ['emptying'], 'scenarios': [], 'iterations': 1, 'inputs': [], 'robustness': [],
-        'ranges': {}, 'base': {'answers': {}, 'verdicts': {}}, 'map': m}), False)
+        'ranges': {}, 'base': {'answers': {}, 'verdicts': {}}, 'map': m.model_dump()}), False)
     assert '| 12 | **FEASIBLE** | **UNDECIDED** | **UNDECIDED** |' in text
     # a level at the file's value: that grid point is the file's own run
     centred = experiment_file.parse(sensitivity(
@@ -343,10 +343,10 @@ def test_a_grid_maps_the_verdicts_over_two_inputs():
         'gripper.body_diameter_mm: {low: 4, high: 12, source: a}, '
         'gripper.jaw_depth_mm: {low: 1, high: 5, source: b}}')).experiment('robust')
     assert len(centred.scenarios) == 4 + 4         # 9 points less the file's and 4 ends
-    m = _map(centred, {'verdicts': {'static bin': 'FEASIBLE'}},
-             [{'name': s.name, 'values': dict(s.values),
-               'verdicts': {'static bin': 'NOT FEASIBLE'}} for s in centred.scenarios])
-    assert [row[1] for row in m['verdicts']['static bin']] == [
+    m = _map(centred, Said(answers={}, verdicts={'static bin': 'FEASIBLE'}),
+             [Scenario(name=s.name, values=dict(s.values), answers={},
+                       verdicts={'static bin': 'NOT FEASIBLE'}) for s in centred.scenarios])
+    assert [row[1] for row in m.verdicts['static bin']] == [
         'NOT FEASIBLE', 'FEASIBLE', 'NOT FEASIBLE']
     with pytest.raises(InvalidArgument, match=r'over the limit of 200'):
         experiment_file.parse(sensitivity(
@@ -366,20 +366,21 @@ def test_only_the_options_whose_runs_are_repeated_are_said_to_hold(small):
         '  - {id: robust, type: sensitivity, iterations: 1, of: [feeder], inputs: '
         '{materials.part_on_surface.restitution: {low: 0, high: 0.2, source: a}}}\n'))
     robust = file.experiment('robust')
-    summaries = {**summary['experiments'], **{
-        f'feeder@{s.name}': summary['experiments']['feeder'] for s in robust.scenarios}}
+    summaries = {**summary.experiments, **{
+        f'feeder@{s.name}': summary.experiments['feeder'] for s in robust.scenarios}}
     said = sensitivity_summary(file, robust, summaries)
-    assert list(said['base']['verdicts']) == ['vibrating table']
-    assert [r['option'] for r in said['robustness']] == ['vibrating table']
-    assert said['robustness'][0]['holds']       # the same runs: the same verdict
+    assert list(said.base.verdicts) == ['vibrating table']
+    assert [r.option for r in said.robustness] == ['vibrating table']
+    assert said.robustness[0].holds       # the same runs: the same verdict
     # the feeder's range came from the sweep, not repeated: said with the section and a flip
-    assert said['held'] == {'feeder': {'what': 'range', 'from': 'sweep'}}
+    assert said.held == {'feeder': Held(what='range', source='sweep')}
     assert '`feeder` ran at the range of `sweep`' in '\n'.join(
-        sensitivity_section('robust', _typed(said), False))
-    flipped = _held_said([{**said['robustness'][0], 'holds': False, 'flips': [{}],
-                           'line': 'vibrating table FEASIBLE here, but NOT FEASIBLE at x 1'}],
-                         said['held'])
-    assert flipped[0]['line'].endswith('at x 1 (`feeder` at the range of `sweep`, not repeated)')
+        sensitivity_section('robust', said, False))
+    flip = Flip(scenario='x_high', verdict='NOT FEASIBLE', values={'x': 1})
+    flipped = _held_said([said.robustness[0].model_copy(update={
+        'holds': False, 'flips': [flip],
+        'line': 'vibrating table FEASIBLE here, but NOT FEASIBLE at x 1'})], said.held)
+    assert flipped[0].line.endswith('at x 1 (`feeder` at the range of `sweep`, not repeated)')
 
 
 def test_a_gripper_input_is_refused_for_a_gripper_sweep_whose_grippers_are_its_own():

@@ -114,7 +114,6 @@ experiments:
 
 
 def test_one_file_compares_options_per_gripper_with_the_stage_that_stops_most(tmp_path):
-    from experiment_manager.analysis import summary as summary_model
     from experiment_manager.analysis.results import ResultsWriter
     from experiment_manager.analysis.verdicts import verdicts
     from experiment_manager.running.local_backend import LocalBackend
@@ -126,21 +125,21 @@ def test_one_file_compares_options_per_gripper_with_the_stage_that_stops_most(tm
     assert file.for_experiment(file.experiment('emptying')).setup == file.setup
     with LocalBackend() as backend, ResultsWriter(str(tmp_path), file.text) as writer:
         summary = Runner(file, [backend], writer).run()
-    assert summary['experiments']['emptying_cup']['gripper'] == 'cup'
-    assert 'gripper' not in summary['experiments']['emptying']
-    found = verdicts(summary_model.validate(summary))
+    assert summary.experiments['emptying_cup'].gripper == 'cup'
+    assert summary.experiments['emptying'].gripper is None
+    found = verdicts(summary)
     bins = [v for v in found if v.kind.startswith('static bin')]
     assert [v.kind for v in bins] == ['static bin', 'static bin with a regrasp station',
                                       'static bin, gripper cup']
     assert bins[2].option == 'static bin 60 x 60 x 20 mm, gripper cup'
-    assert summary['experiments']['emptying_station']['station'] is True
+    assert summary.experiments['emptying_station'].station is True
     assert any('after a regrasp on the station' in r for r in bins[1].reasons)
     for v in bins:       # the stage that stops most parts, with its share
         assert v.stops.split(' (')[0] in ('candidacy', 'placeability', 'container',
                                           'neighbours')
         assert '% of the parts checked)' in v.stops
     # the cup's checks are the cup's: its emptying removed parts on its own grasps
-    assert summary['experiments']['emptying_cup']['removed']['mean'] is not None
+    assert summary.experiments['emptying_cup'].removed.mean is not None
 
 
 STATION = """id: station
@@ -163,12 +162,12 @@ def test_a_regrasp_station_picks_what_could_not_be_placed_on_the_same_scenes(tmp
     rows = {r['experiment']: r for r in read_csv(str(tmp_path / 'iterations.csv'))}
     assert rows['station']['seed'] == rows['emptying']['seed']         # the same scene
     picks = [p for p in read_csv(str(tmp_path / 'picks.csv')) if p['experiment'] == 'station']
-    station = summary['experiments']['station']
+    station = summary.experiments['station']
     # the regrasps counted are the picks placed only after one: here the station placed two
     # parts held as they lay could not be, and the bin gave 14 parts against the plain 11
-    assert station['regrasps']['mean'] == sum(p['regrasp'] for p in picks) >= 1
-    plain = summary['experiments']['emptying']['removed']['mean']
-    assert station['removed']['mean'] > plain
+    assert station.regrasps.mean == sum(p['regrasp'] for p in picks) >= 1
+    plain = summary.experiments['emptying'].removed.mean
+    assert station.removed.mean > plain
 
 
 @pytest.mark.parametrize('change, field, words', [

@@ -1,14 +1,13 @@
 """summary.json as a typed, versioned model: the schema published in docs is the model's, a run's
 summary.json validates against it by a reader independent of the model (jsonschema), a summary
 of version 0 or 1 is read through the one migration, and a summary that breaks the model is refused
-before it is written."""
+where it is made."""
 
 import copy
 import json
 import os
 
 from experiment_manager.analysis import summary
-from experiment_manager.analysis.results import ResultsWriter
 import jsonschema
 import pydantic
 import pytest
@@ -88,10 +87,15 @@ def test_a_version_1_summary_is_read_through_the_migration(small, tmp_path):
     assert typed.experiments['feeder'].decision == now.experiments['feeder'].decision
 
 
-def test_a_summary_that_breaks_the_model_is_never_written(small, tmp_path):
-    broken = _written(small)
-    broken['experiments']['sweep']['n_star'] = 'many'
-    with ResultsWriter(str(tmp_path), 'id: x\n') as writer:
-        with pytest.raises(pydantic.ValidationError, match=r'experiments\.sweep'):
-            writer.write_summary(broken)
-    assert not os.path.exists(tmp_path / 'summary.json')
+def test_a_summary_that_breaks_the_model_is_never_made(small, tmp_path):
+    """The metrics make each record typed (a wrong value is refused where it is made, naming
+    its field), and what a run writes is its Summary's own text."""
+    directory, made = small
+    sweep = made.experiments['sweep']
+    with pytest.raises(pydantic.ValidationError, match='n_star'):
+        type(sweep)(**{**sweep.model_dump(exclude_unset=True), 'n_star': 'many'})
+    nan = made.requirements.model_copy(update={'success_rate': float('nan')})
+    with pytest.raises(ValueError, match='Out of range float values'):    # JSON has no NaN
+        made.model_copy(update={'requirements': nan}).json_text()
+    with open(os.path.join(directory, 'summary.json'), encoding='utf-8') as f:
+        assert f.read() == made.json_text()

@@ -67,10 +67,10 @@ def test_the_example_runs_end_to_end(tmp_path):
     # where its experiment.yaml names it
     again = experiment_file.load(str(tmp_path / 'experiment.yaml'))
     assert again.part.mesh_path == str(tmp_path / 'TO-220-3_Vertical.step')
-    sweep = summary['experiments']['sweep']
-    assert sweep['n_star'] is not None
-    feeder = summary['experiments']['feeder']
-    assert feeder['iterations'] == 1 and feeder['emptied'] in (0, 1)
+    sweep = summary.experiments['sweep']
+    assert sweep.n_star is not None
+    feeder = summary.experiments['feeder']
+    assert feeder.iterations == 1 and feeder.emptied in (0, 1)
     # the report names the part file, its frame, its pieces and its grasps, with its sheet
     part_sheet.write_account(file, str(tmp_path))
     report.write(str(tmp_path))

@@ -23,6 +23,7 @@ import numpy as np
 from pick_common.parts.aspects import agreement
 
 from ..experiment_file.scenarios import DROP_HEIGHT
+from .summary import Calibration, DropTest, Point
 
 SMOOTH = 0.5            # added to every simulated count
 CHI2_HALF = 1.920729    # half the 95 % quantile of chi-square with one degree of freedom
@@ -40,13 +41,13 @@ def log_likelihood(measured: dict[str, int], simulated: dict[str, int]) -> float
                   for n, m in measured.items() if m))
 
 
-def counts_of(drop_summary: dict) -> dict[str, int]:
+def counts_of(drop_summary: DropTest) -> dict[str, int]:
     """A drop test's summary's counts by aspect."""
-    return {a['name']: a['count'] for a in drop_summary['aspects']}
+    return {a.name: a.count for a in drop_summary.aspects}
 
 
 def calibrate(experiment: str, measured: dict[str, int],
-              points: list[tuple[dict[str, float], dict[str, int]]]) -> dict:
+              points: list[tuple[dict[str, float], dict[str, int]]]) -> Calibration:
     """The fit of `points` ((input values, simulated counts) per scenario) to `measured`: the
     likeliest values, each input's 95 % interval, the G-test p there, every point's log
     likelihood, and the file keys to paste (file_keys)."""
@@ -64,11 +65,12 @@ def calibrate(experiment: str, measured: dict[str, int],
             keys[f'{pair}.source'] = (f'calibrated to the drop test {experiment} '
                                       f'({sum(measured.values())} drops measured)')
     sd = noise(measured, best_counts)
-    return {'experiment': experiment, 'best': best, 'intervals': intervals,
-            'p': agreement(best_counts, measured), 'noise_sd': sd,
-            'noise_outside': math.erfc(CHI2_HALF / (sd * math.sqrt(2))) if sd > 0 else 0.0,
-            'points': [{'values': v, 'log_likelihood': ll} for ll, v, _ in scored],
-            'keys': file_keys(keys) + height_note(best, intervals)}
+    return Calibration(
+        experiment=experiment, best=best, intervals=intervals,
+        p=agreement(best_counts, measured), noise_sd=sd,
+        noise_outside=math.erfc(CHI2_HALF / (sd * math.sqrt(2))) if sd > 0 else 0.0,
+        points=[Point(values=v, log_likelihood=ll) for ll, v, _ in scored],
+        keys=file_keys(keys) + height_note(best, intervals))
 
 
 def noise(measured: dict[str, int], simulated: dict[str, int], seed: int = 0) -> float:

@@ -8,13 +8,14 @@ from pick_common.parts import aspects
 from pick_common.stats import wilson_interval
 
 from ..experiment_file import Experiment, ExperimentFile
+from .summary import AspectCount, DropTest, Measured
 
 
-def summary(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> dict:
+def summary(file: ExperimentFile, exp: Experiment, rows: list[dict], base: dict) -> DropTest:
     """A drop test's aspects: each one's count, share and 95 % interval of the drops at rest
     on an aspect, the quasi-static share, and against the measured counts (when the file
     gives them) each one's difference and the G-test's p (aspects.agreement; agrees: p at
-    least 0.05)."""
+    least 0.05). `base`: the fields every summary has (metrics' _base)."""
     counts = Counter(r['aspect'] for r in rows if r['aspect'])
     other = counts.pop(aspects.OTHER, 0)
     drops = sum(counts.values())
@@ -26,14 +27,14 @@ def summary(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> dict:
         m = measured.get(a.name) if measured else None
         share = k / drops if drops else None
         m_share = m / measured_drops if m is not None and measured_drops else None
-        found.append({'name': a.name, 'normal': [round(v, 6) for v in a.normal], 'count': k,
-                      'share': share, 'ci95': list(wilson_interval(k, drops)),
-                      'quasi_static': a.quasi_static, 'measured': m,
-                      'measured_share': m_share,
-                      'difference': share - m_share if None not in (share, m_share) else None})
-    out = {'drops': drops, 'height_mm': round(exp.bin.drop_height * 1000, 6),
-           'aspects': found, 'other': other, 'measured': None}
+        found.append(AspectCount(
+            name=a.name, normal=[round(v, 6) for v in a.normal], count=k, share=share,
+            ci95=list(wilson_interval(k, drops)), quasi_static=a.quasi_static, measured=m,
+            measured_share=m_share,
+            difference=share - m_share if None not in (share, m_share) else None))
+    agreement = None
     if measured_drops:
         p = aspects.agreement(dict(counts), measured)
-        out['measured'] = {'drops': measured_drops, 'p': p, 'agrees': p >= 0.05}
-    return out
+        agreement = Measured(drops=measured_drops, p=p, agrees=p >= 0.05)
+    return DropTest(**base, drops=drops, height_mm=round(exp.bin.drop_height * 1000, 6),
+                    aspects=found, other=other, measured=agreement)

@@ -11,6 +11,8 @@ interval's low end reaches the experiment's min_valid. Standard deviations are s
 (n - 1), 0 for a single value.
 """
 
+from dataclasses import asdict, dataclass
+
 import numpy as np
 from pick_common.stats import interval, rate_interval, stats
 
@@ -25,6 +27,8 @@ from ..experiment_file import (
     TABLE_SWEEP,
 )
 from . import decisions, drop_tests
+from . import summary as model
+from .records import Faults, Flagged, Fractions, Physics, Stats
 from .summary import SCHEMA_VERSION
 
 # The physics faults an iteration is flagged with (procedures.faults); the first three leave it
@@ -37,56 +41,62 @@ EXCLUDED = (PHYSICS_FAULT, TUNNELLED, THROWN)
 FIT_ORDER = 4
 BOOTSTRAP = 4000        # resamples of a table_sweep's iterations for the interval of n*
 
+def _stats(values) -> Stats:
+    return Stats(**stats(values))
 
 
+def _fractions(rows: list[dict]) -> Fractions:
+    return Fractions(**{stage: _stats([r[stage] / r['checked'] for r in rows if r.get('checked')])
+                        for stage in ('candidates', 'placeable', 'container_free', 'valid')})
 
 
+def _decision(d: decisions.Decision) -> model.Decision:
+    return model.Decision(**d.as_dict())
 
 
+def _scene_mm(rows: list[dict]) -> list[float] | None:
+    """The first iteration's container, mm; None for no iteration."""
+    return ([round(rows[0][k] * 1000, 6) for k in ('container_x', 'container_y', 'container_z')]
+            if rows else None)
 
 
-
-def _fractions(rows: list[dict]) -> dict:
-    out = {}
-    for stage in ('candidates', 'placeable', 'container_free', 'valid'):
-        values = [r[stage] / r['checked'] for r in rows if r.get('checked')]
-        out[stage] = stats(values)
-    return out
+def _regrasps(exp: Experiment, rows: list[dict]) -> dict:
+    """`regrasps` with a station (picks placed only after a regrasp, per iteration)."""
+    return {'regrasps': _stats([r.get('regrasps', 0) for r in rows])} if exp.station else {}
 
 
-def bin_static(exp: Experiment, rows: list[dict]) -> dict:
+def bin_static(exp: Experiment, rows: list[dict], base: dict | None = None) -> model.BinStatic:
     bins = []
     for b, spec in enumerate(exp.bins):
         mine = [r for r in rows if r['group'] == b]
-        bins.append({'index': b, 'size_mm': [round(s * 1000, 6) for s in spec.inner_size],
-                     'xy_area_mm2': round(spec.inner_size[0] * spec.inner_size[1] * 1e6, 3),
-                     'iterations': len(mine), 'fractions': _fractions(mine),
-                     'spilled': stats([r['spilled'] for r in mine])})
-    scored = [(b['fractions']['container_free']['mean'], -b['index']) for b in bins
-              if b['fractions']['container_free']['mean'] is not None]
+        bins.append(model.Bin(
+            index=b, size_mm=[round(s * 1000, 6) for s in spec.inner_size],
+            xy_area_mm2=round(spec.inner_size[0] * spec.inner_size[1] * 1e6, 3),
+            iterations=len(mine), fractions=_fractions(mine),
+            spilled=_stats([r['spilled'] for r in mine])))
+    scored = [(b.fractions.container_free.mean, -b.index) for b in bins
+              if b.fractions.container_free.mean is not None]
     best = -max(scored)[1] if scored else None
-    return {'bins': bins, 'best_bin': best,
-            'best_bin_mm': bins[best]['size_mm'] if best is not None else None}
+    return model.BinStatic(**(base or _base(exp, rows)), bins=bins, best_bin=best,
+                           best_bin_mm=bins[best].size_mm if best is not None else None)
 
 
 def bin_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
-                 picks: list[dict]) -> dict:
+                 picks: list[dict], base: dict | None = None) -> model.BinEmptying:
     """Table 2, with `emptied_ci95`: the 95 % interval of the share of bins emptied, and
     `decision`: that share against requirements.success_rate on its one-sided bounds
     (decisions.rate)."""
-    first = rows[0] if rows else None
     emptied = sum(bool(r['emptied']) for r in rows)
     decision = decisions.rate(emptied, len(rows), file.requirements.success_rate,
                               'bins emptied')
-    return {'iterations': len(rows), 'parts': exp.parts, 'decision': decision.as_dict(),
-            'bin_mm': [round(first[k] * 1000, 6) for k in ('container_x', 'container_y',
-                                                             'container_z')] if first else None,
-            'emptied': emptied, 'emptied_ci95': list(rate_interval(emptied, len(rows))),
-            'removed': stats([r['picks'] for r in rows]),
-            'searches_per_pick': stats([p['searches'] for p in picks]),
-            'first_check': _fractions(rows),
-            **({'regrasps': stats([r.get('regrasps', 0) for r in rows])}
-               if exp.station else {})}
+    return model.BinEmptying(
+        **(base or _base(exp, rows)), iterations=len(rows), parts=exp.parts,
+        decision=_decision(decision),
+        bin_mm=_scene_mm(rows), emptied=emptied,
+        emptied_ci95=list(rate_interval(emptied, len(rows))),
+        removed=_stats([r['picks'] for r in rows]),
+        searches_per_pick=_stats([p['searches'] for p in picks]), first_check=_fractions(rows),
+        **_regrasps(exp, rows))
 
 
 def fit(counts: np.ndarray, means: np.ndarray, order: int, first: int, last: int
@@ -102,11 +112,23 @@ def fit(counts: np.ndarray, means: np.ndarray, order: int, first: int, last: int
     return coefficients, grid[np.argmax(values, axis=0)]
 
 
-def fit_optimum(counts, valid, first: int, last: int, margin: int) -> dict:
+@dataclass(frozen=True)
+class Fit:
+    """A table_sweep's polynomial fit (fit_optimum): its order, coefficients (highest power
+    first), n* at its maximum and the optimal range about it; fit_max the fit's value at n*
+    (None for order 0: a single count); no_valid: no valid part at any count."""
+    order: int
+    coefficients: list[float]
+    n_star: int
+    optimal_range: list[int]
+    no_valid: bool
+    fit_max: float | None = None
+
+
+def fit_optimum(counts, valid, first: int, last: int, margin: int) -> Fit:
     """The polynomial fit (order 4, lower with fewer distinct counts) of valid parts against
     parts on the table (`counts`, `valid`: one per iteration; fit), n* at its maximum over the
-    integers in [first, last], and the range [max(1, n* - margin), n* + margin]. Coefficients
-    highest power first."""
+    integers in [first, last], and the range [max(1, n* - margin), n* + margin]."""
     n, v = np.asarray(counts, dtype=float), np.asarray(valid, dtype=float)
     tested = np.unique(n)
     order = min(FIT_ORDER, len(tested) - 1)
@@ -114,14 +136,13 @@ def fit_optimum(counts, valid, first: int, last: int, margin: int) -> dict:
     no_valid = not np.any(v > 0)
     if order < 1:
         best = int(n[0])
-        return {'order': 0, 'coefficients': [float(np.mean(v))], 'n_star': best,
-                'optimal_range': [max(1, best - margin), best + margin], 'no_valid': no_valid}
+        return Fit(0, [float(np.mean(v))], best, [max(1, best - margin), best + margin],
+                   no_valid)
     means = np.array([v[n == c].mean() for c in tested])
     coefficients, best = fit(tested, means, order, first, last)
     best = int(best)
-    return {'order': order, 'coefficients': coefficients.tolist(), 'n_star': best,
-            'fit_max': float(np.polyval(coefficients, best)),
-            'optimal_range': [max(1, best - margin), best + margin], 'no_valid': no_valid}
+    return Fit(order, coefficients.tolist(), best, [max(1, best - margin), best + margin],
+               no_valid, float(np.polyval(coefficients, best)))
 
 
 def resampled_means(by_count: list, rng: np.random.Generator) -> np.ndarray:
@@ -152,7 +173,8 @@ def n_star_interval(counts, by_count: list, order: int, first: int, last: int,
             int(np.quantile(stars, 1.0 - tail, method='higher')))
 
 
-def table_sweep(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> dict:
+def table_sweep(file: ExperimentFile, exp: Experiment, rows: list[dict],
+                base: dict | None = None) -> model.TableSweep:
     """Valid parts per count, the fit and its n* with optimal range, and `n_star_ci95`: n*'s
     95 % bootstrap interval (n_star_interval, seeded by the file's seed and the rows), when
     every count has two iterations or more."""
@@ -161,20 +183,22 @@ def table_sweep(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> dict
         mine = [r['valid'] for r in rows if r['group'] == n]
         by_count.append(mine)
         if mine:
-            per_n.append({'n': n, 'valid': stats(mine)})
-    out = {'iterations': exp.iterations, 'per_n': per_n, 'margin': exp.margin}
+            per_n.append(model.Count(n=n, valid=_stats(mine)))
+    fitted = {}
     if rows:
-        out.update(fit_optimum([r['group'] for r in rows], [r['valid'] for r in rows],
-                               exp.counts[0], exp.counts[-1], exp.margin))
-        found = n_star_interval(exp.counts, by_count, out['order'], exp.counts[0],
-                                exp.counts[-1], 0.95, np.random.default_rng([file.seed, len(rows)]))
-        if found:
-            out['n_star_ci95'] = list(found)
-    return out
+        found = fit_optimum([r['group'] for r in rows], [r['valid'] for r in rows],
+                            exp.counts[0], exp.counts[-1], exp.margin)
+        fitted = {k: v for k, v in asdict(found).items() if k != 'fit_max' or v is not None}
+        ci = n_star_interval(exp.counts, by_count, found.order, exp.counts[0], exp.counts[-1],
+                             0.95, np.random.default_rng([file.seed, len(rows)]))
+        if ci:
+            fitted['n_star_ci95'] = list(ci)
+    return model.TableSweep(**(base or _base(exp, rows)), iterations=exp.iterations,
+                            per_n=per_n, margin=exp.margin, **fitted)
 
 
 def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
-                    optimal_range) -> dict:
+                    optimal_range, base: dict | None = None) -> model.FeederEmptying:
     """`emptied`: runs that emptied the feeder and the table; `accepted`: of them, those that
     spilled at most requirements.max_spilled_parts over the tray's walls, and `accepted_ci95`
     the 95 % interval of that share of the runs (rate_interval); `parts_per_hour`: the cell's
@@ -186,25 +210,25 @@ def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
     hourly = throughputs(file.cell, rows)
     tolerated = file.requirements.max_spilled
     accepted = sum(r['spilled'] <= tolerated for r in emptied)
-    vibrations = stats([r['vibrations'] for r in emptied])
+    vibrations = _stats([r['vibrations'] for r in emptied])
     refill = file.requirements.refill_interval
-    per_vibration = (refill / vibrations['mean'] / 60.0
-                     if vibrations['mean'] else None)
-    return {'iterations': len(rows), 'parts': exp.parts, 'optimal_range': list(optimal_range),
-            'max_vibrations': exp.max_vibrations, 'emptied': len(emptied),
-            'accepted': accepted, 'accepted_ci95': list(rate_interval(accepted, len(rows))),
-            'max_spilled': tolerated, 'runs_spilling': sum(r['spilled'] > 0 for r in rows),
-            'vibrations_to_empty': vibrations, 'feeds': stats([r['feeds'] for r in rows]),
-            'stops': {s: sum(r['stop'] == s for r in rows) for s in sorted({r['stop']
-                                                                            for r in rows})},
-            'minutes_per_vibration_allowed': per_vibration,
-            'parts_per_hour': stats(hourly), 'parts_per_hour_ci95': list(interval(hourly)),
-            'cell': {'pick_s': file.cell.pick_time, 'image_s': file.cell.image_time,
-                     'regrasp_s': file.cell.regrasp_time},
-            'decision': {name: d.as_dict() for name, d in table_grounds(file, rows).items()},
-            'first_check': _fractions(rows),
-            **({'regrasps': stats([r.get('regrasps', 0) for r in rows])}
-               if exp.station else {})}
+    grounds = table_grounds(file, rows)
+    return model.FeederEmptying(
+        **(base or _base(exp, rows)), iterations=len(rows), parts=exp.parts,
+        optimal_range=list(optimal_range), max_vibrations=exp.max_vibrations,
+        emptied=len(emptied), accepted=accepted,
+        accepted_ci95=list(rate_interval(accepted, len(rows))), max_spilled=tolerated,
+        runs_spilling=sum(r['spilled'] > 0 for r in rows), vibrations_to_empty=vibrations,
+        feeds=_stats([r['feeds'] for r in rows]),
+        stops={s: sum(r['stop'] == s for r in rows) for s in sorted({r['stop'] for r in rows})},
+        minutes_per_vibration_allowed=(refill / vibrations.mean / 60.0 if vibrations.mean
+                                       else None),
+        parts_per_hour=_stats(hourly), parts_per_hour_ci95=list(interval(hourly)),
+        cell=model.Cell(pick_s=file.cell.pick_time, image_s=file.cell.image_time,
+                        regrasp_s=file.cell.regrasp_time),
+        decision=model.TableGrounds(time=_decision(grounds['time']),
+                                    spills=_decision(grounds['spills'])),
+        first_check=_fractions(rows), **_regrasps(exp, rows))
 
 
 def table_grounds(file: ExperimentFile, rows: list[dict],
@@ -231,7 +255,8 @@ def cell_throughput(cell, row: dict) -> float:
     return 3600.0 * row['picks'] / busy
 
 
-def gripper_sweep(exp: Experiment, rows: list[dict], checks: list[dict]) -> dict:
+def gripper_sweep(exp: Experiment, rows: list[dict], checks: list[dict],
+                  base: dict | None = None) -> model.GripperSweep:
     """Per variant (gripper and grasp set, in the experiment's order; check k of each scene is
     variant k): the stage fractions, the valid parts per check with their 95 % interval
     (interval(counts=True)) and the scenes with at least one valid part; `meets`: the
@@ -244,40 +269,37 @@ def gripper_sweep(exp: Experiment, rows: list[dict], checks: list[dict]) -> dict
         mine = [c for c in checks if c['check'] == k and (c['group'], c['iteration']) in kept]
         valid = [c['valid'] for c in mine]
         low, high = interval(valid, counts=True)
-        variants.append({
-            'index': k, 'grasp_set': v.grasp_set, 'grasps': [g.name for g in v.grasps],
-            'gripper_mm': v.gripper.file_values(),
-            'scenes': len(mine), 'fractions': _fractions(mine), 'valid': stats(valid),
-            'valid_ci95': [low, high], 'scenes_with_valid': sum(x > 0 for x in valid),
-            'meets': low is not None and low >= exp.min_valid})
+        variants.append(model.Variant(
+            index=k, grasp_set=v.grasp_set, grasps=[g.name for g in v.grasps],
+            gripper_mm=v.gripper.file_values(), scenes=len(mine), fractions=_fractions(mine),
+            valid=_stats(valid), valid_ci95=[low, high],
+            scenes_with_valid=sum(x > 0 for x in valid),
+            meets=low is not None and low >= exp.min_valid))
     by_size = sorted(range(len(variants)), key=lambda k: (exp.variants[k].size, k))
-    smallest = next((k for k in by_size if variants[k]['meets']), None)
-    first = rows[0] if rows else None
-    return {'iterations': len(rows), 'parts': exp.parts,
-            'scene_mm': [round(first[k] * 1000, 6) for k in ('container_x', 'container_y',
-                                                               'container_z')] if first else None,
-            'min_valid': exp.min_valid, 'variants': variants, 'smallest': smallest}
+    smallest = next((k for k in by_size if variants[k].meets), None)
+    return model.GripperSweep(**(base or _base(exp, rows)), iterations=len(rows),
+                              parts=exp.parts, scene_mm=_scene_mm(rows),
+                              min_valid=exp.min_valid, variants=variants, smallest=smallest)
 
 
-def physics(rows: list[dict]) -> dict:
+def physics(rows: list[dict]) -> Physics:
     """The physics health of every iteration (left-out ones too): parts spilled, tunnelled and
     thrown (totals), the most parts left moving at a settle's end, the deepest penetration (m),
     the fastest part (m/s) and the worst tray tracking error (fraction of the command)."""
-    return {'spilled': sum(r['spilled'] for r in rows),
-            'tunnelled': sum(r['tunnelled'] for r in rows),
-            'thrown': sum(r['thrown'] for r in rows),
-            'max_speed': max((r['max_speed'] for r in rows), default=0.0),
-            'unsettled': max((r['unsettled'] for r in rows), default=0),
-            'max_penetration': max((r['max_penetration'] for r in rows), default=0.0),
-            'tray_error': max((r['tray_error'] for r in rows), default=0.0)}
+    return Physics(spilled=sum(r['spilled'] for r in rows),
+                   tunnelled=sum(r['tunnelled'] for r in rows),
+                   thrown=sum(r['thrown'] for r in rows),
+                   max_speed=max((r['max_speed'] for r in rows), default=0.0),
+                   unsettled=max((r['unsettled'] for r in rows), default=0),
+                   max_penetration=max((r['max_penetration'] for r in rows), default=0.0),
+                   tray_error=max((r['tray_error'] for r in rows), default=0.0))
 
 
-def fault_counts(rows: list[dict]) -> dict:
+def fault_counts(rows: list[dict]) -> Faults:
     """How many iterations each physics fault flagged (procedures.faults), and which."""
-    flagged = [r for r in rows if r['fault']]
-    return {**{name: sum(name in r['fault'].split('+') for r in rows) for name in FAULTS},
-            'flagged': [{'group': r['group'], 'iteration': r['iteration'],
-                         'fault': r['fault']} for r in flagged]}
+    return Faults(**{name: sum(name in r['fault'].split('+') for r in rows) for name in FAULTS},
+                  flagged=[Flagged(group=r['group'], iteration=r['iteration'], fault=r['fault'])
+                           for r in rows if r['fault']])
 
 
 def left_out(rows: list[dict]) -> set[tuple[int, int]]:
@@ -287,53 +309,59 @@ def left_out(rows: list[dict]) -> set[tuple[int, int]]:
             if set(r['fault'].split('+')) & set(EXCLUDED)}
 
 
+def _base(exp: Experiment, rows: list[dict]) -> dict:
+    """The fields every experiment's summary has (summary._Experiment) from all its rows,
+    left-out ones too: its type, faults and physics health, and its gripper and station when
+    it names them."""
+    return {'type': exp.type, 'faults': fault_counts(rows), 'physics': physics(rows),
+            **({'gripper': exp.gripper} if exp.gripper else {}),
+            **({'station': True} if exp.station else {})}
+
+
 def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: list[dict],
-              earlier: dict | None = None, checks: list[dict] = ()) -> dict:
+              earlier: dict | None = None, checks: list[dict] = ()) -> model.Experiment:
     """The metrics of one experiment from its rows of iterations.csv, picks.csv and checks.csv.
     `earlier`: the summaries of the experiments before it (for feeder_emptying's range taken
     from a table_sweep). Iterations that ended in a physics fault or with a tunnelled or
     thrown part have no figures and are left out; every flagged iteration is listed in
     `faults`, and `physics` tells the health of all."""
-    faults = fault_counts(rows)
-    health = physics(rows)
+    base = _base(exp, rows)
     faulted = left_out(rows)
     rows = [r for r in rows if (r['group'], r['iteration']) not in faulted]
     picks = [p for p in picks if (p['group'], p['iteration']) not in faulted]
-    out = SUMMARIES[exp.type](file, exp, rows, picks, earlier or {}, checks)
-    if exp.gripper:
-        out['gripper'] = exp.gripper
-    if exp.station:
-        out['station'] = True
-    return {'type': exp.type, **out, 'faults': faults, 'physics': health}
+    return SUMMARIES[exp.type](file, exp, rows, picks, earlier or {}, checks, base)
 
 
-def file_summary(file: ExperimentFile, summaries: dict) -> dict:
-    """The run's summary, as summary.json holds it (summary.Summary describes it):
-    `experiments`, the file's own by id; `repeats`, a sensitivity experiment's repeats of them
-    in its scenarios (id `<experiment>@<scenario>`), apart, so that the verdicts and the
-    report's tables are the file's experiments'."""
+def file_summary(file: ExperimentFile, summaries: dict) -> model.Summary:
+    """The run's summary, as summary.json holds it: `experiments`, the file's own by id;
+    `repeats`, a sensitivity experiment's repeats of them in its scenarios (id
+    `<experiment>@<scenario>`), apart, so that the verdicts and the report's tables are the
+    file's experiments'."""
     r = file.requirements
     repeats = {k: v for k, v in summaries.items() if '@' in k}
-    return {'schema_version': SCHEMA_VERSION, 'id': file.id, 'seed': file.seed,
-            'requirements': {'parts_per_hour': r.parts_per_hour,
-                             'refill_interval_h': r.refill_interval / 3600.0,
-                             'capacity': r.capacity, 'success_rate': r.success_rate,
-                             'max_dimension_mm': round(r.max_dimension * 1000, 6)},
-            'experiments': {k: v for k, v in summaries.items() if k not in repeats},
-            **({'repeats': repeats} if repeats else {})}
+    return model.Summary(
+        schema_version=SCHEMA_VERSION, id=file.id, seed=file.seed,
+        requirements=model.Requirements(
+            parts_per_hour=r.parts_per_hour, refill_interval_h=r.refill_interval / 3600.0,
+            capacity=r.capacity, success_rate=r.success_rate,
+            max_dimension_mm=round(r.max_dimension * 1000, 6)),
+        experiments={k: v for k, v in summaries.items() if k not in repeats},
+        **({'repeats': repeats} if repeats else {}))
 
 
-# Per kind, its metrics: (file, exp, rows, picks, the summaries before it, checks) -> its
-# summary's own keys. A sensitivity's are sensitivity.summarise's, from its repeats'.
+# Per kind, its metrics: (file, exp, rows, picks, the summaries before it, checks, the base
+# fields) -> its summary. A sensitivity's are sensitivity.summarise's, from its repeats'.
 SUMMARIES = {
-    BIN_STATIC: lambda file, exp, rows, picks, earlier, checks: bin_static(exp, rows),
-    BIN_EMPTYING: lambda file, exp, rows, picks, earlier, checks: bin_emptying(file, exp, rows,
-                                                                               picks),
-    TABLE_SWEEP: lambda file, exp, rows, picks, earlier, checks: table_sweep(file, exp, rows),
-    FEEDER_EMPTYING: lambda file, exp, rows, picks, earlier, checks: feeder_emptying(
-        file, exp, rows, exp.optimal_range or earlier[exp.range_from]['optimal_range']),
-    GRIPPER_SWEEP: lambda file, exp, rows, picks, earlier, checks: gripper_sweep(exp, rows,
-                                                                                 checks),
-    DROP_TEST: lambda file, exp, rows, picks, earlier, checks: drop_tests.summary(file, exp,
-                                                                                  rows),
+    BIN_STATIC: lambda file, exp, rows, picks, earlier, checks, base: bin_static(exp, rows,
+                                                                                 base),
+    BIN_EMPTYING: lambda file, exp, rows, picks, earlier, checks, base: bin_emptying(
+        file, exp, rows, picks, base),
+    TABLE_SWEEP: lambda file, exp, rows, picks, earlier, checks, base: table_sweep(
+        file, exp, rows, base),
+    FEEDER_EMPTYING: lambda file, exp, rows, picks, earlier, checks, base: feeder_emptying(
+        file, exp, rows, exp.optimal_range or earlier[exp.range_from].optimal_range, base),
+    GRIPPER_SWEEP: lambda file, exp, rows, picks, earlier, checks, base: gripper_sweep(
+        exp, rows, checks, base),
+    DROP_TEST: lambda file, exp, rows, picks, earlier, checks, base: drop_tests.summary(
+        file, exp, rows, base),
 }

@@ -44,9 +44,9 @@ SIZE = (800, 600)
 STOPPED = {STAGE_PLACEABILITY: ('placeability', 'the placing surface'),
            STAGE_CONTAINER: ('container', 'the bin'), STAGE_NEIGHBOUR: ('neighbour', 'a neighbour')}
 GREEN, RED = (0.1, 0.8, 0.1, 0.55), (0.9, 0.1, 0.1, 0.55)
-# a picture's drawer: (file, the summary's experiments as plan reads them, run directory, the
-# captions so far) -> its caption, None when it has nothing to draw
-Drawer = Callable[['ExperimentFile', dict, str, dict[str, str]], str | None]
+# a picture's drawer: (file, the run's summary, run directory, the captions so far) -> its
+# caption, None when it has nothing to draw
+Drawer = Callable[['ExperimentFile', summary_model.Summary, str, dict[str, str]], str | None]
 
 
 def gripper_overlays(shapes: tuple[Shape, ...], pose, rgba) -> list[Overlay]:
@@ -171,15 +171,15 @@ def placeability_picture(validator: Validator, rows: list[dict], exp_id: str,
             '(yellow).')
 
 
-def bin_picture(file: ExperimentFile, summary: dict, run_dir: str,
+def bin_picture(file: ExperimentFile, summary: summary_model.Summary, run_dir: str,
                 captions: dict[str, str]) -> str | None:
     """bin.png with a valid and a rejected grasp, and the parts its bin's stages stopped
     (`stopped_in_world`, into `captions`); returns its caption (None: nothing to draw)."""
     exp = file.first_of(BIN_EMPTYING)
-    if exp is None or exp.id not in summary['experiments'] or (
-            exp.bin_from and exp.bin_from not in summary['experiments']):
+    if exp is None or exp.id not in summary.experiments or (
+            exp.bin_from and exp.bin_from not in summary.experiments):
         return None
-    unit = plan(file, exp, summary['experiments'])[0]
+    unit = plan(file, exp, summary.experiments)[0]
     parts, picks = _rows(run_dir, 'parts', exp.id), _rows(run_dir, 'picks', exp.id)
     if not parts:
         return None
@@ -214,16 +214,17 @@ def bin_picture(file: ExperimentFile, summary: dict, run_dir: str,
             + '; '.join(notes) + '.')
 
 
-def tray_picture(file: ExperimentFile, summary: dict, run_dir: str,
+def tray_picture(file: ExperimentFile, summary: summary_model.Summary, run_dir: str,
                  captions: dict[str, str]) -> str | None:
     """tray.png at the count nearest n*, and the parts its stages stopped that the bin did not
     show (`stopped_in_world`); returns its caption (None: nothing to draw)."""
     exp = file.first_of(TABLE_SWEEP)
-    if exp is None or summary['experiments'].get(exp.id, {}).get('n_star') is None:
+    sweep = summary.experiments.get(exp.id) if exp is not None else None
+    if sweep is None or sweep.n_star is None:
         return None
-    n_star = summary['experiments'][exp.id]['n_star']
+    n_star = sweep.n_star
     n = min(exp.counts, key=lambda c: (abs(c - n_star), c))
-    unit = next(u for u in plan(file, exp, summary['experiments'])
+    unit = next(u for u in plan(file, exp, summary.experiments)
                 if u.group == n and u.iteration == 0)
     rows = [r for r in _rows(run_dir, 'parts', exp.id) if int(r['group']) == n]
     with _settle(file, unit) as world:
@@ -237,16 +238,16 @@ def tray_picture(file: ExperimentFile, summary: dict, run_dir: str,
             f'{"identical to" if same else "DIFFERENT from"} the recorded ones).')
 
 
-def feed_picture(file: ExperimentFile, summary: dict, run_dir: str,
+def feed_picture(file: ExperimentFile, summary: summary_model.Summary, run_dir: str,
                  captions: dict[str, str]) -> str | None:
     """feed.png: the tray of the first feeder_emptying iteration as its first feed left it,
     the pile by the hopper's outlet, before the vibrations that centre it, beside the tray
     after them; the latter checked against the recorded poses of its first check. Returns
     its caption (None: nothing to draw)."""
     exp = file.first_of(FEEDER_EMPTYING)
-    if exp is None or exp.id not in summary['experiments']:
+    if exp is None or exp.id not in summary.experiments:
         return None
-    unit = plan(file, exp, summary['experiments'])[0]
+    unit = plan(file, exp, summary.experiments)[0]
     rows = _rows(run_dir, 'parts', exp.id)
     dose = FeederPolicy(unit.feeder).decide(0, 0).feed
     with World(SceneSpec(unit.container, file.part, 1, unit.seed)) as world:
@@ -276,10 +277,7 @@ def write(file: ExperimentFile, run_dir: str, more: Mapping[str, Drawer] = Mappi
     """Render the pictures of a finished run, and `more` ({file name: its drawer}, drawn by a
     later room: running.resimulate's run again to the move that spilled); returns {file name:
     caption}, also written to pictures.json for the report."""
-    typed = summary_model.read(os.path.join(run_dir, 'summary.json'))
-    # the experiments' summaries as the scheduler keeps them, which plan() reads
-    summary = {'experiments': {k: v.model_dump(by_alias=True, exclude_unset=True)
-                               for k, v in typed.experiments.items()}}
+    summary = summary_model.read(os.path.join(run_dir, 'summary.json'))
     captions: dict[str, str] = {}
     for name, draw in (('bin.png', bin_picture), ('tray.png', tray_picture),
                        ('feed.png', feed_picture), *more.items()):
@@ -288,7 +286,7 @@ def write(file: ExperimentFile, run_dir: str, more: Mapping[str, Drawer] = Mappi
             captions[name] = caption
     validators: dict[tuple, Validator] = {}     # per setup: the file's and its grippers'
     for exp in file.experiments:
-        if exp.id in summary['experiments']:
+        if exp.id in summary.experiments:
             setup = file.for_experiment(exp).setup
             if setup.key() not in validators:
                 validators[setup.key()] = Validator(setup)

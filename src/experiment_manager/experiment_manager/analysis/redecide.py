@@ -13,11 +13,13 @@ from .. import experiment_file
 from ..experiment_file.kinds import kind_of
 from . import metrics, sensitivity
 from . import summary as summary_model
+from .records import Sampling
 from .results import read_csv
 
 
-def redecide(run_dir: str, recorded: summary_model.Summary | None = None) -> dict:
-    """The summary (summary.json's dict, current version) of the run in `run_dir` as today's
+def redecide(run_dir: str, recorded: summary_model.Summary | None = None
+             ) -> summary_model.Summary:
+    """The summary (current version) of the run in `run_dir` as today's
     metrics and decisions give it; `recorded`: the run's summary.json when the caller has read
     it (read here otherwise, when there is one). Raises InvalidArgument when its
     experiment.yaml no longer reads, OSError when a result file is missing."""
@@ -28,7 +30,7 @@ def redecide(run_dir: str, recorded: summary_model.Summary | None = None) -> dic
     if recorded is None and os.path.exists(path):
         recorded = summary_model.read(path)
     sampled = _sampling(recorded) if recorded is not None else {}
-    summaries: dict[str, dict] = {}
+    summaries: dict[str, summary_model.Experiment] = {}
     for exp in file.experiments:
         mine = [r for r in rows if r['experiment'] == exp.id]
         reached = (all(s in summaries for s in exp.sources) if kind_of(exp).repeats_others
@@ -39,12 +41,14 @@ def redecide(run_dir: str, recorded: summary_model.Summary | None = None) -> dic
             file, exp, mine, [p for p in picks if p['experiment'] == exp.id],
             [c for c in checks if c['experiment'] == exp.id], summaries)
         if exp.id in sampled:
-            summaries[exp.id]['sampling'] = sampled[exp.id]
+            summaries[exp.id] = summaries[exp.id].model_copy(
+                update={'sampling': sampled[exp.id]})
     return metrics.file_summary(file, summaries)
 
 
 def summarise(file: experiment_file.ExperimentFile, exp: experiment_file.Experiment,
-              rows: list[dict], picks: list[dict], checks: list[dict], earlier: dict) -> dict:
+              rows: list[dict], picks: list[dict], checks: list[dict], earlier: dict
+              ) -> summary_model.Experiment:
     """An experiment's summary from its rows of iterations.csv, picks.csv and checks.csv, and
     the summaries of the experiments before it (`earlier`): a sensitivity's from its repeats'
     (sensitivity.summarise), every other kind's from its rows (metrics.summarise)."""
@@ -53,8 +57,7 @@ def summarise(file: experiment_file.ExperimentFile, exp: experiment_file.Experim
     return metrics.summarise(file.for_experiment(exp), exp, rows, picks, earlier, checks)
 
 
-def _sampling(recorded: summary_model.Summary) -> dict[str, dict]:
+def _sampling(recorded: summary_model.Summary) -> dict[str, Sampling]:
     """Each adaptive experiment's sampling as the run's summary recorded it, by id."""
     every = {**recorded.experiments, **(recorded.repeats or {})}
-    return {k: s.sampling.model_dump(exclude_unset=True) for k, s in every.items()
-            if s.sampling is not None}
+    return {k: s.sampling for k, s in every.items() if s.sampling is not None}

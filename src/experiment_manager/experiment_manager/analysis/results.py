@@ -17,7 +17,6 @@ are skipped. Floats are written with repr(), which reads back to the same float.
 
 from collections.abc import Callable
 import csv
-import json
 import os
 import shutil
 import tempfile
@@ -25,7 +24,7 @@ import tempfile
 from pick_common.errors import InvalidArgument
 
 from .rows import FILES, KEY, parse_row, Record
-from .summary import validate
+from .summary import Summary
 
 UMASK = os.umask(0o022)
 os.umask(UMASK)
@@ -57,12 +56,10 @@ def write_atomic(path: str, text: str) -> None:
     os.replace(tmp, path)
 
 
-def write_summary(directory: str, summary: dict) -> None:
-    """A run directory's summary.json, checked against its model first (summary.validate): a
-    summary that breaks the published schema is a bug of ours, raised here, never written."""
-    validate(summary)
-    write_atomic(os.path.join(directory, 'summary.json'),
-                 json.dumps(summary, indent=2, allow_nan=False) + '\n')
+def write_summary(directory: str, summary: Summary) -> None:
+    """A run directory's summary.json (Summary.json_text): the model checked every record as
+    it was made, so a summary that breaks the published schema never comes this far."""
+    write_atomic(os.path.join(directory, 'summary.json'), summary.json_text())
 
 
 def read_csv(path: str) -> list[dict]:
@@ -248,7 +245,7 @@ class ResultsWriter:
     def checks(self, experiment_id: str) -> list[dict]:
         return [r for r in self._rows['checks'] if r['experiment'] == experiment_id]
 
-    def write_summary(self, summary: dict) -> None:
+    def write_summary(self, summary: Summary) -> None:
         write_summary(self.directory, summary)
 
     def close(self) -> None:

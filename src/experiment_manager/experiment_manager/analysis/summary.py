@@ -1,9 +1,11 @@
 """summary.json as one typed, versioned model: what a run measured and decided, per experiment.
 
-The metrics (metrics.py, sensitivity.py) build an experiment's summary; `Summary` is the
-contract every summary.json a run writes is checked against (results.ResultsWriter), and the
-one way to read one back (`read`, through `migrate` for files of an older version). Its JSON
-Schema is published as docs/summary.schema.json:
+The metrics (metrics.py, drop_tests.py, sensitivity.py, calibration.py) make each
+experiment's record here, typed where it is made, and metrics.file_summary the `Summary`; what
+reads a summary (the verdicts, the report, plan, the pictures, redecide) reads its fields. A
+run writes `Summary.json_text()` (results.write_summary); `read` is the one way to read a file
+back (through `migrate` for files of an older version). Its JSON Schema is published as
+docs/summary.schema.json:
 
     python -m experiment_manager.analysis.summary --schema docs/summary.schema.json
 
@@ -326,6 +328,13 @@ class Summary(_Record):
     def of_type(self, kind: str) -> list[tuple[str, _Experiment]]:
         """(id, summary) of the file's experiments of this type, in the file's order."""
         return [(k, v) for k, v in self.experiments.items() if v.type == kind]
+
+    def json_text(self) -> str:
+        """summary.json's text: every key the summary was made with, none it left out (a
+        record's optional key it was not given stays out, as the published schema allows),
+        NaN refused."""
+        return json.dumps(self.model_dump(by_alias=True, exclude_unset=True), indent=2,
+                          allow_nan=False) + '\n'
 
     def last(self, kind: str):
         """The file's last experiment of this type (the one a report shows), or None."""

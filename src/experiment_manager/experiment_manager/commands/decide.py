@@ -38,8 +38,7 @@ def decide(run_dir: str, write: bool) -> list[str]:
     path = os.path.join(run_dir, 'summary.json')
     recorded = summary_model.read(path) if os.path.exists(path) else None
     before = {v.kind: v.verdict for v in verdicts(recorded)} if recorded is not None else {}
-    raw = redecide(run_dir, recorded)
-    now = summary_model.validate(raw)
+    now = redecide(run_dir, recorded)
     rows = []
     for v in verdicts(now):
         was = before.get(v.kind)
@@ -47,7 +46,7 @@ def decide(run_dir: str, write: bool) -> list[str]:
         rows.append((v.option, v.verdict + moved, v.stops, v.reasons[0]))
     lines = [run_dir, *headlines(now), 'verdicts:', *verdict_table(rows)]
     if write:
-        write_summary(run_dir, raw)
+        write_summary(run_dir, now)
         lines.append(f'written: {path}, {report.write(run_dir)}')
     return lines
 

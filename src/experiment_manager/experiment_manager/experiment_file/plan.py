@@ -53,16 +53,16 @@ class Unit:
 EXTEND_STEPS = 3    # counts a table_sweep adds at a time while its fit still rises at its last
 
 
-def extended(file: ExperimentFile, exp: Experiment, summary: dict) -> Experiment | None:
+def extended(file: ExperimentFile, exp: Experiment, summary) -> Experiment | None:
     """A table_sweep whose n* (`summary`, its metrics) sits at its last count, with up to
     EXTEND_STEPS more counts at its step, as many as fit the tray with the sweep's margin
     (containers' packing rule) and the per-instance limit; None when n* lies inside its counts,
     no part was valid, no more fit, or the sweep says `extend: false`."""
-    if (not kind_of(exp).extends or not exp.extend or summary.get('no_valid')
-            or summary.get('n_star') is None):
+    if (not kind_of(exp).extends or not exp.extend or summary.no_valid
+            or summary.n_star is None):
         return None
     last = exp.counts[-1]
-    if summary['n_star'] < last:
+    if summary.n_star < last:
         return None
     step = exp.counts[1] - exp.counts[0] if len(exp.counts) > 1 else 1
     most = MAX_PARTS_PER_INSTANCE
@@ -90,8 +90,10 @@ def count_iterations(file: ExperimentFile) -> int:
 
 
 def plan(file: ExperimentFile, exp: Experiment, summary: dict) -> list[Unit]:
-    """The iterations of `exp`, given the metrics of the experiments before it. A sensitivity
-    scenario's repeat runs on the seeds of the experiment it repeats (scenarios.py)."""
+    """The iterations of `exp`, given the summaries of the experiments before it (by id,
+    analysis.summary's records: this room reads their fields, never imports them). A
+    sensitivity scenario's repeat runs on the seeds of the experiment it repeats
+    (scenarios.py)."""
     seeded_by = exp.seeded_by or exp.id.partition('@')[0]
     return [Unit(exp, group, i, iteration_seed(file.seed, seeded_by, (group, i)), container,
                  parts, feeder)

@@ -10,7 +10,6 @@ progress, the experiment file and the results go into one MCAP file per run (rec
 One run at a time: a second goal is answered BUSY, not queued.
 """
 
-import json
 import os
 import threading
 import time
@@ -29,7 +28,7 @@ from rclpy.node import Node
 from rclpy.validate_namespace import validate_namespace
 from std_msgs.msg import Header
 
-from ..analysis import summary as summary_model
+from ..analysis.summary import Summary
 from ..analysis.verdicts import verdicts
 from ..running.scheduler import Progress
 from .graph_backend import GraphBackend, GraphError
@@ -166,13 +165,13 @@ class ExperimentManagerNode(Node):
         self._topics.write(self._progress, msg)
         self._topics.flush()   # once per iteration: a killed manager's recording keeps the rest
 
-    def _publish_verdicts(self, session: RunSession, summary: dict) -> list[Verdict]:
+    def _publish_verdicts(self, session: RunSession, summary: Summary) -> list[Verdict]:
         """The run's decisions, published (latched) and recorded with the run."""
         msg = RunVerdicts(header=Header(stamp=self.get_clock().now().to_msg()),
                           experiment_id=session.file.id, run_directory=session.run_dir,
                           verdicts=[Verdict(option=v.option, verdict=v.verdict,
                                             reasons=v.reasons, stops_most=v.stops)
-                                    for v in verdicts(summary_model.validate(summary))])
+                                    for v in verdicts(summary)])
         self._verdicts.publish(msg)
         self._topics.write(self._verdicts, msg)
         return msg.verdicts
@@ -199,7 +198,7 @@ class ExperimentManagerNode(Node):
             backends = self._workers_of_run()
             summary = session.run(backends, self._publish_progress, self._abort,
                                   [b.worker or '.' for b in backends])
-            result.summary_json = json.dumps(summary)
+            result.summary_json = summary.json_text()
             result.verdicts = self._publish_verdicts(session, summary)
             result.report_path = session.write_report()
             goal_handle.succeed()

@@ -16,6 +16,7 @@ from pick_common.errors import check_inside, InvalidArgument
 
 from ..analysis import part_sheet, report
 from ..analysis.results import keep_part_file, ResultsWriter
+from ..analysis.summary import Summary
 from ..experiment_file import ExperimentFile, load, resolved
 from ..running.backend import Backend
 from ..running.scheduler import Progress, Runner
@@ -81,7 +82,7 @@ class RunSession:
         return self.writer.directory
 
     def run(self, backends: Sequence[Backend], progress: Callable[[Progress], None],
-            abort: threading.Event, names: Sequence[str]) -> dict:
+            abort: threading.Event, names: Sequence[str]) -> Summary:
         """Run the file on the backends (workers, named `names` in the log); the summary."""
         self._logger.info(f'running {self.file.path} into {self.run_dir} on {len(backends)} '
                           f'worker(s): {", ".join(names)}')

@@ -13,6 +13,7 @@ import os
 import numpy as np
 
 from ..analysis.pictures import camera, save, SIZE
+from ..analysis.summary import Summary
 from ..experiment_file import ExperimentFile, FEEDER_EMPTYING
 from ..experiment_file.plan import plan
 from .local_backend import LocalBackend
@@ -61,19 +62,19 @@ def _spilled(report) -> set[int]:
     return set(report.spilled_ids) - set(report.tunnelled_ids) - set(report.thrown_ids)
 
 
-def spill_picture(file: ExperimentFile, summary: dict, run_dir: str,
+def spill_picture(file: ExperimentFile, summary: Summary, run_dir: str,
                   captions: dict[str, str]) -> str | None:     # an analysis.pictures.Drawer
     """spill.png: the first feeder run that spilled, re-simulated to the feed or move that
     spilled: the tray before it and after it; returns its caption (None: no run spilled)."""
     exp = file.first_of(FEEDER_EMPTYING)
-    if exp is None or exp.id not in summary['experiments']:
+    if exp is None or exp.id not in summary.experiments:
         return None
     with open(os.path.join(run_dir, 'iterations.csv'), newline='') as f:
         row = next((r for r in csv.DictReader(f) if r['experiment'] == exp.id
                     and int(r['spilled'] or 0) > 0), None)
     if row is None:
         return None
-    unit = next(u for u in plan(file, exp, summary['experiments'])
+    unit = next(u for u in plan(file, exp, summary.experiments)
                 if u.iteration == int(row['iteration']))
     with _Watching(camera(unit)) as backend:
         backend.start(file)

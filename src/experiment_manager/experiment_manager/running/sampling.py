@@ -174,23 +174,23 @@ def _sweep_unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict]) ->
     first, last = exp.counts[0], exp.counts[-1]
     fitted = metrics.fit_optimum([r['group'] for r in rows], [r['valid'] for r in rows],
                                  first, last, exp.margin)
-    if fitted['order'] < 1:
+    if fitted.order < 1:
         return []           # one count: n* is that count
-    best = fitted['n_star']
-    low, high = metrics.n_star_interval(exp.counts, by_count, fitted['order'], first, last,
+    best = fitted.n_star
+    low, high = metrics.n_star_interval(exp.counts, by_count, fitted.order, first, last,
                                         INTERIM_CONFIDENCE,
                                         np.random.default_rng([file.seed, len(rows)]))
     if best - exp.margin <= low and high <= best + exp.margin:
         return []
-    peak = fitted['fit_max']
-    if peak > 0 and np.polyval(fitted['coefficients'], np.arange(low, high + 1)).min() \
+    peak = fitted.fit_max
+    if peak > 0 and np.polyval(fitted.coefficients, np.arange(low, high + 1)).min() \
             >= (1.0 - FLAT_TOP) * peak:
         return []           # a flat top: any n* of its interval yields within FLAT_TOP
     return _sweep_batches(file, exp, by_count, fitted)
 
 
 def _sweep_batches(file: ExperimentFile, exp: Experiment, by_count: list[np.ndarray],
-                   fitted: dict | None) -> list[int]:
+                   fitted: metrics.Fit | None) -> list[int]:
     """Where a sweep's next look puts its iterations: as many parts' worth of drops as a batch
     at every count, given a batch at a time to the count where a batch shrinks the variance of
     the fit's slope at n* most per part dropped (a greedy sequential c-optimal design: n* is
@@ -209,9 +209,9 @@ def _sweep_batches(file: ExperimentFile, exp: Experiment, by_count: list[np.ndar
     left = exp.iterations - taken
     # not settled: never [], even with no iterations left (the scheduler then stops)
     everywhere = [n for n, k in zip(exp.counts, left, strict=True) if k > 0] or list(exp.counts)
-    if fitted is None or fitted['order'] < 1 or len(counts) < 3:
+    if fitted is None or fitted.order < 1 or len(counts) < 3:
         return everywhere
-    first, last, order = exp.counts[0], exp.counts[-1], fitted['order']
+    first, last, order = exp.counts[0], exp.counts[-1], fitted.order
     spread = np.array([v.var(ddof=1) for v in by_count])
     if not spread.any():
         return everywhere
@@ -219,7 +219,7 @@ def _sweep_batches(file: ExperimentFile, exp: Experiment, by_count: list[np.ndar
     variance = np.maximum(smooth, 1e-3 * spread.max())
     u = 2.0 * (counts - first) / (last - first) - 1.0      # the fit's basis, scaled
     basis = np.vander(u, order + 1)
-    at = 2.0 * (fitted['n_star'] - first) / (last - first) - 1.0
+    at = 2.0 * (fitted.n_star - first) / (last - first) - 1.0
     slope = np.array([k * at ** (k - 1) if k else 0.0 for k in range(order, -1, -1)])
     influence = basis @ np.linalg.solve(basis.T @ basis, slope)   # d slope / d mean, per count
     weight = influence ** 2 * variance

@@ -24,6 +24,8 @@ from ..analysis import metrics
 from ..analysis.records import Sampling
 from ..analysis.redecide import summarise
 from ..analysis.rows import Record
+from ..analysis.summary import Experiment as ExperimentSummary
+from ..analysis.summary import Summary
 from ..experiment_file import Experiment, ExperimentFile
 from ..experiment_file.kinds import kind_of
 from ..experiment_file.plan import count_iterations, experiment_iterations, extended, plan, Unit
@@ -50,7 +52,7 @@ class Sink(Protocol):
     def iterations(self, experiment_id: str) -> list[dict]: ...
     def picks(self, experiment_id: str) -> list[dict]: ...
     def checks(self, experiment_id: str) -> list[dict]: ...
-    def write_summary(self, summary: dict) -> None: ...
+    def write_summary(self, summary: Summary) -> None: ...
     def reorder(self, rank: dict[tuple, tuple[int, int]]) -> None: ...
 
 
@@ -82,7 +84,7 @@ class Runner:
         self._done = 0
         self._costs = Costs()
         self._start = time.monotonic()
-        self._summary: dict[str, dict] = {}
+        self._summary: dict[str, ExperimentSummary] = {}
         self._rank: dict[tuple, tuple[int, int]] = {}   # key -> (experiment, plan position)
         self._ready: list[tuple[tuple[int, int], Unit]] = []    # a heap by rank
         self._left: dict[str, int] = {}                # planned experiment -> units unwritten
@@ -100,7 +102,7 @@ class Runner:
         """Indexes of the backends whose worker was missing at the start or lost since."""
         return [k for k in range(len(self.backends)) if k not in self._live]
 
-    def run(self) -> dict:
+    def run(self) -> Summary:
         """Run every experiment; returns the summary (also written to the sink). A worker
         missing at the start is left out; the run fails when all are."""
         missing = []
@@ -228,8 +230,8 @@ class Runner:
             self._extend(exp, wider)
             return
         if self.file.sampling.adaptive and not kind_of(exp).repeats_others:
-            self._summary[exp.id]['sampling'] = self._sampling(exp, rows, checks).model_dump(
-                exclude_none=True)
+            self._summary[exp.id] = self._summary[exp.id].model_copy(
+                update={'sampling': self._sampling(exp, rows, checks)})
         self.sink.write_summary(metrics.file_summary(self.file, self._ordered_summary()))
         self._release()
 

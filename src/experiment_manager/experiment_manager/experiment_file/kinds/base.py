@@ -70,5 +70,5 @@ def scene_container(file: ExperimentFile, exp: Experiment, summary: dict) -> Con
     """An experiment's one container: its bin, the best bin of the bin_static it names, or
     the tray when it has neither."""
     if exp.bin_from:
-        return file.experiment(exp.bin_from).bins[summary[exp.bin_from]['best_bin']]
+        return file.experiment(exp.bin_from).bins[summary[exp.bin_from].best_bin]
     return file.tray if exp.bin is None else exp.bin

@@ -66,6 +66,6 @@ class FeederEmptying(ExperimentKind):
         return [Experiment(**out, max_vibrations=e.max_vibrations, max_feed=e.max_feed or 0)]
 
     def scenes(self, file: ExperimentFile, exp: Experiment, summary: dict) -> list[Scene]:
-        low, high = exp.optimal_range or summary[exp.range_from]['optimal_range']
+        low, high = exp.optimal_range or summary[exp.range_from].optimal_range
         feeder = FeederConfig(exp.parts, low, high, exp.max_vibrations, exp.max_feed)
         return [(0, scene_container(file, exp, summary), exp.parts, feeder)]
