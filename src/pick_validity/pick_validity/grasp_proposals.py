@@ -24,6 +24,7 @@ Units: metres; the part frame.
 """
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from pick_common.errors import InvalidArgument
@@ -33,8 +34,10 @@ import trimesh
 
 from .grasp_fit import crossings, round_axis, surface
 from .grasps import GraspPose, SuctionGrasp
-from .grippers import check_grasps, SuctionCup
 from .suction import holding, seal
+
+if TYPE_CHECKING:       # the gripper kinds ask for proposals; this module never imports them
+    from .grippers import SuctionCup
 
 # 3 mm on each side of the part: the margin of every grasp of the project's test case
 # (config/test_case/grippers_pth*.yaml: 11 mm over the capacitor's 5 mm body, 16 and 10.5 mm
@@ -215,7 +218,7 @@ def _distinct(directions: list[np.ndarray], signed: bool) -> list[np.ndarray]:
     return kept
 
 
-def propose_suction(part: PartGeometry, cup: SuctionCup) -> tuple[Proposal, ...]:
+def propose_suction(part: PartGeometry, cup: 'SuctionCup') -> tuple[Proposal, ...]:
     """One suction grasp per way the part can lie (module docstring); InvalidArgument naming
     gripper.cup_diameter when the cup seals nowhere, with the largest of the cup's halves and
     quarters that would."""
@@ -234,7 +237,7 @@ def propose_suction(part: PartGeometry, cup: SuctionCup) -> tuple[Proposal, ...]
                           f'can lie: {fits}; write its grasps, or choose a smaller cup')
 
 
-def _cup_grasps(part: PartGeometry, cup: SuctionCup) -> tuple[Proposal, ...]:
+def _cup_grasps(part: PartGeometry, cup: 'SuctionCup') -> tuple[Proposal, ...]:
     centre = part.mass_centre
     triangles = surface(part)
     step = cup.cup_diameter / 4
@@ -257,7 +260,7 @@ def _cup_grasps(part: PartGeometry, cup: SuctionCup) -> tuple[Proposal, ...]:
             point = np.round((base + (top - float(t.min())) * up) / ROUNDING) * ROUNDING
             grasp = SuctionGrasp(f'cup_up{_name(up)}', tuple(float(v) for v in up),
                                  tuple(float(v) for v in point))
-            (checked,) = check_grasps([grasp], cup)
+            checked = cup.check_grasp(grasp, f'grasps.{grasp.name}', grasp.name)
             found = seal(part, cup, checked)
             if found.ok and holding(part, cup, checked).ok:
                 out.append(Proposal(grasp, found.deviation))

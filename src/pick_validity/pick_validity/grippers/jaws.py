@@ -176,7 +176,7 @@ class Jaws(Kind):
 
     @property
     def proposal_rule(self) -> str:
-        from ..grasp_proposals import JAW_MARGIN  # builds on this package's records
+        from ..grasp_proposals import JAW_MARGIN  # trimesh: loaded when asked
         return ('across opposed faces at the mass centre and round bodies level with it (or, '
                 'with neither, across its principal axes), jaws '
                 f'{JAW_MARGIN * MM:g} mm wider than the part each side')
@@ -184,7 +184,7 @@ class Jaws(Kind):
     def propose(self, part: 'PartGeometry') -> tuple:
         """The jaws' proposals (grasp_proposals.propose); InvalidArgument naming `grasps`
         when there is none."""
-        from ..grasp_proposals import propose  # builds on this module's records
+        from ..grasp_proposals import propose  # trimesh: loaded when asked
         found = propose(part)
         if not found:
             raise InvalidArgument('grasps', 'auto', 'found no grasp: the part has no opposed '

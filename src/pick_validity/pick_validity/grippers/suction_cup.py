@@ -193,5 +193,5 @@ class SuctionCup(Kind):
 
     def propose(self, part: 'PartGeometry') -> tuple:
         """The cup's proposals (grasp_proposals.propose_suction)."""
-        from ..grasp_proposals import propose_suction  # builds on this module's records
+        from ..grasp_proposals import propose_suction  # trimesh: loaded when asked
         return propose_suction(part, self)
