@@ -452,3 +452,12 @@ def test_the_trays_hopper_and_walls_are_inputs_of_the_repeats_on_the_tray():
 def test_a_tray_input_that_cannot_apply_is_named(text, field, rule):
     with pytest.raises(InvalidArgument, match=field + '.*' + rule):
         experiment_file.parse(sensitivity(text))
+
+
+def test_a_gripper_input_of_another_kind_is_refused_in_the_one_wording():
+    with pytest.raises(InvalidArgument) as err:
+        experiment_file.parse(sensitivity(
+            'iterations: 1, of: [emptying], inputs: {'
+            'gripper.cup_diameter_mm: {low: 2, high: 4, source: a}}'))
+    assert str(err.value).endswith('is a key of a suction cup, and the gripper is parallel '
+                                   'jaws (gripper.type: jaws)'), str(err.value)

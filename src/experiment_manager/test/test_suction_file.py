@@ -61,7 +61,7 @@ def test_check_prints_and_writes_each_grasp_s_seal_and_margin(tmp_path, capsys):
     (('type: suction, cup_diameter_mm: 4', 'type: jaws'),
      "part.grasps[0].closing_axis (grasp 'top')", 'is required with parallel jaws'),
     (('cup_diameter_mm: 4', 'cup_diameter_mm: 4, jaw_depth_mm: 3'), 'gripper.jaw_depth_mm',
-     'is a key of parallel jaws, and the gripper is type: suction'),
+     'is a key of parallel jaws, and the gripper is a suction cup (gripper.type: suction)'),
     # no grasp the cup can use
     (('- {name: top, up_axis: [0, 0, 1], grasp_point_mm: [0, 0, 1.65]}\n', ''), 'part.grasps',
      "hold no grasp the cup can use: 'end': the rim leaves the part"),

@@ -10,7 +10,7 @@ import math
 from pick_common.errors import check_number, InvalidArgument
 from pick_common.parts.geometry import PartGeometry
 from pick_validity.config import Setup
-from pick_validity.grippers import GripperKind
+from pick_validity.grippers import GripperKind, not_its_key
 
 from . import experiment_keys, schema, sections
 from . import part as part_section
@@ -30,8 +30,7 @@ def variants(e: experiment_keys.GripperSweepKeys, where: str, gripper: GripperKi
         if getattr(e.grippers, key) is not None and key not in \
                 {k.file_key for k in gripper.KEYS}:
             raise InvalidArgument(f'{where}.grippers.{key}', getattr(e.grippers, key),
-                                  f"is not a key of the file's gripper, {gripper.description} "
-                                  f'(gripper.type: {gripper.kind})')
+                                  not_its_key(key, gripper))
     axes = []
     for key in gripper.KEYS:
         given = getattr(e.grippers, key.file_key)

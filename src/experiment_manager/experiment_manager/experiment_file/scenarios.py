@@ -39,7 +39,7 @@ from pick_common.errors import check_number, InvalidArgument
 from pick_common.parts.materials import body_values
 from pick_common.specs import check_vibration, Vibration
 from pick_validity.config import Setup
-from pick_validity.grippers import KINDS
+from pick_validity.grippers import KINDS, not_its_key
 
 from .errors import checked
 from .model import G, Input, MM, Scenario
@@ -105,8 +105,8 @@ def base_value(name: str, setup: Setup, mass: float, tray: ContainerSpec,
     if section == 'tray':
         return _tray_value(attr, tray) / unit
     if section == 'gripper' and attr not in setup.gripper.values():
-        raise InvalidArgument(where or name, name, f"is not a key of the file's gripper, "
-                              f'{setup.gripper.description} (gripper.type)')
+        raise InvalidArgument(where or name, name,
+                              not_its_key(name.split('.', 1)[1], setup.gripper))
     if section == 'moves':
         return 1.0
     if attr == 'mass':

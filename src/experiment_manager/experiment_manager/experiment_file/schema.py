@@ -32,7 +32,7 @@ from pick_common.specs import (
     MOVES,
 )
 from pick_validity.config import CheckConfig
-from pick_validity.grippers import kind_of_key, KINDS
+from pick_validity.grippers import KINDS, not_its_key
 from pydantic import (
     BaseModel,
     BeforeValidator,
@@ -193,8 +193,7 @@ class _Gripper(Section):
         own = {key.file_key for key in KINDS[self.type].KEYS}
         for key in GRIPPER_FILE_KEYS:
             if key in self.model_fields_set and key not in own:
-                fail(f'is a key of {kind_of_key(key).description}, and the gripper is type: '
-                     f'{self.type}', getattr(self, key), f'.{key}')
+                fail(not_its_key(key, KINDS[self.type]), getattr(self, key), f'.{key}')
         return self
 
 

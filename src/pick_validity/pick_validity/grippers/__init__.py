@@ -47,6 +47,15 @@ def kind_of_key(file_key: str) -> type[GripperKind] | None:
                 None)
 
 
+def not_its_key(file_key: str, gripper) -> str:
+    """The one wording that refuses a file key `gripper`'s kind (a kind or one of it) does
+    not have, wherever the key is given (the gripper section, a sweep's grid, a
+    sensitivity's input): whose key it is, and the gripper's kind."""
+    owner = kind_of_key(file_key)
+    return (f'is a key of {owner.description}' if owner else 'is no gripper key') + (
+        f', and the gripper is {gripper.description} (gripper.type: {gripper.kind})')
+
+
 def check_grasps(grasps, gripper: GripperKind) -> tuple[Grasp, ...] | tuple[CupGrasp, ...]:
     """Check every grasp pose as the gripper's kind reads it. A grasp of another kind is
     refused, saying what the gripper's kind wants."""
