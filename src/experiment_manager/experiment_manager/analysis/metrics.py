@@ -41,6 +41,7 @@ EXCLUDED = (PHYSICS_FAULT, TUNNELLED, THROWN)
 FIT_ORDER = 4
 BOOTSTRAP = 4000        # resamples of a table_sweep's iterations for the interval of n*
 
+
 def _stats(values) -> Stats:
     return Stats(**stats(values))
 
