@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from scipy.stats import fisher_exact
 
 from ..experiment_file import ExperimentFile
+from ..experiment_file.kinds import kind_of
 from ..experiment_file.model import Experiment
 from ..experiment_file.scenarios import grid_levels, point_key
 from . import calibration, metrics
@@ -67,7 +68,8 @@ def answers(experiments: dict) -> dict:
 def summarise(file: ExperimentFile, exp: Experiment, summaries: dict) -> model.Sensitivity:
     """The sensitivity experiment `exp`'s summary from every experiment's (`summaries`, by
     id; its repeats among them)."""
-    base = {k: v for k, v in summaries.items() if '@' not in k and v.type != exp.type}
+    base = {k: v for k, v in summaries.items()
+            if '@' not in k and not kind_of(file.experiment(k)).repeats_others}
 
     def view(scenario: str | None) -> dict:
         swapped = dict(base)
@@ -80,7 +82,7 @@ def summarise(file: ExperimentFile, exp: Experiment, summaries: dict) -> model.S
     last = {v.type: k for k, v in base.items()}
     moved = ({'static bin'} if last.get('bin_emptying') in exp.of else set()) | (
         {'vibrating table'} if last.get('feeder_emptying') in exp.of else set()) | {
-        f'gripper (`{e}`)' for e in exp.of if base[e].type == 'gripper_sweep'}
+        f'gripper (`{e}`)' for e in exp.of if kind_of(file.experiment(e)).own_grippers}
 
     def said(experiments: dict) -> dict:
         # the answers of the experiments repeated (the others' do not move), and the verdicts
@@ -133,7 +135,7 @@ def _calibrations(file: ExperimentFile, exp: Experiment, base: dict, summaries: 
     out = []
     for e in exp.of:
         measured = dict(file.experiment(e).measured)
-        if base[e].type != 'drop_test' or not measured:
+        if not kind_of(file.experiment(e)).names_aspects or not measured:
             continue
         points = [({x.name: x.base for x in exp.inputs}, calibration.counts_of(base[e]))]
         points += [({**{x.name: x.base for x in exp.inputs}, **dict(sc.values)},
