@@ -19,6 +19,9 @@ CONFIG = os.path.join(os.path.dirname(__file__), '..', 'config')
 def test_every_type_is_one_kind_and_every_table_holds_every_kind_that_runs():
     assert list(KINDS) == list(TYPES) or set(KINDS) == set(TYPES)
     assert all(k.name == name for name, k in KINDS.items())
+    # each kind reads its entry into a record of its own, which says its type
+    assert all(k.record.type == name for name, k in KINDS.items())
+    assert len({k.record for k in KINDS.values()}) == len(KINDS)
     running = {name for name, k in KINDS.items() if not k.repeats_others}
     for table in (metrics.SUMMARIES, sampling.DECISIONS, procedures.PROCEDURES,
                   estimate.PRIOR):
@@ -36,6 +39,7 @@ def test_a_kind_plans_its_groups_and_names_its_iterations():
     for exp in file.experiments:
         kind = kind_of(exp)
         seen.add(kind.name)
+        assert type(exp) is kind.record
         units = plan(file, exp, summary)
         assert len(units) == len(groups(exp)) * exp.iterations
         assert [u.group for u in units[::exp.iterations]] == groups(exp)

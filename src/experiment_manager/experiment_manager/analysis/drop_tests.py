@@ -7,11 +7,12 @@ from collections import Counter
 from pick_common.parts import aspects
 from pick_common.stats import wilson_interval
 
-from ..experiment_file import Experiment, ExperimentFile
+from ..experiment_file import DropTestExperiment, ExperimentFile
 from .summary import AspectCount, DropTest, Measured
 
 
-def summary(file: ExperimentFile, exp: Experiment, rows: list[dict], base: dict) -> DropTest:
+def summary(file: ExperimentFile, exp: DropTestExperiment,
+            rows: list[dict], base: dict) -> DropTest:
     """A drop test's aspects: each one's count, share and 95 % interval of the drops at rest
     on an aspect, the quasi-static share, and against the measured counts (when the file
     gives them) each one's difference and the G-test's p (aspects.agreement; agrees: p at

@@ -19,12 +19,17 @@ from pick_common.stats import interval, rate_interval, stats
 from ..experiment_file import (
     BIN_EMPTYING,
     BIN_STATIC,
+    BinEmptyingExperiment,
+    BinStaticExperiment,
     DROP_TEST,
     Experiment,
     ExperimentFile,
     FEEDER_EMPTYING,
+    FeederEmptyingExperiment,
     GRIPPER_SWEEP,
+    GripperSweepExperiment,
     TABLE_SWEEP,
+    TableSweepExperiment,
 )
 from . import decisions, drop_tests
 from . import summary as model
@@ -66,7 +71,8 @@ def _regrasps(exp: Experiment, rows: list[dict]) -> dict:
     return {'regrasps': _stats([r.get('regrasps', 0) for r in rows])} if exp.station else {}
 
 
-def bin_static(exp: Experiment, rows: list[dict], base: dict | None = None) -> model.BinStatic:
+def bin_static(exp: BinStaticExperiment,
+               rows: list[dict], base: dict | None = None) -> model.BinStatic:
     bins = []
     for b, spec in enumerate(exp.bins):
         mine = [r for r in rows if r['group'] == b]
@@ -82,7 +88,7 @@ def bin_static(exp: Experiment, rows: list[dict], base: dict | None = None) -> m
                            best_bin_mm=bins[best].size_mm if best is not None else None)
 
 
-def bin_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
+def bin_emptying(file: ExperimentFile, exp: BinEmptyingExperiment, rows: list[dict],
                  picks: list[dict], base: dict | None = None) -> model.BinEmptying:
     """Table 2, with `emptied_ci95`: the 95 % interval of the share of bins emptied, and
     `decision`: that share against requirements.success_rate on its one-sided bounds
@@ -174,7 +180,7 @@ def n_star_interval(counts, by_count: list, order: int, first: int, last: int,
             int(np.quantile(stars, 1.0 - tail, method='higher')))
 
 
-def table_sweep(file: ExperimentFile, exp: Experiment, rows: list[dict],
+def table_sweep(file: ExperimentFile, exp: TableSweepExperiment, rows: list[dict],
                 base: dict | None = None) -> model.TableSweep:
     """Valid parts per count, the fit and its n* with optimal range, and `n_star_ci95`: n*'s
     95 % bootstrap interval (n_star_interval, seeded by the file's seed and the rows), when
@@ -198,7 +204,7 @@ def table_sweep(file: ExperimentFile, exp: Experiment, rows: list[dict],
                             per_n=per_n, margin=exp.margin, **fitted)
 
 
-def feeder_emptying(file: ExperimentFile, exp: Experiment, rows: list[dict],
+def feeder_emptying(file: ExperimentFile, exp: FeederEmptyingExperiment, rows: list[dict],
                     optimal_range, base: dict | None = None) -> model.FeederEmptying:
     """`emptied`: runs that emptied the feeder and the table; `accepted`: of them, those that
     spilled at most requirements.max_spilled_parts over the tray's walls, and `accepted_ci95`
@@ -256,7 +262,7 @@ def cell_throughput(cell, row: dict) -> float:
     return 3600.0 * row['picks'] / busy
 
 
-def gripper_sweep(exp: Experiment, rows: list[dict], checks: list[dict],
+def gripper_sweep(exp: GripperSweepExperiment, rows: list[dict], checks: list[dict],
                   base: dict | None = None) -> model.GripperSweep:
     """Per variant (gripper and grasp set, in the experiment's order; check k of each scene is
     variant k): the stage fractions, the valid parts per check with their 95 % interval

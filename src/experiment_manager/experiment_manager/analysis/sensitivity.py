@@ -20,9 +20,8 @@ from dataclasses import dataclass
 
 from scipy.stats import fisher_exact
 
-from ..experiment_file import ExperimentFile
+from ..experiment_file import ExperimentFile, SensitivityExperiment
 from ..experiment_file.kinds import kind_of
-from ..experiment_file.model import Experiment
 from ..experiment_file.scenarios import grid_levels, point_key
 from . import calibration, metrics
 from . import summary as model
@@ -65,7 +64,8 @@ def answers(experiments: dict) -> dict:
     return out
 
 
-def summarise(file: ExperimentFile, exp: Experiment, summaries: dict) -> model.Sensitivity:
+def summarise(file: ExperimentFile, exp: SensitivityExperiment,
+              summaries: dict) -> model.Sensitivity:
     """The sensitivity experiment `exp`'s summary from every experiment's (`summaries`, by
     id; its repeats among them)."""
     base = {k: v for k, v in summaries.items()
@@ -112,8 +112,8 @@ def summarise(file: ExperimentFile, exp: Experiment, summaries: dict) -> model.S
                for e in exp.of}
     # a repeat whose bin or range comes from an experiment not repeated ran at the file's
     held = {e: model.Held(what=what, source=source) for e in exp.of
-            for what, source in (('range', file.experiment(e).range_from),
-                                 ('bin', file.experiment(e).bin_from))
+            for what, source in (('range', getattr(file.experiment(e), 'range_from', '')),
+                                 ('bin', getattr(file.experiment(e), 'bin_from', '')))
             if source and source not in exp.of}
     grid = _map(exp, base_said, scenarios)
     fitted = _calibrations(file, exp, base, summaries)
@@ -128,15 +128,15 @@ def summarise(file: ExperimentFile, exp: Experiment, summaries: dict) -> model.S
         faults=_faults(repeats), physics=_physics(repeats))
 
 
-def _calibrations(file: ExperimentFile, exp: Experiment, base: dict, summaries: dict
+def _calibrations(file: ExperimentFile, exp: SensitivityExperiment, base: dict, summaries: dict
                   ) -> list[model.Calibration]:
     """Each repeated drop test with measured counts fitted over the scenarios (and the
     file's own values): calibration.calibrate."""
     out = []
     for e in exp.of:
-        measured = dict(file.experiment(e).measured)
-        if not kind_of(file.experiment(e)).names_aspects or not measured:
+        if not kind_of(file.experiment(e)).names_aspects or not file.experiment(e).measured:
             continue
+        measured = dict(file.experiment(e).measured)
         points = [({x.name: x.base for x in exp.inputs}, calibration.counts_of(base[e]))]
         points += [({**{x.name: x.base for x in exp.inputs}, **dict(sc.values)},
                     calibration.counts_of(summaries[f'{e}@{sc.name}'])) for sc in exp.scenarios]
@@ -144,7 +144,7 @@ def _calibrations(file: ExperimentFile, exp: Experiment, base: dict, summaries: 
     return out
 
 
-def _map(exp: Experiment, base: model.Said, scenarios: list[model.Scenario]
+def _map(exp: SensitivityExperiment, base: model.Said, scenarios: list[model.Scenario]
          ) -> model.VerdictMap | None:
     """With two inputs on a grid: each option's verdict at each pair of their levels (rows the
     first input's, columns the second's), a map over them; None otherwise. A grid point that
@@ -229,7 +229,7 @@ def _one_rate_p(k: int, n: int, j: int, m: int) -> float:
     return float(fisher_exact([[k, n - k], [j, m - j]]).pvalue)
 
 
-def _robustness(exp: Experiment, base: model.Said, scenarios: list[model.Scenario],
+def _robustness(exp: SensitivityExperiment, base: model.Said, scenarios: list[model.Scenario],
                 spill_runs: dict | None = None) -> list[model.Robustness]:
     """Per option of the base verdicts: whether it holds in every scenario, and where not,
     the scenarios that flip it (their verdict and their inputs' values; for the table, a

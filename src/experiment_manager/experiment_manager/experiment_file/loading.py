@@ -59,7 +59,7 @@ def _experiment(e: experiment_keys.ExperimentKeys, where: str, c: Context) -> li
     scenes and station), then its kind's own keys (kinds.ExperimentKind.read)."""
     if e.id in c.earlier:
         raise InvalidArgument(f'{where}.id', e.id, 'is the id of an earlier experiment')
-    out: dict[str, Any] = {'id': e.id, 'type': e.type, 'iterations': e.iterations}
+    out: dict[str, Any] = {'id': e.id, 'iterations': e.iterations}
     if 'parts' in type(e).model_fields:
         out['parts'] = e.parts
     if getattr(e, 'gripper', None) is not None:

@@ -3,6 +3,7 @@
 
 from dataclasses import dataclass, field, replace
 import math
+from typing import ClassVar
 
 from pick_common.containers import ContainerSpec
 from pick_common.parts.spec import PartSpec
@@ -119,54 +120,123 @@ class Scenario:
     moves: tuple[Vibration, ...]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Experiment:
-    """One experiment of the file.
+    """One experiment of the file: what every kind has. Each kind's record below adds its
+    own fields (its kind in kinds/ builds it, `kinds.base.ExperimentKind.record`); `type` is
+    the record's, not an argument.
 
-    bins: bin_static's candidate bins. bin: bin_emptying's bin, or None when `bin_from` names
-    the bin_static experiment whose best bin is used (gripper_sweep: the same, and neither
-    means the tray). counts: table_sweep's parts on the tray. optimal_range:
-    feeder_emptying's [min*, max*], or None when `range_from` names the table_sweep whose
-    optimum is used. variants: gripper_sweep's grippers and grasp sets, checked on the same
-    scenes; min_valid: the valid parts per check a gripper must give (its 95 % interval's low
-    end at least this). of, inputs, scenarios, grid: a sensitivity's experiments repeated,
-    uncertain inputs, scenarios and grid levels per input (0: no grid); scenario: the one a
-    repeat (`<id>@<scenario>`) runs in.
+    parts: the parts of a scene. gripper: the gripper of the file's `grippers` it runs with
+    ('' and None: the file's own); setup: the setup it runs with (None: the file's); station:
+    with a regrasp station (its setup's check says so); seeded_by: the experiment whose
+    seeds it runs on (scenes_of; '': its own); scenario: the sensitivity scenario a repeat
+    (`<id>@<scenario>`) runs in.
     """
 
+    type: ClassVar[str]
     id: str
-    type: str
     iterations: int
     parts: int = 0
-    bins: tuple[ContainerSpec, ...] = ()
-    bin: ContainerSpec | None = None
-    bin_from: str = ''
-    counts: tuple[int, ...] = ()
-    margin: int = 5
-    optimal_range: tuple[int, int] | None = None
-    range_from: str = ''
-    max_vibrations: int = 500
-    max_feed: int = 0
-    variants: tuple[GripperVariant, ...] = ()
-    min_valid: float = 1.0
-    of: tuple[str, ...] = ()
-    inputs: tuple[Input, ...] = ()
-    scenarios: tuple[Scenario, ...] = ()
-    scenario: Scenario | None = None
-    grid: int = 0
-    measured: tuple[tuple[str, int], ...] = ()
-    extend: bool = True
-    # the gripper of the file's `grippers` it runs with ('' and None: the file's own)
     gripper: str = ''
     setup: Setup | None = None
-    station: bool = False       # with a regrasp station (its setup's check says so)
-    seeded_by: str = ''         # the experiment whose seeds it runs on (scenes_of); '': its own
+    station: bool = False
+    seeded_by: str = ''
+    scenario: Scenario | None = None
 
     @property
     def sources(self) -> tuple[str, ...]:
         """The experiments whose summaries this one needs before it is planned."""
-        repeats = tuple(f'{e}@{s.name}' for s in self.scenarios for e in self.of)
-        return tuple(s for s in (self.bin_from, self.range_from) if s) + repeats
+        return ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class BinStaticExperiment(Experiment):
+    """bin_static: its candidate bins."""
+
+    type: ClassVar[str] = BIN_STATIC
+    bins: tuple[ContainerSpec, ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class OneContainerExperiment(Experiment):
+    """A kind whose scenes are in one container: `bin`, or the best bin of the bin_static
+    `bin_from` names, or (neither) the tray (kinds.base.scene_container)."""
+
+    bin: ContainerSpec | None = None
+    bin_from: str = ''
+
+    @property
+    def sources(self) -> tuple[str, ...]:
+        return (self.bin_from,) if self.bin_from else ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class BinEmptyingExperiment(OneContainerExperiment):
+    """bin_emptying: one bin picked until no part is valid."""
+
+    type: ClassVar[str] = BIN_EMPTYING
+
+
+@dataclass(frozen=True, kw_only=True)
+class TableSweepExperiment(OneContainerExperiment):
+    """table_sweep: counts, the parts on the tray per group; margin, the counts a sweep may
+    go on beyond its last while its fit still rises (extend)."""
+
+    type: ClassVar[str] = TABLE_SWEEP
+    counts: tuple[int, ...] = ()
+    margin: int = 5
+    extend: bool = True
+
+
+@dataclass(frozen=True, kw_only=True)
+class FeederEmptyingExperiment(OneContainerExperiment):
+    """feeder_emptying: its [min*, max*], or None when `range_from` names the table_sweep
+    whose optimum is used; the feeder's limits on vibrations and one feed's parts."""
+
+    type: ClassVar[str] = FEEDER_EMPTYING
+    optimal_range: tuple[int, int] | None = None
+    range_from: str = ''
+    max_vibrations: int = 500
+    max_feed: int = 0
+
+    @property
+    def sources(self) -> tuple[str, ...]:
+        return super().sources + ((self.range_from,) if self.range_from else ())
+
+
+@dataclass(frozen=True, kw_only=True)
+class GripperSweepExperiment(OneContainerExperiment):
+    """gripper_sweep: its grippers and grasp sets, checked on the same scenes; min_valid:
+    the valid parts per check a gripper must give (its 95 % interval's low end at least
+    this)."""
+
+    type: ClassVar[str] = GRIPPER_SWEEP
+    variants: tuple[GripperVariant, ...] = ()
+    min_valid: float = 1.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class DropTestExperiment(OneContainerExperiment):
+    """drop_test: its plate is its `bin`; measured: the user's counts per aspect name."""
+
+    type: ClassVar[str] = DROP_TEST
+    measured: tuple[tuple[str, int], ...] = ()
+
+
+@dataclass(frozen=True, kw_only=True)
+class SensitivityExperiment(Experiment):
+    """sensitivity: the experiments repeated (`of`), the uncertain inputs, the scenarios and
+    the grid levels per input (0: no grid)."""
+
+    type: ClassVar[str] = SENSITIVITY
+    of: tuple[str, ...] = ()
+    inputs: tuple[Input, ...] = ()
+    scenarios: tuple[Scenario, ...] = ()
+    grid: int = 0
+
+    @property
+    def sources(self) -> tuple[str, ...]:
+        return tuple(f'{e}@{s.name}' for s in self.scenarios for e in self.of)
 
 
 @dataclass(frozen=True)

@@ -66,12 +66,18 @@ from ..analysis import decisions, metrics
 from ..experiment_file import (
     BIN_EMPTYING,
     BIN_STATIC,
+    BinEmptyingExperiment,
+    BinStaticExperiment,
     DROP_TEST,
+    DropTestExperiment,
     Experiment,
     ExperimentFile,
     FEEDER_EMPTYING,
+    FeederEmptyingExperiment,
     GRIPPER_SWEEP,
+    GripperSweepExperiment,
     TABLE_SWEEP,
+    TableSweepExperiment,
 )
 from ..experiment_file.kinds import kind_of
 from ..experiment_file.plan import groups
@@ -105,24 +111,24 @@ def ended(file: ExperimentFile, exp: Experiment, rows: list[dict],
     return DECISIONS[exp.type](file, exp, kept, checks)
 
 
-def _drops_unsettled(file: ExperimentFile, exp: Experiment, kept: list[dict],
+def _drops_unsettled(file: ExperimentFile, exp: DropTestExperiment, kept: list[dict],
                      checks: list[dict]) -> tuple[list[int], list[int]]:
     return groups(exp), []      # no decision: every drop asked for is made
 
 
-def _gripper_unsettled(file: ExperimentFile, exp: Experiment, kept: list[dict],
+def _gripper_unsettled(file: ExperimentFile, exp: GripperSweepExperiment, kept: list[dict],
                        checks: list[dict]) -> tuple[list[int], list[int]]:
     return ([] if _smallest_settled(exp, checks) else groups(exp)), []
 
 
-def _emptying_unsettled(file: ExperimentFile, exp: Experiment, kept: list[dict],
+def _emptying_unsettled(file: ExperimentFile, exp: BinEmptyingExperiment, kept: list[dict],
                         checks: list[dict]) -> tuple[list[int], list[int]]:
     successes = sum(bool(r['emptied']) for r in kept)
     return ([] if rate_settled(successes, len(kept), file.requirements.success_rate)
             else groups(exp)), []
 
 
-def _feeder_unsettled(file: ExperimentFile, exp: Experiment, kept: list[dict],
+def _feeder_unsettled(file: ExperimentFile, exp: FeederEmptyingExperiment, kept: list[dict],
                       checks: list[dict]) -> tuple[list[int], list[int]]:
     grounds = metrics.table_grounds(file, kept, INTERIM_CONFIDENCE)
     return ([] if decisions.combined([g.verdict for g in grounds.values()])
@@ -136,7 +142,7 @@ def rate_settled(successes: int, n: int, required: float,
     return decisions.rate(successes, n, required, '', confidence).verdict != decisions.UNDECIDED
 
 
-def race(exp: Experiment, rows: list[dict]) -> tuple[list[int], list[int]]:
+def race(exp: BinStaticExperiment, rows: list[dict]) -> tuple[list[int], list[int]]:
     """(the bins still in the race, the bins of a tie that ended it). Racing: the leader (the
     highest mean container-free fraction) and every bin not known to lie below it: the
     one-sided RACE_CONFIDENCE bound of its mean less the leader's (metrics.difference_bound)
@@ -163,7 +169,8 @@ def race(exp: Experiment, rows: list[dict]) -> tuple[list[int], list[int]]:
     return racing, []
 
 
-def _sweep_unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict]) -> list[int]:
+def _sweep_unsettled(file: ExperimentFile, exp: TableSweepExperiment,
+                     rows: list[dict]) -> list[int]:
     """[] when the sweep's n* is settled (its bootstrap interval at INTERIM_CONFIDENCE lies
     inside n* +- margin, or the fit is flat across it: FLAT_TOP), else where the next look's
     drops go (_sweep_batches). The counts' rows and the fit are made once for both."""
@@ -189,7 +196,7 @@ def _sweep_unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict]) ->
     return _sweep_batches(file, exp, by_count, fitted)
 
 
-def _sweep_batches(file: ExperimentFile, exp: Experiment, by_count: list[np.ndarray],
+def _sweep_batches(file: ExperimentFile, exp: TableSweepExperiment, by_count: list[np.ndarray],
                    fitted: metrics.Fit | None) -> list[int]:
     """Where a sweep's next look puts its iterations: as many parts' worth of drops as a batch
     at every count, given a batch at a time to the count where a batch shrinks the variance of
@@ -248,7 +255,7 @@ def _sweep_batches(file: ExperimentFile, exp: Experiment, by_count: list[np.ndar
     return out or everywhere
 
 
-def _smallest_settled(exp: Experiment, checks: list[dict]) -> bool:
+def _smallest_settled(exp: GripperSweepExperiment, checks: list[dict]) -> bool:
     """In size order: every gripper known not to meet min_valid up to one known to meet it,
     or all known not to."""
     for k in sorted(range(len(exp.variants)), key=lambda k: (exp.variants[k].size, k)):

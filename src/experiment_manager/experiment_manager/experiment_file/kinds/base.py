@@ -6,7 +6,7 @@ from typing import Any, ClassVar
 from feeder_controller.policy import FeederConfig
 from pick_common.containers import ContainerSpec
 
-from ..model import Experiment, ExperimentFile
+from ..model import Experiment, ExperimentFile, OneContainerExperiment
 
 # The registry, by the file's `type`: filled by the package's __init__ with one instance of
 # each kind; read through it (or `kind_of`).
@@ -18,12 +18,13 @@ Scene = tuple[int, ContainerSpec, int, FeederConfig | None]
 
 class ExperimentKind:
     """One experiment type of the file (its `type`). Its keys are `keys`, a model of
-    experiment_keys; `read` turns a checked entry into the Experiment's fields; `groups`,
+    experiment_keys; `read` turns a checked entry into its `record` (model.py); `groups`,
     `scenes` and `label` plan its iterations. The traits below are what the later rooms
     (analysis, running) read of a kind besides their own tables of it."""
 
     name: ClassVar[str]
     keys: ClassVar[type]
+    record: ClassVar[type[Experiment]]          # what `read` makes (model.py)
     checks_neighbours: ClassVar[bool] = True      # a check asks stage 4 (neighbours)
     left_out_settles: ClassVar[bool] = False      # a left-out iteration decides it
     groups_are_bins: ClassVar[bool] = False       # its groups are bins that race
@@ -36,9 +37,9 @@ class ExperimentKind:
 
     def read(self, e: Any, where: str, c: Any, out: dict) -> list[Experiment]:
         """The Experiment(s) of the checked entry `e` at `where` (`c`: context.Context; `out`:
-        the fields every kind reads, id, type, iterations, parts, gripper, setup, station,
-        seeded_by)."""
-        return [Experiment(**out)]
+        the fields every kind reads, id, iterations, parts, gripper, setup, station,
+        seeded_by): one `record`."""
+        return [self.record(**out)]
 
     def groups(self, exp: Experiment) -> list[int]:
         """The groups of its iterations (Unit.group)."""
@@ -66,7 +67,8 @@ def kind_of(exp: Experiment) -> ExperimentKind:
     return KINDS[exp.type]
 
 
-def scene_container(file: ExperimentFile, exp: Experiment, summary: dict) -> ContainerSpec:
+def scene_container(file: ExperimentFile, exp: OneContainerExperiment, summary: dict
+                    ) -> ContainerSpec:
     """An experiment's one container: its bin, the best bin of the bin_static it names, or
     the tray when it has neither."""
     if exp.bin_from:

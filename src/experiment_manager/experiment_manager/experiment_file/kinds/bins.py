@@ -6,7 +6,14 @@ from typing import Any, ClassVar
 from pick_common.containers import check_fits
 
 from .. import experiment_keys
-from ..model import BIN_EMPTYING, BIN_STATIC, Experiment, ExperimentFile
+from ..model import (
+    BIN_EMPTYING,
+    BIN_STATIC,
+    BinEmptyingExperiment,
+    BinStaticExperiment,
+    Experiment,
+    ExperimentFile,
+)
 from .base import ExperimentKind, Scene
 from .context import bin_or_source, bin_spec
 
@@ -16,6 +23,7 @@ class BinStatic(ExperimentKind):
 
     name: ClassVar[str] = BIN_STATIC
     keys: ClassVar[type] = experiment_keys.BinStaticKeys
+    record: ClassVar[type] = BinStaticExperiment
     checks_neighbours: ClassVar[bool] = False
     groups_are_bins: ClassVar[bool] = True
 
@@ -24,15 +32,15 @@ class BinStatic(ExperimentKind):
                             for i, v in enumerate(e.bins_mm))
         for i, b in enumerate(out['bins']):
             check_fits(f'{where}.parts (bins_mm[{i}])', e.parts, c.geometry.volume, b)
-        return [Experiment(**out)]
+        return [BinStaticExperiment(**out)]
 
-    def groups(self, exp: Experiment) -> list[int]:
+    def groups(self, exp: BinStaticExperiment) -> list[int]:
         return list(range(len(exp.bins)))
 
-    def scenes(self, file: ExperimentFile, exp: Experiment, summary: dict) -> list[Scene]:
+    def scenes(self, file: ExperimentFile, exp: BinStaticExperiment, summary: dict) -> list[Scene]:
         return [(b, container, exp.parts, None) for b, container in enumerate(exp.bins)]
 
-    def label(self, exp: Experiment, group: int, iteration: int) -> str:
+    def label(self, exp: BinStaticExperiment, group: int, iteration: int) -> str:
         return f'bin {group + 1}/{len(exp.bins)}, iteration {iteration + 1}'
 
 
@@ -41,7 +49,8 @@ class BinEmptying(ExperimentKind):
 
     name: ClassVar[str] = BIN_EMPTYING
     keys: ClassVar[type] = experiment_keys.BinEmptyingKeys
+    record: ClassVar[type] = BinEmptyingExperiment
     left_out_settles: ClassVar[bool] = True
 
     def read(self, e: Any, where: str, c: Any, out: dict) -> list[Experiment]:
-        return [Experiment(**out, **bin_or_source(e.bin, e.parts, where, c))]
+        return [BinEmptyingExperiment(**out, **bin_or_source(e.bin, e.parts, where, c))]

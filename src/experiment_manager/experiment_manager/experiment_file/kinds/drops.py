@@ -5,7 +5,7 @@ from typing import Any, ClassVar
 
 from .. import experiment_keys
 from ..drop_test import drop_test
-from ..model import DROP_TEST, Experiment
+from ..model import DROP_TEST, DropTestExperiment, Experiment
 from .base import ExperimentKind
 
 
@@ -14,9 +14,10 @@ class DropTest(ExperimentKind):
 
     name: ClassVar[str] = DROP_TEST
     keys: ClassVar[type] = experiment_keys.DropTestKeys
+    record: ClassVar[type] = DropTestExperiment
     checks_neighbours: ClassVar[bool] = False
     names_aspects: ClassVar[bool] = True
 
     def read(self, e: Any, where: str, c: Any, out: dict) -> list[Experiment]:
-        base = {k: out[k] for k in ('id', 'type', 'iterations')}
-        return [Experiment(**base, **drop_test(e, where, c.geometry, c.bin_wall))]
+        base = {k: out[k] for k in ('id', 'iterations')}
+        return [DropTestExperiment(**base, **drop_test(e, where, c.geometry, c.bin_wall))]

@@ -6,7 +6,7 @@ from typing import Any, ClassVar
 from pick_common.containers import check_fits
 
 from .. import experiment_keys, grippers
-from ..model import Experiment, GRIPPER_SWEEP
+from ..model import Experiment, GRIPPER_SWEEP, GripperSweepExperiment
 from .base import ExperimentKind
 from .context import bin_or_source
 
@@ -17,6 +17,7 @@ class GripperSweep(ExperimentKind):
 
     name: ClassVar[str] = GRIPPER_SWEEP
     keys: ClassVar[type] = experiment_keys.GripperSweepKeys
+    record: ClassVar[type] = GripperSweepExperiment
     uses_checks: ClassVar[bool] = True
     own_grippers: ClassVar[bool] = True
 
@@ -24,8 +25,8 @@ class GripperSweep(ExperimentKind):
         scene = bin_or_source(e.bin, e.parts, where, c)
         if not scene:       # no bin: the parts lie on the tray, as in a table_sweep
             check_fits(f'{where}.parts (tray_mm)', e.parts, c.geometry.volume, c.tray)
-        return [Experiment(**out, **scene, min_valid=e.min_valid,
+        return [GripperSweepExperiment(**out, **scene, min_valid=e.min_valid,
                            variants=grippers.variants(e, where, c.gripper, c.grasps))]
 
-    def cost_units(self, exp: Experiment, parts: float) -> float:
+    def cost_units(self, exp: GripperSweepExperiment, parts: float) -> float:
         return parts * len(exp.variants)

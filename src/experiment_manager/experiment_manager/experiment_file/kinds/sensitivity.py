@@ -9,7 +9,7 @@ from pick_common.errors import InvalidArgument
 from .. import experiment_keys, schema
 from .. import scenarios as scenario_inputs
 from ..drop_test import drop_test_height
-from ..model import Experiment, Input, SENSITIVITY
+from ..model import Experiment, Input, OneContainerExperiment, SENSITIVITY, SensitivityExperiment
 from .base import ExperimentKind, kind_of
 from .context import Context
 
@@ -19,6 +19,7 @@ class Sensitivity(ExperimentKind):
 
     name: ClassVar[str] = SENSITIVITY
     keys: ClassVar[type] = experiment_keys.SensitivityKeys
+    record: ClassVar[type] = SensitivityExperiment
     repeats_others: ClassVar[bool] = True
 
     def read(self, e: Any, where: str, c: Any, out: dict) -> list[Experiment]:
@@ -33,7 +34,7 @@ class Sensitivity(ExperimentKind):
 
 def _on_tray(exp: Experiment) -> bool:
     """Whether an experiment runs on the file's tray (no bin of its own or of another's)."""
-    return exp.bin is None and not exp.bin_from and not exp.bins
+    return isinstance(exp, OneContainerExperiment) and exp.bin is None and not exp.bin_from
 
 
 def read(e: experiment_keys.SensitivityKeys, where: str, c: Context) -> list[Experiment]:
@@ -94,7 +95,7 @@ def read(e: experiment_keys.SensitivityKeys, where: str, c: Context) -> list[Exp
             source = c.earlier[exp_id]
             renamed = {key: f'{value}@{scenario.name}' if value in e.of else value
                        for key in ('bin_from', 'range_from')
-                       if (value := getattr(source, key))}
+                       if (value := getattr(source, key, ''))}
             if (height := scenario_inputs.drop_height(scenario)) is not None:
                 renamed['bin'] = replace(source.bin, drop_height=height)
             elif _on_tray(source) and (tray := scenario_inputs.tray_of(scenario, c.tray)):
@@ -102,6 +103,5 @@ def read(e: experiment_keys.SensitivityKeys, where: str, c: Context) -> list[Exp
             repeats.append(replace(source, id=f'{exp_id}@{scenario.name}',
                                    iterations=min(source.iterations, e.iterations),
                                    scenario=scenario, **renamed))
-    return repeats + [Experiment(id=e.id, type=SENSITIVITY, iterations=e.iterations,
-                                 of=tuple(e.of), inputs=inputs, scenarios=found,
-                                 grid=e.grid)]
+    return repeats + [SensitivityExperiment(id=e.id, iterations=e.iterations, of=tuple(e.of),
+                                            inputs=inputs, scenarios=found, grid=e.grid)]

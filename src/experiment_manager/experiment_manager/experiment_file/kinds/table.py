@@ -10,7 +10,14 @@ from pick_common.containers import check_fits
 
 from .. import experiment_keys
 from ..errors import checked as checked_as
-from ..model import Experiment, ExperimentFile, FEEDER_EMPTYING, TABLE_SWEEP
+from ..model import (
+    Experiment,
+    ExperimentFile,
+    FEEDER_EMPTYING,
+    FeederEmptyingExperiment,
+    TABLE_SWEEP,
+    TableSweepExperiment,
+)
 from .base import ExperimentKind, Scene, scene_container
 from .context import earlier
 
@@ -21,24 +28,26 @@ class TableSweep(ExperimentKind):
 
     name: ClassVar[str] = TABLE_SWEEP
     keys: ClassVar[type] = experiment_keys.TableSweepKeys
+    record: ClassVar[type] = TableSweepExperiment
     extends: ClassVar[bool] = True
 
     def read(self, e: Any, where: str, c: Any, out: dict) -> list[Experiment]:
         out = {k: v for k, v in out.items() if k != 'parts'}     # its parts are its counts
         out['counts'] = tuple(range(e.counts.first, e.counts.last + 1, e.counts.step))
         check_fits(f'{where}.counts.last', out['counts'][-1], c.geometry.volume, c.tray)
-        return [Experiment(**out, margin=e.margin, extend=e.extend)]
+        return [TableSweepExperiment(**out, margin=e.margin, extend=e.extend)]
 
-    def groups(self, exp: Experiment) -> list[int]:
+    def groups(self, exp: TableSweepExperiment) -> list[int]:
         return list(exp.counts)
 
-    def scenes(self, file: ExperimentFile, exp: Experiment, summary: dict) -> list[Scene]:
+    def scenes(self, file: ExperimentFile, exp: TableSweepExperiment, summary: dict
+               ) -> list[Scene]:
         return [(n, scene_container(file, exp, summary), n, None) for n in exp.counts]
 
-    def label(self, exp: Experiment, group: int, iteration: int) -> str:
+    def label(self, exp: TableSweepExperiment, group: int, iteration: int) -> str:
         return f'{group} parts, iteration {iteration + 1}'
 
-    def parts(self, exp: Experiment) -> float:
+    def parts(self, exp: TableSweepExperiment) -> float:
         return float(np.mean(exp.counts))
 
 
@@ -48,6 +57,7 @@ class FeederEmptying(ExperimentKind):
 
     name: ClassVar[str] = FEEDER_EMPTYING
     keys: ClassVar[type] = experiment_keys.FeederEmptyingKeys
+    record: ClassVar[type] = FeederEmptyingExperiment
     left_out_settles: ClassVar[bool] = True
     feeds: ClassVar[bool] = True
 
@@ -63,9 +73,11 @@ class FeederEmptying(ExperimentKind):
             checked_as(check_feeder, FeederConfig(e.parts, *e.optimal_range, e.max_vibrations,
                                                   e.max_feed or 0), where)
         check_fits(f'{where}.optimal_range (max)', high, c.geometry.volume, c.tray)
-        return [Experiment(**out, max_vibrations=e.max_vibrations, max_feed=e.max_feed or 0)]
+        return [FeederEmptyingExperiment(**out, max_vibrations=e.max_vibrations,
+                                         max_feed=e.max_feed or 0)]
 
-    def scenes(self, file: ExperimentFile, exp: Experiment, summary: dict) -> list[Scene]:
+    def scenes(self, file: ExperimentFile, exp: FeederEmptyingExperiment, summary: dict
+               ) -> list[Scene]:
         low, high = exp.optimal_range or summary[exp.range_from].optimal_range
         feeder = FeederConfig(exp.parts, low, high, exp.max_vibrations, exp.max_feed)
         return [(0, scene_container(file, exp, summary), exp.parts, feeder)]
