@@ -17,7 +17,12 @@ from experiment_manager.experiment_file.board import (
     table,
     write_parts,
 )
-from experiment_manager.experiment_file.board.parts import DECIDE, NOT_THROUGH_HOLE, REFUSED
+from experiment_manager.experiment_file.board.parts import (
+    board_parts,
+    DECIDE,
+    NOT_THROUGH_HOLE,
+    REFUSED,
+)
 from experiment_manager.experiment_file.part import geometry
 import numpy as np
 from pick_common.errors import InvalidArgument
@@ -170,6 +175,35 @@ def test_a_model_that_does_not_exist_and_a_wrl_with_no_step_are_refused_and_the_
     assert parts['Altech_AK300_1x02_P5.00mm_45-Degree'].status == DECIDE
     assert set(board.files) == {'Altech_AK300_1x02_P5.00mm_45-Degree',
                                 'C_Disc_D4.7mm_W2.5mm_P5.00mm'}
+
+
+def test_a_relative_model_path_is_looked_for_beside_the_board_then_in_the_library(tmp_path):
+    # KiCad's resolver (common/filename_resolver.cpp, ResolvePath): the project's folder first,
+    # then the partial path under the 3D library's folder
+    board_dir, library = tmp_path / 'board', tmp_path / 'library'
+    for folder in (board_dir / 'Mine.3dshapes', library / 'Mine.3dshapes'):
+        folder.mkdir(parents=True)
+    (library / 'Mine.3dshapes' / 'a.step').write_text('ISO-10303-21;')
+    path, why = kicad.resolve('Mine.3dshapes/a.wrl', str(board_dir), str(library), {})
+    assert (path, why) == (str(library / 'Mine.3dshapes' / 'a.wrl'), '')
+    # the library from the environment when board.models is not given
+    path, _ = kicad.resolve('Mine.3dshapes/a.wrl', str(board_dir), None,
+                            {'KICAD8_3DMODEL_DIR': str(library)})
+    assert path == str(library / 'Mine.3dshapes' / 'a.wrl')
+    # the board's own copy wins over the library's
+    (board_dir / 'Mine.3dshapes' / 'a.step').write_text('ISO-10303-21;')
+    path, _ = kicad.resolve('Mine.3dshapes/a.wrl', str(board_dir), str(library), {})
+    assert path == str(board_dir / 'Mine.3dshapes' / 'a.wrl')
+    # in neither: the board's, which the part's refusal says is missing from both
+    path, _ = kicad.resolve('Other.3dshapes/b.wrl', str(board_dir), str(library), {})
+    assert path == str(board_dir / 'Other.3dshapes' / 'b.wrl')
+    fp = kicad.Footprint(reference='L1', library='L:L', kind='through_hole', side='top',
+                         models=(kicad.Model(path='Other.3dshapes/b.wrl', line=9),), line=7)
+    [part] = board_parts([fp], str(board_dir), str(library), {})
+    assert part.status == REFUSED
+    missing = board_dir / 'Other.3dshapes' / 'b.wrl'
+    assert part.reason == (f"its model {missing} does not exist, nor under the 3D library's "
+                           'folder (board line 9)')
 
 
 def test_bad_board_keys_are_named(tmp_path):

@@ -19,7 +19,8 @@ read of each:
   and the leads into -z.
 - Paths: `${VAR}` and `$(VAR)` from KiCad's variables: `${KIPRJMOD}` is the board's folder,
   the `KICAD<n>_3DMODEL_DIR` and `KISYS3DMOD` ones the 3D library's folder (`models`, else
-  the environment's), any other from the environment.
+  the environment's), any other from the environment. A relative path is looked for in the
+  board's folder, then in the 3D library's (as KiCad's resolver does).
 
 Every error names the board file, its line and what is wrong (`InvalidArgument`).
 """
@@ -262,9 +263,19 @@ def resolve(written: str, board_dir: str, models: str | None,
         return '', (f'its model path uses ${{{missing[0]}}}, which is not set: give board.models '
                      "(KiCad's 3D library folder) or set it in the environment")
     out = os.path.expanduser(out)
-    if not os.path.isabs(out):
-        out = os.path.join(board_dir, out)
-    return os.path.normpath(out), ''
+    if os.path.isabs(out):
+        return os.path.normpath(out), ''
+    # a path relative to neither: the board's folder first, then the 3D library's (KiCad's
+    # FILENAME_RESOLVER::ResolvePath, common/filename_resolver.cpp: the project's folder,
+    # then the partial path under ${KICAD<n>_3DMODEL_DIR}, "legacy behavior")
+    beside = os.path.normpath(os.path.join(board_dir, out))
+    library = models if models is not None else next(
+        (v for k, v in sorted(environ.items()) if LIBRARY_VARIABLE.fullmatch(k)), None)
+    if library and not (os.path.exists(beside) or step_beside(beside)):
+        there = os.path.normpath(os.path.join(library, out))
+        if os.path.exists(there) or step_beside(there):
+            return there, ''
+    return beside, ''
 
 
 def step_beside(model_path: str) -> str:

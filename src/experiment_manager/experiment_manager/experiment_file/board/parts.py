@@ -71,7 +71,9 @@ def _status(fp: kicad.Footprint, board_dir: str, models: str | None,
     if step:
         return DECIDE, '', step
     if not os.path.exists(path):
-        return REFUSED, f'its model {path} does not exist (board line {model.line})', ''
+        also = ('' if os.path.isabs(os.path.expanduser(model.path)) or '$' in model.path
+                else ", nor under the 3D library's folder")
+        return REFUSED, f'its model {path} does not exist{also} (board line {model.line})', ''
     return REFUSED, (f'its model {os.path.basename(path)} has no STEP file beside it: the '
                      'physics reads solids from STEP (a .wrl holds triangles and colours '
                      'only)'), ''
