@@ -237,6 +237,14 @@ def test_a_part_of_many_bodies_shares_its_pieces_out_rather_than_becoming_one_hu
     assert to220.volume < together < trimesh.convex.convex_hull(to220.vertices).volume
 
 
+def test_pieces_much_larger_than_the_part_are_said_with_why():
+    # within the 15 % allowance nothing is said; beyond it, the threshold that fills hollows
+    assert pieces.why_larger(1.14e-6, 1.0e-6) == ''
+    said = pieces.why_larger(1.6e-6, 1.0e-6)
+    assert said.startswith('more than 15 % over the part') and '0.05' in said
+    assert 'open body' in said
+
+
 def test_convex_and_open_bodies_keep_their_hulls_and_say_so(tmp_path):
     trimesh.creation.box((0.006, 0.004, 0.002)).export(tmp_path / 'box.stl')
     box = build_part(PartSpec(model='mesh', mesh_path=str(tmp_path / 'box.stl'), mass=0.001))

@@ -21,6 +21,7 @@ import numpy as np
 from pick_common.parts.aspects import part_aspects
 from pick_common.parts.geometry import build_part
 from pick_common.parts.insets import HULL_MARGIN, hull_swelling
+from pick_common.parts.pieces import why_larger
 from pick_common.parts.primitives import Hull
 from pick_common.parts.spec import states_units
 from pick_validity.geometry import (
@@ -119,6 +120,8 @@ def part_lines(part) -> list[str]:
                      f'{together * 1e9:.1f} mm^3 together, {over:+.1f} '
                      f"% on the part's volume (pieces that overlap count twice)")
         lines.append(f'    made as: {part.collision_note}')
+        if why := why_larger(together, part.volume):
+            lines.append(f'    {why}')
         swollen = hull_swelling(part)
         lines.append("    in the physics: each piece inset by pybullet's "
                      f'{HULL_MARGIN * MM:g} mm margin, so that it collides this surface'

@@ -44,6 +44,10 @@ SEED = 0
 # A closed body whose hull exceeds its volume by less than this is kept as its hull: it is
 # convex but for its tessellation (a cylinder's facets).
 CONVEX_SLACK = 0.02
+# Pieces whose volume together exceeds the part's by more than this make the part's account
+# say why (`why_larger`): the allowance the board's issue sets for a model read at board
+# scale, not a measured figure.
+VOLUME_SLACK = 0.15
 
 
 def cache_dir() -> str:
@@ -174,6 +178,18 @@ def convex_cover(mesh: trimesh.Trimesh, path: str) -> tuple[list[trimesh.Trimesh
         words.append(f'{counts["open"]} open body(ies) as its hull (not closed, so not cut: '
                      'its hollows and gaps collide as filled; close the mesh to have it cut)')
     return hulls, '; '.join(words) + failed
+
+
+def why_larger(pieces_volume: float, part_volume: float) -> str:
+    """'' when the pieces' volume is within VOLUME_SLACK of the part's; else why the part
+    collides larger than it is, in words."""
+    if pieces_volume <= (1.0 + VOLUME_SLACK) * part_volume:
+        return ''
+    return (f'more than {100 * VOLUME_SLACK:g} % over the part: CoACD stops cutting a piece '
+            f"whose concavity is under its threshold ({THRESHOLD:g} of the part's size), so "
+            "hollows shallower than that (a socket's contact holes, a housing's pockets), and "
+            'every hollow of an open body, collide as filled; where the part lies or is '
+            'gripped by them, it does so as a solid block')
 
 
 def _cut(bodies: list[trimesh.Trimesh], concave: list[bool], hulls: list[list], most: int
