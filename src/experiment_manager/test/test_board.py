@@ -9,6 +9,7 @@ import shutil
 from experiment_manager import experiment_file
 from experiment_manager.experiment_file.board import (
     answer,
+    cut_side_by_side,
     expand,
     kicad,
     load_board,
@@ -23,9 +24,11 @@ from experiment_manager.experiment_file.board.parts import (
     NOT_THROUGH_HOLE,
     REFUSED,
 )
+from experiment_manager.experiment_file.loading import part_of
 from experiment_manager.experiment_file.part import geometry
 import numpy as np
 from pick_common.errors import InvalidArgument
+from pick_common.parts import pieces
 from pick_common.parts.solids import body_density, LEADS, solid_mass
 import pytest
 import yaml
@@ -204,6 +207,24 @@ def test_a_relative_model_path_is_looked_for_beside_the_board_then_in_the_librar
     missing = board_dir / 'Other.3dshapes' / 'b.wrl'
     assert part.reason == (f"its model {missing} does not exist, nor under the 3D library's "
                            'folder (board line 9)')
+
+
+def test_parts_cut_side_by_side_are_in_the_cache_when_read_in_turn(tmp_path, monkeypatch):
+    # the pool's processes are spawned with this environment: the same cache
+    monkeypatch.setenv('PICK_SIM_CACHE', str(tmp_path / 'cache'))
+    parts = os.path.join(os.path.dirname(__file__), '..', 'config', 'parts')
+    files = [os.path.join(parts, 'to220_kicad.yaml')]
+    (tmp_path / 'broken.yaml').write_text('part: {model: mesh, mesh: none.step}\n')
+    # a file that does not read is left to its reading in turn, which names its error
+    cut_side_by_side(files + [str(tmp_path / 'broken.yaml')], 2)
+
+    cut_again = []
+    monkeypatch.setattr(pieces, '_decompose', lambda *a: cut_again.append(a) or [])
+    for path in files:
+        assert len(geometry(part_of(path)).primitives) > 1
+    assert not cut_again        # every piece came from the cache the pool filled
+    with pytest.raises(InvalidArgument):
+        part_of(str(tmp_path / 'broken.yaml'))
 
 
 def test_bad_board_keys_are_named(tmp_path):

@@ -16,6 +16,7 @@ from ..analysis.report.board import write_board_page
 from ..experiment_file.board import (
     answer,
     Board,
+    cut_side_by_side,
     load_board,
     record,
     settle,
@@ -98,8 +99,9 @@ def expand_boards(files: list[str], args: argparse.Namespace,
         directory = os.path.abspath(os.path.expanduser(args.output or board.output_dir))
         run = BoardRun(board, {}, {}, directory=directory)
         done = _done_before(os.path.join(directory, f'{board.id}_board.json'))
-        for name, path in write_parts(board, os.path.join(directory,
-                                                          f'{board.id}_parts')).items():
+        files = write_parts(board, os.path.join(directory, f'{board.id}_parts'))
+        cut_side_by_side(list(files.values()), args.workers)
+        for name, path in files.items():
             try:
                 _, dropped = settle(path)
             except InvalidArgument as exc:

@@ -14,7 +14,15 @@ from pick_common.specs import CENTRE, FIXED, MOVES, RANDOM, Vibration
 
 from .. import experiment_file
 from ..analysis import part_sheet
-from ..experiment_file.board import Board, load_board, record, settle, table, write_parts
+from ..experiment_file.board import (
+    Board,
+    cut_side_by_side,
+    load_board,
+    record,
+    settle,
+    table,
+    write_parts,
+)
 from ..experiment_file.kinds import kind_of
 from ..experiment_file.model import ExperimentFile
 from ..experiment_file.part import NoGrasp
@@ -23,10 +31,11 @@ from .boards import write_answer
 
 
 def check(paths: list[str], output: str | None, iterations: int | None = None,
-          adaptive: bool = False) -> int:
+          adaptive: bool = False, workers: int = 1) -> int:
     """0 when every file reads and its sheet is drawn; 2 at the first file that does not (its
     errors printed, each naming the file, the key, the value and the rule). `iterations` and
-    `adaptive` as the run's options: the plan printed is the one the run would follow."""
+    `adaptive` as the run's options: the plan printed is the one the run would follow; a
+    board's parts are cut on up to `workers` processes (board.cutting)."""
     for given in paths:
         path = os.path.abspath(given)
         try:
@@ -35,7 +44,7 @@ def check(paths: list[str], output: str | None, iterations: int | None = None,
             print(f'run --check: {path}: {exc}', file=sys.stderr)
             return 2
         if board is not None:
-            check_board(board, output, iterations, adaptive)
+            check_board(board, output, iterations, adaptive, workers)
             continue
         try:
             file = experiment_file.load(path)
@@ -80,12 +89,13 @@ def _no_grasp(errors: list[InvalidArgument], path: str, output: str | None) -> N
 
 
 def check_board(board: Board, output: str | None, iterations: int | None,
-                adaptive: bool) -> None:
+                adaptive: bool, workers: int = 1) -> None:
     """A board's check: each part's experiment file written beside the sheets
     (<output>/<board id>_parts/) and checked as a file of its own; a part whose file does
     not read is refused with its error, and the rest go on; then the board's table."""
     directory = os.path.abspath(os.path.expanduser(output or board.output_dir))
     files = write_parts(board, os.path.join(directory, f'{board.id}_parts'))
+    cut_side_by_side(list(files.values()), workers)
     said, left = {}, {}
     for name, part_file in files.items():
         print(f'--- {name} ({part_file})')

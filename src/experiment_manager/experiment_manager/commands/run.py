@@ -226,7 +226,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.check:
         from .check import check  # the sheet's drawing is loaded only to draw it
         return check(_board_given(args) or args.experiment_files, args.output,
-                     args.iterations, args.adaptive)
+                     args.iterations, args.adaptive, args.workers)
     temporary: list[str] = []
     try:
         return _main(args, temporary)

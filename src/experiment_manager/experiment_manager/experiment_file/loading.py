@@ -17,6 +17,7 @@ from typing import Any
 
 from pick_common.errors import check_int, InvalidArgument
 from pick_common.parts.aspects import part_aspects
+from pick_common.parts.spec import PartSpec
 from pick_validity.config import check_place, Setup, tilts
 import yaml
 
@@ -173,6 +174,12 @@ def parse(text: str, path: str = '') -> ExperimentFile:
 
 def load(path: str) -> ExperimentFile:
     """Read and check the experiment file at `path`."""
+    return parse(load_text(path), path)
+
+
+def load_text(path: str) -> str:
+    """The text of the experiment file at `path`; InvalidArgument naming why it cannot be
+    read (too large, unreadable, not UTF-8)."""
     try:
         size = os.path.getsize(path)
         if size > MAX_FILE_BYTES:
@@ -185,7 +192,23 @@ def load(path: str) -> ExperimentFile:
                               f'cannot be read: {exc.strerror or exc}') from None
     except UnicodeDecodeError as exc:
         raise InvalidArgument('experiment_file', path, f'is not UTF-8 text: {exc}') from None
-    return parse(text, path)
+    return text
+
+
+def part_of(path: str) -> PartSpec:
+    """The part of the experiment file at `path` as `load` reads it (its `part` and
+    `materials` sections only: what its geometry is built from), without the rest of the
+    file's checks. InvalidArgument for the first error."""
+    data = yaml.safe_load(load_text(path))
+    if not isinstance(data, Mapping):
+        raise InvalidArgument('file', short(data), 'must be a mapping of keys')
+    s = {}
+    for key in ('part', 'materials'):
+        s[key], errors = read_keys(schema.SECTIONS[key], data.get(key, {}), key)
+        if errors:
+            raise errors[0]
+    return part_section.read_part(s['part'], s['materials'],
+                                  os.path.dirname(os.path.abspath(path)))[0]
 
 
 def reduced(file: ExperimentFile, max_iterations: int | None, adaptive: bool = False) -> str:

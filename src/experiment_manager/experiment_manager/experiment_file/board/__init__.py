@@ -41,15 +41,16 @@ from ..model import MAX_FILE_BYTES, Requirements
 from ..schema import NamedGripper, RequirementsSection
 from ..values import Number, Text
 from . import kicad
+from .cutting import cut_side_by_side
 from .parts import board_parts, BoardPart, DECIDE, NOT_THROUGH_HOLE, REFUSED
 
 # The experiments that hold a refill of the part: their `parts`, left out in a board file, is
 # each part's own refill.
 REFILLED = ('bin_emptying', 'feeder_emptying')
 
-__all__ = ['answer', 'Board', 'BoardPart', 'DECIDE', 'expand', 'is_board', 'load_board',
-           'NOT_THROUGH_HOLE', 'placement', 'record', 'REFUSED', 'settle', 'table',
-           'write_parts']
+__all__ = ['answer', 'Board', 'BoardPart', 'cut_side_by_side', 'DECIDE', 'expand', 'is_board',
+           'load_board', 'NOT_THROUGH_HOLE', 'placement', 'record', 'REFUSED', 'settle',
+           'table', 'write_parts']
 
 
 class _Keys(BaseModel):
