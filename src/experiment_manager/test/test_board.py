@@ -350,7 +350,7 @@ def test_a_board_run_again_keeps_the_parts_done_with_the_same_file_and_writes_it
 
     from experiment_manager.commands.boards import decided, expand_boards
     path = _board_file(tmp_path)
-    args = argparse.Namespace(output=str(tmp_path / 'out'))
+    args = argparse.Namespace(output=str(tmp_path / 'out'), workers=2)
     boards = []
     first = expand_boards([path], args, boards)
     assert len(first) == 4                     # the four parts with a STEP model

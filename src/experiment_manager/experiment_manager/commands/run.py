@@ -135,7 +135,8 @@ def _parse(argv: list[str]) -> argparse.Namespace:
                         '<namespace>/worker_<k>')
     parser.add_argument('--workers', type=int, metavar='N', default=default_workers(),
                         help=f'worker processes to start (default {default_workers()}: a '
-                        'worker per CPU, at most 8)')
+                        "worker per CPU, at most 8); a board's parts are cut on as many "
+                        'processes, with --check too')
     parser.add_argument('--iterations', type=int, metavar='N',
                         help='cap every experiment at N iterations')
     parser.add_argument('--adaptive', action='store_true',

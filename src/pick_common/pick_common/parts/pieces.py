@@ -14,9 +14,10 @@ Its settings, and where they come from:
 - MAX_PIECE_VERTICES 64: CoACD's decimation cap (`max_ch_vertex`, default 256) lowered, because
   a 1,090-vertex hull made table drops 4 to 7 times slower (docs/benchmarks.md); a small
   part's piece rarely needs more than a few dozen (TO-220: at most 25).
-- SEED 0: CoACD's search is random; a fixed seed makes it give the same pieces each time
-  (checked: three runs of the TO-220, the same nine pieces; their order and vertex order
-  vary, so `convex_pieces` sorts both).
+- SEED 0 and one thread: CoACD's search is random; a fixed seed and one OpenMP thread make
+  it give the same pieces each time (checked: the TO-220 three times, the same nine pieces;
+  KiCad's DIP-40 socket twice on one thread, the same 13, where on two threads it gave 13, then
+  9). The pieces' order and vertex order vary, so `convex_pieces` sorts both.
 
 Decomposing takes about a second for a small part (TO-220: 1.1-1.6 s), and every node that
 builds the part would pay it, so the pieces are kept in a cache directory keyed by a hash of
@@ -28,6 +29,7 @@ read the same pieces.
 import fcntl
 import hashlib
 import os
+import sys
 import tempfile
 
 import numpy as np
@@ -63,19 +65,39 @@ def is_convex(body: trimesh.Trimesh) -> bool:
     return body.convex_hull.volume <= (1.0 + CONVEX_SLACK) * body.volume
 
 
+def _coacd():
+    """The coacd module, its OpenMP runtime on one thread. On more, CoACD's search is not
+    repeatable: KiCad's DIP-40 socket cut twice in one process on 2 threads gave 13 pieces,
+    then 9; on one thread, the same 13 each time (docs/boards.md). Its wheel carries its own
+    libgomp, which reads OMP_NUM_THREADS when it loads: set for that import only."""
+    if 'coacd' not in sys.modules:
+        saved = os.environ.get('OMP_NUM_THREADS')
+        os.environ['OMP_NUM_THREADS'] = '1'
+        try:
+            import coacd  # loaded here, with its one thread
+        finally:
+            if saved is None:
+                del os.environ['OMP_NUM_THREADS']
+            else:
+                os.environ['OMP_NUM_THREADS'] = saved
+    coacd = sys.modules['coacd']
+    coacd.set_log_level('error')
+    return coacd
+
+
 def _key(body: trimesh.Trimesh, most: int) -> str:
-    import coacd
+    coacd = _coacd()
     h = hashlib.sha256()
     h.update(np.ascontiguousarray(body.vertices, dtype=np.float64).tobytes())
     h.update(np.ascontiguousarray(body.faces, dtype=np.int64).tobytes())
+    # 'one thread': pieces cut on more (before it was fixed) are not read back
     h.update(repr((THRESHOLD, most, MAX_PIECE_VERTICES, SEED,
-                   getattr(coacd, '__version__', ''))).encode())
+                   getattr(coacd, '__version__', ''), 'one thread')).encode())
     return h.hexdigest()
 
 
 def _decompose(body: trimesh.Trimesh, most: int) -> list[np.ndarray]:
-    import coacd
-    coacd.set_log_level('error')
+    coacd = _coacd()
     pieces = coacd.run_coacd(coacd.Mesh(np.asarray(body.vertices, dtype=np.float64),
                                         np.asarray(body.faces, dtype=np.int64)),
                              threshold=THRESHOLD, max_convex_hull=most,
