@@ -22,8 +22,8 @@ Its settings, and where they come from:
 Decomposing takes about a second for a small part (TO-220: 1.1-1.6 s), and every node that
 builds the part would pay it, so the pieces are kept in a cache directory keyed by a hash of
 the mesh and the settings: `$PICK_SIM_CACHE`, else `$XDG_CACHE_HOME/pick_sim`, else
-`~/.cache/pick_sim`. A lock on the entry makes nodes that start together compute it once and
-read the same pieces.
+`~/.cache/pick_sim`. A lock on the entry (a file beside it) makes nodes that start together
+compute it once and read the same pieces, and lets different parts be cut side by side.
 """
 
 import fcntl
@@ -126,12 +126,15 @@ def convex_pieces(body: trimesh.Trimesh, most: int = MAX_PIECES) -> list[np.ndar
 def _cached_pieces(body: trimesh.Trimesh, most: int) -> list[np.ndarray]:
     """CoACD's pieces of `body` as it lies, from the cache when it holds them."""
     directory = cache_dir()
+    key = _key(body, most)
     try:
         os.makedirs(directory, exist_ok=True)
-        lock = open(os.path.join(directory, 'lock'), 'w')
+        # a lock per entry: processes cutting different parts (a board's, side by side) do
+        # not wait on each other; two asking for the same part cut it once
+        lock = open(os.path.join(directory, key + '.lock'), 'w')
     except OSError:                     # no cache where none can be written: compute each time
         return _decompose(body, most)
-    path = os.path.join(directory, _key(body, most) + '.npz')
+    path = os.path.join(directory, key + '.npz')
     with lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         try:
