@@ -1,9 +1,9 @@
 """A board's parts cut side by side: each part's collision pieces (CoACD's cut,
-pick_common.parts.pieces, the slow step of reading a model: 50 to 110 s of one core for a DIP
-socket or a terminal block, docs/benchmarks.md) made on a pool of processes before the parts
-are read in turn, which then find them in the pieces' cache. The cut is the same whichever
-process makes it (its seed is fixed and its result is keyed by the mesh), so the answer does
-not depend on the pool."""
+pick_common.parts.pieces, the slow step of reading a model: 57 to 102 s of one core for a DIP
+socket, a D-sub or a terminal block, docs/boards.md) made on a pool of processes before the
+parts are read in turn, which then find them in the pieces' cache. The cut is the same
+whichever process makes it (a fixed seed, one thread, its result keyed by the mesh), so the
+answer does not depend on the pool."""
 
 from concurrent.futures import ProcessPoolExecutor
 import multiprocessing
