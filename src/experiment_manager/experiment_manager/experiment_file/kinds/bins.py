@@ -32,7 +32,7 @@ class BinStatic(ExperimentKind):
                             for i, v in enumerate(e.bins_mm))
         for i, b in enumerate(out['bins']):
             check_fits(f'{where}.parts (bins_mm[{i}])', e.parts, c.geometry.volume, b)
-        return [BinStaticExperiment(**out)]
+        return [self.record(**out)]
 
     def groups(self, exp: BinStaticExperiment) -> list[int]:
         return list(range(len(exp.bins)))
@@ -53,4 +53,4 @@ class BinEmptying(ExperimentKind):
     left_out_settles: ClassVar[bool] = True
 
     def read(self, e: Any, where: str, c: Any, out: dict) -> list[Experiment]:
-        return [BinEmptyingExperiment(**out, **bin_or_source(e.bin, e.parts, where, c))]
+        return [self.record(**out, **bin_or_source(e.bin, e.parts, where, c))]

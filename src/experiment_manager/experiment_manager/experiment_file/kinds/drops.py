@@ -20,4 +20,4 @@ class DropTest(ExperimentKind):
 
     def read(self, e: Any, where: str, c: Any, out: dict) -> list[Experiment]:
         base = {k: out[k] for k in ('id', 'iterations')}
-        return [DropTestExperiment(**base, **drop_test(e, where, c.geometry, c.bin_wall))]
+        return [self.record(**base, **drop_test(e, where, c.geometry, c.bin_wall))]

@@ -25,8 +25,8 @@ class GripperSweep(ExperimentKind):
         scene = bin_or_source(e.bin, e.parts, where, c)
         if not scene:       # no bin: the parts lie on the tray, as in a table_sweep
             check_fits(f'{where}.parts (tray_mm)', e.parts, c.geometry.volume, c.tray)
-        return [GripperSweepExperiment(**out, **scene, min_valid=e.min_valid,
-                           variants=grippers.variants(e, where, c.gripper, c.grasps))]
+        return [self.record(**out, **scene, min_valid=e.min_valid,
+                                variants=grippers.variants(e, where, c.gripper, c.grasps))]
 
     def cost_units(self, exp: GripperSweepExperiment, parts: float) -> float:
         return parts * len(exp.variants)

@@ -35,7 +35,7 @@ class TableSweep(ExperimentKind):
         out = {k: v for k, v in out.items() if k != 'parts'}     # its parts are its counts
         out['counts'] = tuple(range(e.counts.first, e.counts.last + 1, e.counts.step))
         check_fits(f'{where}.counts.last', out['counts'][-1], c.geometry.volume, c.tray)
-        return [TableSweepExperiment(**out, margin=e.margin, extend=e.extend)]
+        return [self.record(**out, margin=e.margin, extend=e.extend)]
 
     def groups(self, exp: TableSweepExperiment) -> list[int]:
         return list(exp.counts)
@@ -73,8 +73,8 @@ class FeederEmptying(ExperimentKind):
             checked_as(check_feeder, FeederConfig(e.parts, *e.optimal_range, e.max_vibrations,
                                                   e.max_feed or 0), where)
         check_fits(f'{where}.optimal_range (max)', high, c.geometry.volume, c.tray)
-        return [FeederEmptyingExperiment(**out, max_vibrations=e.max_vibrations,
-                                         max_feed=e.max_feed or 0)]
+        return [self.record(**out, max_vibrations=e.max_vibrations,
+                                max_feed=e.max_feed or 0)]
 
     def scenes(self, file: ExperimentFile, exp: FeederEmptyingExperiment, summary: dict
                ) -> list[Scene]:
