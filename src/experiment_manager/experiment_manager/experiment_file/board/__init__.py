@@ -376,7 +376,7 @@ def record(board: Board, said: Mapping[str, str],
     same), and its options' verdicts with the first reason and the best option (`answer`'s
     rule)."""
     # the records' module is also a command (it writes their schema): loaded here, not above
-    from .record import BOARD_JSON_VERSION, BoardOption, BoardPartRecord, BoardRecord
+    from .board_json import BOARD_JSON_VERSION, BoardOption, BoardPartRecord, BoardRecord
     parts = []
     for p in board.parts:
         options = [BoardOption(option=o, verdict=v, reason=why)

@@ -1,7 +1,7 @@
 """The board's answer as data, `<output>/<board id>_board.json`: a model per record, its JSON
 Schema published as docs/board.schema.json:
 
-    python -m experiment_manager.experiment_file.board.record --schema docs/board.schema.json
+    python -m experiment_manager.experiment_file.board.board_json --schema docs/board.schema.json
 
 writes it from this module (a test checks that the committed file is current). No rclpy."""
 
