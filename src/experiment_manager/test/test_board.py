@@ -354,6 +354,7 @@ def test_a_board_run_again_keeps_the_parts_done_with_the_same_file_and_writes_it
     boards = []
     first = expand_boards([path], args, boards)
     assert len(first) == 4                     # the four parts with a STEP model
+    assert set(boards[0].read) == set(first)   # as settle read them: run reads them no more
     part = next(p for p in first if RESISTOR.replace('.', '_') in p)
     run_dir = tmp_path / 'out' / 'resistor_run'
     run_dir.mkdir()
@@ -392,11 +393,11 @@ def _valid_against_the_published_schema(data: dict) -> None:
 
 
 def test_the_published_board_schema_is_the_models():
-    from experiment_manager.experiment_file.board.record import schema_text
+    from experiment_manager.experiment_file.board.board_json import schema_text
     with open(os.path.join(DOCS, 'board.schema.json'), encoding='utf-8') as f:
         assert f.read() == schema_text(), (
             "docs/board.schema.json is not the model's: write it again with `python -m "
-            'experiment_manager.experiment_file.board.record --schema docs/board.schema.json`')
+            'experiment_manager.experiment_file.board.board_json --schema docs/board.schema.json`')
 
 
 def test_a_part_with_no_grasp_still_gets_its_account_and_its_sheet(tmp_path, capsys):
@@ -442,3 +443,36 @@ def test_the_board_page_says_an_option_left_out_for_a_part_and_why():
     assert '- static bin: **left out** (below)' in page
     assert '- emptying left out: 960 parts do not fit the bin' in page
     assert 'not analysed' not in page and 'no bin_emptying' not in page
+
+
+def test_a_board_check_reads_each_part_once_and_checks_every_part(tmp_path, monkeypatch,
+                                                                     capsys):
+    """run --check on a board: each part's file is read by `settle` (with what cannot run
+    left out) and that read is the one checked: no part's file is read again."""
+    from experiment_manager.commands import check as check_command
+    from experiment_manager.experiment_file import loading
+    parsed, in_settle = [], []
+    parse = loading.parse
+    monkeypatch.setattr(loading, 'parse', lambda text, path='': parsed.append(path)
+                        or parse(text, path))
+
+    def settle_counted(path):
+        before = len(parsed)
+        try:
+            return settle(path)
+        finally:
+            in_settle.extend(parsed[before:])
+    monkeypatch.setattr(check_command, 'settle', settle_counted)
+    models = tmp_path / 'models'         # two of the four parts' models, the others refused
+    shutil.copytree(MODELS, models)
+    os.remove(models / 'Capacitor_THT.3dshapes' / 'CP_Radial_D10.0mm_P5.00mm.step')
+    os.remove(models / 'TerminalBlock_Altech.3dshapes'
+              / 'Altech_AK300_1x02_P5.00mm_45-Degree.step')
+    board = _board_file(tmp_path, models=models)
+    assert check_command.check([board], str(tmp_path / 'out')) == 0
+    out = capsys.readouterr().out
+    assert out.count('reads as a run would') == 2 and 'board: ' in out
+    assert len(in_settle) >= 2 and parsed == in_settle      # nothing read outside settle
+    for name in os.listdir(tmp_path / 'out'):
+        if os.path.isdir(tmp_path / 'out' / name) and not name.endswith('_parts'):
+            assert (tmp_path / 'out' / name / 'check.json').is_file()

@@ -23,12 +23,14 @@ from ..experiment_file.board import (
     table,
     write_parts,
 )
+from ..experiment_file.model import ExperimentFile
 
 
 @dataclass
 class BoardRun:
     """A board being run: the board, what became of each part before the run (`said`), the
-    part by its file's path, and each part's options as the run decided them."""
+    part by its file's path, each part's file as `settle` read it by its path (`read`: the
+    run's check reads it no more), and each part's options as the run decided them."""
     board: Board
     said: dict[str, str]
     by_path: dict[str, str]
@@ -36,6 +38,7 @@ class BoardRun:
     left: dict[str, dict[str, str]] = field(default_factory=dict)
     runs: dict[str, str] = field(default_factory=dict)
     shas: dict[str, str] = field(default_factory=dict)
+    read: dict[str, ExperimentFile] = field(default_factory=dict)
     directory: str = ''
 
     def lines(self) -> list[str]:
@@ -103,7 +106,7 @@ def expand_boards(files: list[str], args: argparse.Namespace,
         cut_side_by_side(list(files.values()), args.workers)
         for name, path in files.items():
             try:
-                _, dropped = settle(path)
+                file, dropped = settle(path)
             except InvalidArgument as exc:
                 run.said[name] = f'refused: {exc}'
                 continue
@@ -120,6 +123,7 @@ def expand_boards(files: list[str], args: argparse.Namespace,
             run.said[name] = 'to run' + ''.join(f'; {g} left out: {why}'
                                                  for g, why in dropped.items())
             run.by_path[path] = name
+            run.read[path] = file
             out.append(path)
         print('\n'.join(table(board, run.said)), file=sys.stderr)
         run.write()

@@ -47,31 +47,42 @@ def check(paths: list[str], output: str | None, iterations: int | None = None,
             check_board(board, output, iterations, adaptive, workers)
             continue
         try:
-            file = experiment_file.load(path)
-            if iterations is not None or adaptive:
-                file = experiment_file.parse(
-                    experiment_file.reduced(file, iterations, adaptive), path)
+            file = _capped(experiment_file.load(path), path, iterations, adaptive)
         except InvalidArgument as exc:
             errors = exc.errors if isinstance(exc, experiment_file.InvalidFile) else [exc]
             for e in errors:
                 print(f'run --check: {path}: {e}', file=sys.stderr)
             _no_grasp(errors, path, output)
             return 2
-        checks = part_sheet.validator(file)
-        print(f'{path}: reads as a run would')
-        print('\n'.join(part_sheet.describe(file, checks)))
-        for name, mine, theirs in part_sheet.named_grippers(file, checks):
-            print(f'  gripper {name!r} (grippers.{name}), for the experiments that name it:')
-            print('\n'.join('  ' + line for line in part_sheet.grasp_lines(mine, theirs)))
-        directory = os.path.abspath(os.path.expanduser(output or file.output_dir))
-        sheet = part_sheet.write(checks, os.path.join(directory, f'{file.id}_part.png'))
-        print(f'sheet: {sheet}')
-        if output:          # one file: DIR/check.json; several: DIR/<id>_check.json
-            name = 'check.json' if len(paths) == 1 else f'{file.id}_check.json'
-            print('figures: ' + part_sheet.write_check(file, checks,
-                                                       os.path.join(directory, name)))
-        print('\n'.join(describe_plan(file)))
+        _check_file(file, path, output,
+                    'check.json' if len(paths) == 1 else f'{file.id}_check.json')
     return 0
+
+
+def _capped(file: ExperimentFile, path: str, iterations: int | None,
+            adaptive: bool) -> ExperimentFile:
+    """`file` as the run's options make it: read again from its reduced text when
+    --max-iterations or --adaptive change it, else as it is (read once)."""
+    if iterations is None and not adaptive:
+        return file
+    return experiment_file.parse(experiment_file.reduced(file, iterations, adaptive), path)
+
+
+def _check_file(file: ExperimentFile, path: str, output: str | None, name: str) -> None:
+    """What the run will use of the read `file` (at `path`) and what it will run, printed;
+    its part sheet drawn, and with `output`, its figures written to <output>/`name`."""
+    checks = part_sheet.validator(file)
+    print(f'{path}: reads as a run would')
+    print('\n'.join(part_sheet.describe(file, checks)))
+    for gripper, mine, theirs in part_sheet.named_grippers(file, checks):
+        print(f'  gripper {gripper!r} (grippers.{gripper}), for the experiments that name it:')
+        print('\n'.join('  ' + line for line in part_sheet.grasp_lines(mine, theirs)))
+    directory = os.path.abspath(os.path.expanduser(output or file.output_dir))
+    sheet = part_sheet.write(checks, os.path.join(directory, f'{file.id}_part.png'))
+    print(f'sheet: {sheet}')
+    if output:          # one file: DIR/check.json; several: DIR/<id>_check.json
+        print('figures: ' + part_sheet.write_check(file, checks, os.path.join(directory, name)))
+    print('\n'.join(describe_plan(file)))
 
 
 def _no_grasp(errors: list[InvalidArgument], path: str, output: str | None) -> None:
@@ -100,7 +111,8 @@ def check_board(board: Board, output: str | None, iterations: int | None,
     for name, part_file in files.items():
         print(f'--- {name} ({part_file})')
         try:
-            _, dropped = settle(part_file)
+            file, dropped = settle(part_file)
+            file = _capped(file, part_file, iterations, adaptive)
         except InvalidArgument as exc:
             errors = exc.errors if isinstance(exc, experiment_file.InvalidFile) else [exc]
             for e in errors:
@@ -108,8 +120,8 @@ def check_board(board: Board, output: str | None, iterations: int | None,
             _no_grasp(errors, part_file, os.path.join(directory, name) if output else None)
             said[name] = f'refused: {errors[0]}'
             continue
-        check([part_file], os.path.join(directory, name) if output else None, iterations,
-              adaptive)
+        _check_file(file, part_file, os.path.join(directory, name) if output else None,
+                    'check.json')
         left[name] = dropped
         said[name] = 'checked: ' + board.masses[name].split(':')[0] + ''.join(
             f'; {g} left out: {why}' for g, why in dropped.items())

@@ -192,7 +192,8 @@ def _goals(args: argparse.Namespace,
     for given in expand_boards(_board_given(args) or files, args, args.boards):
         path = os.path.abspath(given)
         try:
-            file = experiment_file.load(path)
+            file = next((b.read[path] for b in args.boards if path in b.read), None) \
+                or experiment_file.load(path)
         except InvalidArgument as exc:
             named = [InvalidArgument(f'{path}: {e.field}', e.value, e.rule) for e in
                      (exc.errors if isinstance(exc, experiment_file.InvalidFile) else [exc])]
