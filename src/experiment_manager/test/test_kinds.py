@@ -60,6 +60,24 @@ def test_a_kind_plans_its_groups_and_names_its_iterations():
     assert seen == set(KINDS)       # the built-in file shows every kind
 
 
+def test_an_experiment_says_what_it_takes_from_which_earlier_one():
+    from experiment_manager.experiment_file.model import (
+        BinStaticExperiment,
+        FeederEmptyingExperiment,
+        TableSweepExperiment,
+    )
+    assert BinStaticExperiment(id='bins', iterations=1).taken_from == {}
+    assert TableSweepExperiment(id='sweep', iterations=1).sources == ()
+    both = FeederEmptyingExperiment(id='feeder', iterations=1, bin_from='bins',
+                                    range_from='sweep')
+    assert both.taken_from == {'bin_from': 'bins', 'range_from': 'sweep'}
+    assert both.sources == ('bins', 'sweep')
+    file = experiment_file.load(os.path.join(CONFIG, 'default_experiment.yaml'))
+    for exp in file.experiments:     # each names an earlier experiment of the file
+        earlier = [e.id for e in file.experiments[:file.experiments.index(exp)]]
+        assert all(source in earlier for source in exp.taken_from.values())
+
+
 @pytest.mark.parametrize('name', sorted(n for n, k in KINDS.items() if not k.repeats_others))
 def test_a_kind_s_cost_is_its_parts_times_what_one_iteration_checks(name):
     file = experiment_file.load(os.path.join(CONFIG, 'default_experiment.yaml'))

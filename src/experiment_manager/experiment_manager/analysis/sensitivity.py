@@ -111,10 +111,9 @@ def summarise(file: ExperimentFile, exp: SensitivityExperiment,
     repeats = {f'{e}@{sc.name}': summaries[f'{e}@{sc.name}'] for sc in exp.scenarios
                for e in exp.of}
     # a repeat whose bin or range comes from an experiment not repeated ran at the file's
-    held = {e: model.Held(what=what, source=source) for e in exp.of
-            for what, source in (('range', getattr(file.experiment(e), 'range_from', '')),
-                                 ('bin', getattr(file.experiment(e), 'bin_from', '')))
-            if source and source not in exp.of}
+    held = {e: model.Held(what=what, source=source) for e in exp.of for what in ('range', 'bin')
+            if (source := file.experiment(e).taken_from.get(f'{what}_from'))
+            and source not in exp.of}
     grid = _map(exp, base_said, scenarios)
     fitted = _calibrations(file, exp, base, summaries)
     return model.Sensitivity(

@@ -144,9 +144,15 @@ class Experiment:
     scenario: Scenario | None = None
 
     @property
+    def taken_from(self) -> dict[str, str]:
+        """Its fields that name an earlier experiment it takes something from (bin_from: that
+        one's best bin; range_from: its optimal range), each with the id it names."""
+        return {}
+
+    @property
     def sources(self) -> tuple[str, ...]:
         """The experiments whose summaries this one needs before it is planned."""
-        return ()
+        return tuple(self.taken_from.values())
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -166,8 +172,8 @@ class OneContainerExperiment(Experiment):
     bin_from: str = ''
 
     @property
-    def sources(self) -> tuple[str, ...]:
-        return (self.bin_from,) if self.bin_from else ()
+    def taken_from(self) -> dict[str, str]:
+        return {'bin_from': self.bin_from} if self.bin_from else {}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -200,8 +206,9 @@ class FeederEmptyingExperiment(OneContainerExperiment):
     max_feed: int = 0
 
     @property
-    def sources(self) -> tuple[str, ...]:
-        return super().sources + ((self.range_from,) if self.range_from else ())
+    def taken_from(self) -> dict[str, str]:
+        return {**super().taken_from, **({'range_from': self.range_from} if self.range_from
+                                         else {})}
 
 
 @dataclass(frozen=True, kw_only=True)

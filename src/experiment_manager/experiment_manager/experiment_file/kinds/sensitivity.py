@@ -94,8 +94,7 @@ def read(e: experiment_keys.SensitivityKeys, where: str, c: Context) -> list[Exp
         for exp_id in e.of:
             source = c.earlier[exp_id]
             renamed = {key: f'{value}@{scenario.name}' if value in e.of else value
-                       for key in ('bin_from', 'range_from')
-                       if (value := getattr(source, key, ''))}
+                       for key, value in source.taken_from.items()}
             if (height := scenario_inputs.drop_height(scenario)) is not None:
                 renamed['bin'] = replace(source.bin, drop_height=height)
             elif _on_tray(source) and (tray := scenario_inputs.tray_of(scenario, c.tray)):
