@@ -5,6 +5,7 @@ import os
 from experiment_manager import experiment_file
 from experiment_manager.analysis.results import ResultsWriter
 from experiment_manager.analysis.summary import Summary
+from experiment_manager.experiment_file import resolved
 from experiment_manager.running.local_backend import LocalBackend
 from experiment_manager.running.scheduler import Runner
 import pytest
@@ -13,9 +14,12 @@ SMALL = os.path.join(os.path.dirname(__file__), 'small_experiment.yaml')
 
 
 def run_small(directory: str, resume: bool = False) -> Summary:
-    """Run the small file on the cores (LocalBackend) into `directory`; returns the summary."""
+    """Run the small file on the cores (LocalBackend) into `directory`, with its resolved.json
+    as a run writes it; returns the summary."""
     file = experiment_file.load(SMALL)
     with LocalBackend() as backend, ResultsWriter(directory, file.text, resume) as writer:
+        if not resume:
+            resolved.write(file, directory)
         return Runner(file, [backend], writer).run()
 
 

@@ -143,7 +143,7 @@ def test_a_sensitivity_varies_the_height_its_drop_tests_drop_from():
     assert heights == pytest.approx({'drop': 0.08, 'drop@drop_test_height_mm_low': 0.04,
                                      'drop@drop_test_height_mm_high': 0.12})
     # the part's setup is the file's in every repeat: only the plate's height moves
-    assert all(e.scenario.setup == f.setup for e in f.experiments if '@' in e.id)
+    assert all(e.setup == f.setup for e in f.experiments if '@' in e.id)
 
 
 @pytest.mark.parametrize('text, rule', [

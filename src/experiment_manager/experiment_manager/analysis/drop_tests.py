@@ -7,11 +7,11 @@ from collections import Counter
 from pick_common.parts import aspects
 from pick_common.stats import wilson_interval
 
-from ..experiment_file import DropTestExperiment, ExperimentFile
+from ..experiment_file import DropTestExperiment, Ran
 from .summary import AspectCount, DropTest, Measured
 
 
-def summary(file: ExperimentFile, exp: DropTestExperiment,
+def summary(file: Ran, exp: DropTestExperiment,
             rows: list[dict], base: dict) -> DropTest:
     """A drop test's aspects: each one's count, share and 95 % interval of the drops at rest
     on an aspect, the quasi-static share, and against the measured counts (when the file

@@ -23,11 +23,11 @@ from ..experiment_file import (
     BinStaticExperiment,
     DROP_TEST,
     Experiment,
-    ExperimentFile,
     FEEDER_EMPTYING,
     FeederEmptyingExperiment,
     GRIPPER_SWEEP,
     GripperSweepExperiment,
+    Ran,
     TABLE_SWEEP,
     TableSweepExperiment,
 )
@@ -88,7 +88,7 @@ def bin_static(exp: BinStaticExperiment,
                            best_bin_mm=bins[best].size_mm if best is not None else None)
 
 
-def bin_emptying(file: ExperimentFile, exp: BinEmptyingExperiment, rows: list[dict],
+def bin_emptying(file: Ran, exp: BinEmptyingExperiment, rows: list[dict],
                  picks: list[dict], base: dict | None = None) -> model.BinEmptying:
     """Table 2, with `emptied_ci95`: the 95 % interval of the share of bins emptied, and
     `decision`: that share against requirements.success_rate on its one-sided bounds
@@ -180,7 +180,7 @@ def n_star_interval(counts, by_count: list, order: int, first: int, last: int,
             int(np.quantile(stars, 1.0 - tail, method='higher')))
 
 
-def table_sweep(file: ExperimentFile, exp: TableSweepExperiment, rows: list[dict],
+def table_sweep(file: Ran, exp: TableSweepExperiment, rows: list[dict],
                 base: dict | None = None) -> model.TableSweep:
     """Valid parts per count, the fit and its n* with optimal range, and `n_star_ci95`: n*'s
     95 % bootstrap interval (n_star_interval, seeded by the file's seed and the rows), when
@@ -204,7 +204,7 @@ def table_sweep(file: ExperimentFile, exp: TableSweepExperiment, rows: list[dict
                             per_n=per_n, margin=exp.margin, **fitted)
 
 
-def feeder_emptying(file: ExperimentFile, exp: FeederEmptyingExperiment, rows: list[dict],
+def feeder_emptying(file: Ran, exp: FeederEmptyingExperiment, rows: list[dict],
                     optimal_range, base: dict | None = None) -> model.FeederEmptying:
     """`emptied`: runs that emptied the feeder and the table; `accepted`: of them, those that
     spilled at most requirements.max_spilled_parts over the tray's walls, and `accepted_ci95`
@@ -238,7 +238,7 @@ def feeder_emptying(file: ExperimentFile, exp: FeederEmptyingExperiment, rows: l
         first_check=_fractions(rows), **_regrasps(exp, rows))
 
 
-def table_grounds(file: ExperimentFile, rows: list[dict],
+def table_grounds(file: Ran, rows: list[dict],
                   confidence: float = decisions.CONFIDENCE) -> dict[str, decisions.Decision]:
     """The vibrating table's grounds from its feeder runs (`rows`, typed, left-out ones
     removed): the cell's time to empty a refill, and the spills."""
@@ -325,7 +325,7 @@ def _base(exp: Experiment, rows: list[dict]) -> dict:
             **({'station': True} if exp.station else {})}
 
 
-def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: list[dict],
+def summarise(file: Ran, exp: Experiment, rows: list[dict], picks: list[dict],
               earlier: dict | None = None, checks: list[dict] = ()) -> model.Experiment:
     """The metrics of one experiment from its rows of iterations.csv, picks.csv and checks.csv.
     `earlier`: the summaries of the experiments before it (for feeder_emptying's range taken
@@ -339,7 +339,7 @@ def summarise(file: ExperimentFile, exp: Experiment, rows: list[dict], picks: li
     return SUMMARIES[exp.type](file, exp, rows, picks, earlier or {}, checks, base)
 
 
-def file_summary(file: ExperimentFile, summaries: dict) -> model.Summary:
+def file_summary(file: Ran, summaries: dict) -> model.Summary:
     """The run's summary, as summary.json holds it: `experiments`, the file's own by id;
     `repeats`, a sensitivity experiment's repeats of them in its scenarios (id
     `<experiment>@<scenario>`), apart, so that the verdicts and the report's tables are the

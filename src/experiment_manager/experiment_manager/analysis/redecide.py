@@ -1,15 +1,16 @@
 """An experiment's summary from its rows (`summarise`: the one step the scheduler takes when an
 experiment's last iteration is written, and `redecide` for each experiment of a finished run),
 and a finished run decided again with today's rules: every experiment's summary computed anew
-from the run's own result files (iterations.csv, picks.csv, checks.csv) and the experiment file
-it kept, in the file's order. What a rule cannot recompute is kept from the run's
+from the run's own result files (iterations.csv, picks.csv, checks.csv) and what it ran with
+(its resolved.json's records, experiment_file.resolved.ran: no experiment file read again, no
+part built), in the file's order. What a rule cannot recompute is kept from the run's
 summary.json: an adaptive experiment's sampling (the batches it took are the run's history).
 Results written before a rule changed (the table's bound, the bins' race) are then read as
 today's. No rclpy."""
 
 import os
 
-from .. import experiment_file
+from ..experiment_file import Experiment, Ran, resolved
 from ..experiment_file.kinds import kind_of
 from . import metrics, sensitivity
 from . import summary as summary_model
@@ -21,9 +22,10 @@ def redecide(run_dir: str, recorded: summary_model.Summary | None = None
              ) -> summary_model.Summary:
     """The summary (current version) of the run in `run_dir` as today's
     metrics and decisions give it; `recorded`: the run's summary.json when the caller has read
-    it (read here otherwise, when there is one). Raises InvalidArgument when its
-    experiment.yaml no longer reads, OSError when a result file is missing."""
-    file = experiment_file.load(os.path.join(run_dir, 'experiment.yaml'))
+    it (read here otherwise, when there is one). Raises InvalidArgument when a run directory
+    with no records in its resolved.json has an experiment.yaml that no longer reads,
+    ValueError for broken records, OSError when a result file is missing."""
+    file = resolved.ran(run_dir)
     rows, picks, checks = (read_csv(os.path.join(run_dir, f'{name}.csv'))
                            for name in ('iterations', 'picks', 'checks'))
     path = os.path.join(run_dir, 'summary.json')
@@ -46,15 +48,14 @@ def redecide(run_dir: str, recorded: summary_model.Summary | None = None
     return metrics.file_summary(file, summaries)
 
 
-def summarise(file: experiment_file.ExperimentFile, exp: experiment_file.Experiment,
-              rows: list[dict], picks: list[dict], checks: list[dict], earlier: dict
-              ) -> summary_model.Experiment:
+def summarise(file: Ran, exp: Experiment, rows: list[dict], picks: list[dict],
+              checks: list[dict], earlier: dict) -> summary_model.Experiment:
     """An experiment's summary from its rows of iterations.csv, picks.csv and checks.csv, and
     the summaries of the experiments before it (`earlier`): a sensitivity's from its repeats'
     (sensitivity.summarise), every other kind's from its rows (metrics.summarise)."""
     if kind_of(exp).repeats_others:
         return sensitivity.summarise(file, exp, earlier)
-    return metrics.summarise(file.for_experiment(exp), exp, rows, picks, earlier, checks)
+    return metrics.summarise(file, exp, rows, picks, earlier, checks)
 
 
 def _sampling(recorded: summary_model.Summary) -> dict[str, Sampling]:

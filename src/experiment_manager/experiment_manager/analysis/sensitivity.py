@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 from scipy.stats import fisher_exact
 
-from ..experiment_file import ExperimentFile, SensitivityExperiment
+from ..experiment_file import Ran, SensitivityExperiment
 from ..experiment_file.kinds import kind_of
 from ..experiment_file.scenarios import grid_levels, point_key
 from . import calibration, metrics
@@ -64,7 +64,7 @@ def answers(experiments: dict) -> dict:
     return out
 
 
-def summarise(file: ExperimentFile, exp: SensitivityExperiment,
+def summarise(file: Ran, exp: SensitivityExperiment,
               summaries: dict) -> model.Sensitivity:
     """The sensitivity experiment `exp`'s summary from every experiment's (`summaries`, by
     id; its repeats among them)."""
@@ -127,7 +127,7 @@ def summarise(file: ExperimentFile, exp: SensitivityExperiment,
         faults=_faults(repeats), physics=_physics(repeats))
 
 
-def _calibrations(file: ExperimentFile, exp: SensitivityExperiment, base: dict, summaries: dict
+def _calibrations(file: Ran, exp: SensitivityExperiment, base: dict, summaries: dict
                   ) -> list[model.Calibration]:
     """Each repeated drop test with measured counts fitted over the scenarios (and the
     file's own values): calibration.calibrate."""

@@ -3,11 +3,13 @@
     decide RUN_DIR [RUN_DIR ...] [--write]
 
 For each run directory, every experiment's summary is computed anew from the run's result
-files (analysis/redecide.py), and the headlines and verdicts are printed as `run` prints
-them, each verdict that differs from the one the run's summary.json holds marked with what it
-was. --write replaces summary.json (current schema version) and the report with today's. No
-graph is started. Exit 0, or 2 for a directory that is not a run directory, whose experiment
-file no longer reads, or whose summary.json or result files are broken (each said with the
+files and what it ran with (its resolved.json's records: no experiment file is read again and
+no part built; analysis/redecide.py), and the headlines and verdicts are printed as `run`
+prints them, each verdict that differs from the one the run's summary.json holds marked with
+what it was. --write replaces summary.json (current schema version) and the report with
+today's. No graph is started. Exit 0, or 2 for a directory that is not a run directory, whose
+resolved.json, summary.json or result files are broken, or (a run directory whose
+resolved.json keeps no records) whose experiment file no longer reads (each said with the
 directory).
 """
 

@@ -30,6 +30,7 @@ from .model import (
     GripperVariant,
     MAX_ITERATIONS,
     MM,
+    Ran,
     Requirements,
     Sampling,
     SEARCH_ORDERS,
@@ -44,7 +45,7 @@ __all__ = [
     'ADAPTIVE', 'BIN_EMPTYING', 'BIN_STATIC', 'BinEmptyingExperiment', 'BinStaticExperiment',
     'Cell', 'DROP_TEST', 'DropTestExperiment', 'Experiment', 'ExperimentFile', 'FEEDER_EMPTYING',
     'FeederEmptyingExperiment', 'FIXED', 'GRIPPER_SWEEP', 'GripperSweepExperiment',
-    'GripperVariant', 'InvalidFile', 'load', 'MAX_ITERATIONS', 'MM', 'parse', 'reduced',
+    'GripperVariant', 'InvalidFile', 'load', 'MAX_ITERATIONS', 'MM', 'parse', 'Ran', 'reduced',
     'Requirements', 'Sampling', 'SEARCH_ORDERS', 'SENSITIVITY', 'SensitivityExperiment',
     'TABLE_SWEEP', 'TableSweepExperiment', 'TYPES',
 ]

@@ -111,13 +111,11 @@ class Input:
 
 @dataclass(frozen=True)
 class Scenario:
-    """The inputs of one sensitivity scenario (name -> value, file units) and what they make:
-    the setup (part, gripper) and table moves its experiments run with."""
+    """One sensitivity scenario: its name and its inputs' values (name -> value, file units).
+    What they make (the part, gripper and table moves) is its repeats' `setup` and `moves`."""
 
     name: str
     values: tuple[tuple[str, float], ...]
-    setup: Setup
-    moves: tuple[Vibration, ...]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -127,10 +125,11 @@ class Experiment:
     the record's, not an argument.
 
     parts: the parts of a scene. gripper: the gripper of the file's `grippers` it runs with
-    ('' and None: the file's own); setup: the setup it runs with (None: the file's); station:
-    with a regrasp station (its setup's check says so); seeded_by: the experiment whose
-    seeds it runs on (scenes_of; '': its own); scenario: the sensitivity scenario a repeat
-    (`<id>@<scenario>`) runs in.
+    ('' and None: the file's own); setup: the setup it runs with (None: the file's; a named
+    gripper's, a scenario's); moves: the table's moves it runs with (None: the file's; a
+    scenario's); station: with a regrasp station (its setup's check says so); seeded_by: the
+    experiment whose seeds it runs on (scenes_of; '': its own); scenario: the sensitivity
+    scenario a repeat (`<id>@<scenario>`) runs in.
     """
 
     type: ClassVar[str]
@@ -139,6 +138,7 @@ class Experiment:
     parts: int = 0
     gripper: str = ''
     setup: Setup | None = None
+    moves: tuple[Vibration, ...] | None = None
     station: bool = False
     seeded_by: str = ''
     scenario: Scenario | None = None
@@ -247,6 +247,26 @@ class SensitivityExperiment(Experiment):
 
 
 @dataclass(frozen=True)
+class Ran:
+    """What deciding a run reads of the file it ran with: its id and seed, the requirements
+    and the cell's times, the aspects the part rests on, and its experiments in the file's
+    order. A run's metrics get it from the file (`ExperimentFile.ran`); `decide` from the
+    run's resolved.json (experiment_file.resolved.ran), with no file read again and no part
+    built: there its experiments' setups and moves are not kept (None), and a gripper_sweep
+    variant's grasps are as written."""
+
+    id: str
+    seed: int
+    requirements: Requirements
+    cell: Cell
+    aspects: tuple
+    experiments: tuple[Experiment, ...]
+
+    def experiment(self, experiment_id: str) -> Experiment:
+        return next(e for e in self.experiments if e.id == experiment_id)
+
+
+@dataclass(frozen=True)
 class ExperimentFile:
     """Everything a run needs, in SI units. `path` is the file read; `text` its content."""
 
@@ -276,6 +296,12 @@ class ExperimentFile:
     def experiment(self, experiment_id: str) -> Experiment:
         return next(e for e in self.experiments if e.id == experiment_id)
 
+    @property
+    def ran(self) -> Ran:
+        """What deciding a run of this file reads of it."""
+        return Ran(self.id, self.seed, self.requirements, self.cell, self.aspects,
+                   self.experiments)
+
     def first_of(self, kind: str) -> Experiment | None:
         """The file's first experiment of this type (the one a picture shows), or None."""
         return next((e for e in self.experiments if e.type == kind), None)
@@ -301,12 +327,11 @@ class ExperimentFile:
         return self.setup.config
 
     def for_experiment(self, exp: Experiment) -> 'ExperimentFile':
-        """The file an experiment's iterations run with: this one, this one with the gripper
-        and grasps the experiment names (`grippers`), or for a sensitivity scenario's repeat
-        this one with the scenario's setup and moves."""
-        if exp.scenario is None:
-            return self if exp.setup is None else replace(self, setup=exp.setup)
-        return replace(self, setup=exp.scenario.setup, moves=exp.scenario.moves)
+        """The file an experiment's iterations run with: this one, or this one with the setup
+        and moves the experiment runs with (a named gripper's; a sensitivity scenario's)."""
+        changed = {k: v for k, v in (('setup', exp.setup), ('moves', exp.moves))
+                   if v is not None}
+        return replace(self, **changed) if changed else self
 
     def variant_setup(self, variant: GripperVariant | None) -> Setup:
         """The setup a check runs with: the file's, or a gripper_sweep variant's gripper and

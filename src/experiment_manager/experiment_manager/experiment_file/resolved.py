@@ -1,6 +1,7 @@
 """What a run ran with, every default applied: `resolved.json` in its run directory, written
-once when the run starts (graph/session.py) and read by the report instead of the raw
-experiment.yaml, so that a default changed later never changes what an old run's report says.
+once when the run starts (graph/session.py) and read by the report and by `decide` instead of
+the raw experiment.yaml, so that a default changed later never changes what an old run's
+report says or how it is decided again, and no part is built to decide it.
 
 It holds the part (its model, dimensions, mesh, mass, placing, and the aspects it can rest on
 with their normals), its materials with the basis of each value, the gripper (its kind and
@@ -8,17 +9,19 @@ every key in the file's units), the grasps, the file's named grippers its experi
 with (each with its grasps), the tray (size, walls, feeder zone, the hopper's lip), each
 feeder run's dose, the table's moves, the requirements and the cell's times, and `defaulted`:
 the file's top keys it left to their defaults. In the file's units (mm, g, deg),
-as the file would say them. Pure: no rclpy, no simulator.
+as the file would say them; and `records`, what deciding the run reads (the requirements, the
+cell, the aspects and every experiment's record), in SI as the run held them
+(experiment_file.ran). Pure: no rclpy, no simulator.
 """
 
-from dataclasses import fields
 import json
 import os
 
+from . import ran as ran_records
 from .kinds import kind_of
 from .loading import load
-from .model import ExperimentFile, MM
-from .part import GRASP_KEYS
+from .model import ExperimentFile, MM, Ran
+from .ran import grasp_keys
 
 NAME = 'resolved.json'
 # the top keys of the file the report speaks of when the file leaves them out
@@ -49,9 +52,9 @@ def resolved(file: ExperimentFile) -> dict:
         'materials': [{'pair': pair, 'basis': dict(bases), 'source': said}
                       for pair, bases, said in file.material_account],
         'gripper': _gripper(gripper),
-        'grasps': [_grasp(g) for g in file.grasps],
+        'grasps': [grasp_keys(g) for g in file.grasps],
         'grippers': {e.gripper: {**_gripper(e.setup.gripper),
-                                 'grasps': [_grasp(g) for g in e.setup.grasps]}
+                                 'grasps': [grasp_keys(g) for g in e.setup.grasps]}
                      for e in file.experiments if e.gripper},
         'auto_grasps': file.auto_grasps,
         'tray': {'tray_mm': _mm(tray.inner_size), 'wall_mm': round(tray.wall_thickness / MM, 6),
@@ -70,24 +73,13 @@ def resolved(file: ExperimentFile) -> dict:
         'cell': {'pick_s': file.cell.pick_time, 'image_s': file.cell.image_time,
                  'regrasp_s': file.cell.regrasp_time},
         'defaulted': [k for k in TOP_KEYS if k not in file.given],
+        'records': ran_records.plain(file.ran),
     }
 
 
 def _gripper(gripper) -> dict:
     """A gripper's kind and every key of it, in the file's units."""
     return {'type': gripper.kind, **gripper.file_values()}
-
-
-def _grasp(g) -> dict:
-    """A written grasp in the file's keys and units."""
-    out = {'name': g.name}
-    for f in fields(g):
-        if f.name in GRASP_KEYS:
-            key, factor = GRASP_KEYS[f.name]
-            value = getattr(g, f.name)
-            out[key] = ([round(v / factor, 6) for v in value] if isinstance(value, tuple)
-                        else round(value / factor, 6))
-    return out
 
 
 def write(file: ExperimentFile, run_dir: str) -> str:
@@ -108,3 +100,18 @@ def read(run_dir: str) -> dict:
         with open(path, encoding='utf-8') as f:
             return json.load(f)
     return json.loads(json.dumps(resolved(load(os.path.join(run_dir, 'experiment.yaml')))))
+
+
+def ran(run_dir: str) -> Ran:
+    """What deciding the run in `run_dir` reads of what it ran with: its resolved.json's
+    `records` (experiment_file.ran); for a run directory whose resolved.json keeps none (or
+    that has none), its experiment.yaml read again by today's rules. InvalidArgument when that
+    file no longer reads; ValueError naming resolved.json when its records are broken."""
+    data = read(run_dir)
+    if 'records' not in data:
+        return load(os.path.join(run_dir, 'experiment.yaml')).ran
+    try:
+        return ran_records.read(data['records'], data['id'], data['seed'])
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ValueError(f'{os.path.join(run_dir, NAME)}: its records do not read '
+                         f'({type(exc).__name__}: {exc})') from None

@@ -188,8 +188,10 @@ def point_key(inputs: tuple[Input, ...], values: dict[str, float]) -> tuple[floa
 
 def scenarios(inputs: tuple[Input, ...], joint: int, setup: Setup,
               moves: tuple[Vibration, ...], seed: int, experiment_id: str, where: str,
-              levels: int = 0, tray: ContainerSpec | None = None) -> tuple[Scenario, ...]:
-    """The scenarios of a sensitivity experiment (module docstring), each checked. A point
+              levels: int = 0, tray: ContainerSpec | None = None
+              ) -> tuple[tuple[Scenario, Setup, tuple[Vibration, ...]], ...]:
+    """The scenarios of a sensitivity experiment (module docstring), each checked, with the
+    setup and moves it makes (what its repeats run with). A point
     whose inputs are all the file's or an earlier scenario's is left out: on the same seeds it
     would give the same answers (an input's low at the file's value; a grid holds each input's
     ends with the others at the file's values when those are among its levels)."""
@@ -207,7 +209,8 @@ def scenarios(inputs: tuple[Input, ...], joint: int, setup: Setup,
             continue
         seen.add(key)
         s, m = apply(values, setup, moves, f'{where}.inputs ({name})')
-        out.append(Scenario(name, tuple(values.items()), s, m))
+        scenario = Scenario(name, tuple(values.items()))
+        out.append((scenario, s, m))
         if tray is not None:
-            checked(check_container, tray_of(out[-1], tray) or tray, f'{where}.inputs ({name})')
+            checked(check_container, tray_of(scenario, tray) or tray, f'{where}.inputs ({name})')
     return tuple(out)

@@ -130,7 +130,7 @@ def _emptying_unsettled(file: ExperimentFile, exp: BinEmptyingExperiment, kept: 
 
 def _feeder_unsettled(file: ExperimentFile, exp: FeederEmptyingExperiment, kept: list[dict],
                       checks: list[dict]) -> tuple[list[int], list[int]]:
-    grounds = metrics.table_grounds(file, kept, INTERIM_CONFIDENCE)
+    grounds = metrics.table_grounds(file.ran, kept, INTERIM_CONFIDENCE)
     return ([] if decisions.combined([g.verdict for g in grounds.values()])
             != decisions.UNDECIDED else groups(exp)), []
 

@@ -130,7 +130,7 @@ class Runner:
         if self._waiting or any(self._left.values()):
             raise AssertionError('the run ended with iterations left undone')
         self._report(self.file.experiments[-1], 'done')
-        return metrics.file_summary(self.file, self._ordered_summary())
+        return metrics.file_summary(self.file.ran, self._ordered_summary())
 
     def _ordered_summary(self) -> dict:
         return {e.id: self._summary[e.id] for e in self.file.experiments
@@ -222,7 +222,7 @@ class Runner:
         experiments waiting for it (under the lock)."""
         self.sink.reorder(self._rank)
         rows, checks = self.sink.iterations(exp.id), self.sink.checks(exp.id)
-        self._summary[exp.id] = summarise(self.file, exp, rows, self.sink.picks(exp.id),
+        self._summary[exp.id] = summarise(self.file.ran, exp, rows, self.sink.picks(exp.id),
                                           checks, self._summary)
         wider = extended(self.file, exp, self._summary[exp.id])
         if wider is not None:       # a sweep still rising at its last count goes on
@@ -232,7 +232,7 @@ class Runner:
         if self.file.sampling.adaptive and not kind_of(exp).repeats_others:
             self._summary[exp.id] = self._summary[exp.id].model_copy(
                 update={'sampling': self._sampling(exp, rows, checks)})
-        self.sink.write_summary(metrics.file_summary(self.file, self._ordered_summary()))
+        self.sink.write_summary(metrics.file_summary(self.file.ran, self._ordered_summary()))
         self._release()
 
     def _sampling(self, exp: Experiment, rows: list[dict], checks: list[dict]) -> Sampling:

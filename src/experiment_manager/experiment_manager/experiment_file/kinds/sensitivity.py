@@ -90,7 +90,7 @@ def read(e: experiment_keys.SensitivityKeys, where: str, c: Context) -> list[Exp
     found = scenario_inputs.scenarios(inputs, e.joint, c.setup, c.moves, c.seed, e.id, where,
                                       e.grid, c.tray)
     repeats = []
-    for scenario in found:
+    for scenario, setup, moves in found:
         for exp_id in e.of:
             source = c.earlier[exp_id]
             renamed = {key: f'{value}@{scenario.name}' if value in e.of else value
@@ -101,6 +101,7 @@ def read(e: experiment_keys.SensitivityKeys, where: str, c: Context) -> list[Exp
                 renamed['bin'] = tray      # its one container (base.scene_container)
             repeats.append(replace(source, id=f'{exp_id}@{scenario.name}',
                                    iterations=min(source.iterations, e.iterations),
-                                   scenario=scenario, **renamed))
+                                   scenario=scenario, setup=setup, moves=moves, **renamed))
     return repeats + [SensitivityExperiment(id=e.id, iterations=e.iterations, of=tuple(e.of),
-                                            inputs=inputs, scenarios=found, grid=e.grid)]
+                                            inputs=inputs, scenarios=tuple(s for s, _, _ in found),
+                                            grid=e.grid)]
