@@ -13,9 +13,11 @@ from experiment_manager import experiment_file
 from experiment_manager.analysis import metrics
 from experiment_manager.analysis.headlines import headlines
 from experiment_manager.analysis.records import Faults, Flagged
+from experiment_manager.analysis.redecide import redecide
 from experiment_manager.analysis.results import read_text_rows, ResultsWriter
 from experiment_manager.analysis.rows import FILES, POSE
 from experiment_manager.analysis.summary import validate
+from experiment_manager.experiment_file import resolved
 from experiment_manager.experiment_file.plan import iteration_seed, plan, Unit
 from experiment_manager.running.backend import WorkerLost
 from experiment_manager.running.local_backend import LocalBackend
@@ -566,7 +568,11 @@ def test_a_sweep_still_rising_at_its_last_count_sweeps_on_until_its_peak_is_insi
                                                                                   mode):
     text = EXTENDING + f'sampling: {{mode: {mode}, batch: 1}}\n'
     with LocalBackend() as backend, ResultsWriter(str(tmp_path), text) as writer:
+        resolved.write(experiment_file.parse(text), str(tmp_path))
         summary = Runner(experiment_file.parse(text), [backend], writer).run()
+    # decided again, it is swept as it ran: on its records' counts and the ones it went on to
+    with open(tmp_path / 'summary.json', encoding='utf-8') as f:
+        assert redecide(str(tmp_path)).json_text() == f.read()
     s = summary.experiments['sweep']
     counts = [p.n for p in s.per_n]
     assert counts[:3] == [1, 2, 3] and len(counts) > 3

@@ -8,6 +8,7 @@ summary.json: an adaptive experiment's sampling (the batches it took are the run
 Results written before a rule changed (the table's bound, the bins' race) are then read as
 today's. No rclpy."""
 
+from dataclasses import replace
 import os
 
 from ..experiment_file import Experiment, Ran, resolved
@@ -39,6 +40,7 @@ def redecide(run_dir: str, recorded: summary_model.Summary | None = None
                    else bool(mine))
         if not reached:         # an interrupted run stopped before it
             continue
+        exp = as_run(exp, mine)
         summaries[exp.id] = summarise(
             file, exp, mine, [p for p in picks if p['experiment'] == exp.id],
             [c for c in checks if c['experiment'] == exp.id], summaries)
@@ -46,6 +48,16 @@ def redecide(run_dir: str, recorded: summary_model.Summary | None = None
             summaries[exp.id] = summaries[exp.id].model_copy(
                 update={'sampling': sampled[exp.id]})
     return metrics.file_summary(file, summaries)
+
+
+def as_run(exp: Experiment, rows: list[dict]) -> Experiment:
+    """`exp` as the run ran it: a table_sweep the run extended to more counts than the file
+    gives (plan.extended; the run's records keep the file's) with those counts, found in its
+    rows."""
+    if not kind_of(exp).extends:
+        return exp
+    more = sorted({r['group'] for r in rows} - set(exp.counts))
+    return replace(exp, counts=exp.counts + tuple(more)) if more else exp
 
 
 def summarise(file: Ran, exp: Experiment, rows: list[dict], picks: list[dict],
