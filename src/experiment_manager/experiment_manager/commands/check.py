@@ -62,7 +62,7 @@ def check(paths: list[str], output: str | None, iterations: int | None = None,
 def _capped(file: ExperimentFile, path: str, iterations: int | None,
             adaptive: bool) -> ExperimentFile:
     """`file` as the run's options make it: read again from its reduced text when
-    --max-iterations or --adaptive change it, else as it is (read once)."""
+    --iterations or --adaptive change it, else as it is (read once)."""
     if iterations is None and not adaptive:
         return file
     return experiment_file.parse(experiment_file.reduced(file, iterations, adaptive), path)
