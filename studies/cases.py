@@ -49,10 +49,23 @@ def summarise_on_cores(part_file: str, experiments: list[dict],
     file = variant(part_file, experiments, **sections)
     with tempfile.TemporaryDirectory() as out:
         start = time.perf_counter()
-        with LocalBackend(physics) as backend, ResultsWriter(out, file.text) as writer:
-            summary = Runner(file, [backend], writer).run()
+        summary = run_file(file, out, physics=physics)
         wall = time.perf_counter() - start
         return read_csv(os.path.join(out, 'iterations.csv')), summary, wall
+
+
+def run_file(file: experiment_file.ExperimentFile, directory: str, workers: int = 1,
+             physics: PhysicsConfig | None = None) -> Summary:
+    """Run `file` on the cores in this process, on `workers` local workers with `physics`
+    (the world's defaults when None), its result files written into `directory`; the
+    summary."""
+    backends = [LocalBackend(physics) for _ in range(workers)]
+    try:
+        with ResultsWriter(directory, file.text) as writer:
+            return Runner(file, backends, writer).run()
+    finally:
+        for backend in backends:
+            backend.close()
 
 
 def parse_args(parser: argparse.ArgumentParser, small: list[str],

@@ -31,14 +31,13 @@ import os
 import tempfile
 
 from experiment_manager import experiment_file
-from experiment_manager.analysis.results import ResultsWriter
-from experiment_manager.running.local_backend import LocalBackend
-from experiment_manager.running.scheduler import Runner
 import numpy as np
 from pick_common.parts import aspects as aspects_of
 from pick_common.parts.materials import Contact, PART_ON_SURFACE
 from pick_common.stats import wilson_interval
 import trimesh
+
+from studies.cases import run_file
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src', 'experiment_manager',
                     'config', 'parts', 'resting_rigid_bodies')
@@ -143,13 +142,7 @@ experiments:
   - {{id: drops, type: drop_test, iterations: {drops}, height_mm: {height * 1000.0!r}}}
 """
         file = experiment_file.parse(text, os.path.join(tmp, 'drops.yaml'))
-        backends = [LocalBackend() for _ in range(workers)]
-        try:
-            with ResultsWriter(os.path.join(tmp, 'run'), text) as writer:
-                summary = Runner(file, backends, writer).run()
-        finally:
-            for b in backends:
-                b.close()
+        summary = run_file(file, os.path.join(tmp, 'run'), workers)
     found = summary.experiments['drops']
     counts = Counter({a.name: a.count for a in found.aspects if a.count})
     if found.other:
