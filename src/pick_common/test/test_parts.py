@@ -2,6 +2,7 @@
 world's tests drop a user mesh)."""
 
 import os
+import warnings
 
 from hypothesis import given, HealthCheck, settings
 from hypothesis import strategies as st
@@ -235,6 +236,21 @@ def test_a_part_of_many_bodies_shares_its_pieces_out_rather_than_becoming_one_hu
     assert 'at most 4 each' in words and 'one convex hull' not in words
     together = sum(h.volume for h in hulls) - 28 * 1e-9
     assert to220.volume < together < trimesh.convex.convex_hull(to220.vertices).volume
+
+
+def test_a_flat_closed_body_is_left_out_without_a_numpy_warning():
+    # KiCad's electrolytic capacitors' models hold closed bodies of no volume (two-triangle
+    # slivers in CP_Radial_D10.0mm and CP_Axial_L10.0mm): trimesh divides by the
+    # volume for the mass centre, and numpy's "invalid value encountered in divide" reached
+    # the user's terminal on every run of a board with one
+    box = trimesh.creation.box((0.004, 0.004, 0.002))
+    flat = trimesh.Trimesh([[0.01, 0, 0], [0.012, 0, 0], [0.01, 0.002, 0], [0.011, 0.001, 0]],
+                           [[0, 1, 2], [0, 3, 1], [1, 3, 2], [2, 3, 0]], process=False)
+    assert flat.is_watertight
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        hulls, _ = pieces.convex_cover(trimesh.util.concatenate([box, flat]), 'flat.stl')
+    assert len(hulls) == 1 and hulls[0].volume == pytest.approx(box.volume)
 
 
 def test_pieces_much_larger_than_the_part_are_said_with_why():

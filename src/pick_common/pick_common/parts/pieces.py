@@ -155,7 +155,15 @@ def _hull(points: np.ndarray) -> trimesh.Trimesh | None:
         hull = trimesh.convex.convex_hull(points)
     except Exception:  # qhull fails on flat or collinear input
         return None
-    return hull if hull.volume > 0 else None
+    return hull if _has_volume(hull) else None
+
+
+def _has_volume(body: trimesh.Trimesh) -> bool:
+    """The body encloses space: a flat closed sheet (KiCad's models have some) or a flat hull
+    does not. Read without numpy's warning: trimesh divides by the volume for the mass centre,
+    which is no fault of the part's."""
+    with np.errstate(divide='ignore', invalid='ignore'):
+        return body.volume > 0
 
 
 def convex_cover(mesh: trimesh.Trimesh, path: str) -> tuple[list[trimesh.Trimesh], str]:
@@ -173,7 +181,7 @@ def convex_cover(mesh: trimesh.Trimesh, path: str) -> tuple[list[trimesh.Trimesh
     if len(bodies) > MAX_MESH_HULLS:
         return _whole(mesh, path, f'it has {len(bodies)} separate bodies, more than '
                       f'{MAX_MESH_HULLS}')
-    closed = [b.is_watertight and b.volume > 0 for b in bodies]
+    closed = [b.is_watertight and _has_volume(b) for b in bodies]
     concave = [c and not is_convex(b) for b, c in zip(bodies, closed, strict=True)]
     hulls = [[] if c else [h for h in [_hull(b.vertices)] if h is not None]
              for b, c in zip(bodies, concave, strict=True)]
