@@ -4,6 +4,7 @@ their published values and their own promise (coverage), on made-up data."""
 import math
 
 from experiment_manager.analysis import decisions
+from experiment_manager.experiment_file.model import Cell
 import numpy as np
 from pick_common.stats import binomial_bounds
 import pytest
@@ -68,6 +69,25 @@ def test_the_time_ground_decides_on_the_bound_and_says_which():
     said = decisions.table_time(stuck, 14400.0, 0.9)
     assert said.interval == 'one-sided 95 % distribution-free (binomial)'
     assert said.verdict == decisions.UNDECIDED and said.detail['over'] == 1
+
+
+def test_runs_the_vibration_limit_ended_early_in_the_interval_are_said_so():
+    # KiCad's axial resistor on the board cell: 5 feeder runs of 80 ended at the 500-vibration
+    # limit after 8-9 picks, about 10 min of cell time into the 240 min interval; "not
+    # emptied" alone read as if the interval had run out
+    cell = Cell()
+    row = {'picks': 9, 'checks': 509, 'table_time': 538.7, 'regrasps': 0, 'spilled': 0}
+    runs = decisions.feeder_runs([{**row, 'emptied': False, 'stop': 'stop: vibration limit'},
+                                  {**row, 'emptied': False, 'stop': 'stop: vibration limit',
+                                   'table_time': 20000.0},
+                                  {**row, 'emptied': True, 'stop': 'stop: empty'}], cell)
+    assert [r['limited'] for r in runs] == [True, True, False]
+    said = decisions.table_time(runs, 14400.0, 0.9)
+    assert '2 of 3 runs over the interval or not emptied' in said.reason
+    # the second ran past the interval: the interval ended it, not the limit
+    assert '1 of them stopped at the vibration limit (max_vibrations) with parts left, ' \
+        '9.6 min or less into the 240.0 min interval' in said.reason
+    assert 'vibration limit' not in decisions.table_time(runs[1:], 14400.0, 0.9).reason
 
 
 def test_spills_are_a_share_of_refills_decided_on_its_bounds():
