@@ -73,7 +73,7 @@ def test_the_time_ground_decides_on_the_bound_and_says_which():
 
 def test_runs_the_vibration_limit_ended_early_in_the_interval_are_said_so():
     # KiCad's axial resistor on the board cell: 5 feeder runs of 80 ended at the 500-vibration
-    # limit after 8-9 picks, about 10 min of cell time into the 240 min interval; "not
+    # limit after 8-9 picks, 9.6 min of cell time into the 240 min interval; "not
     # emptied" alone read as if the interval had run out
     cell = Cell()
     row = {'picks': 9, 'checks': 509, 'table_time': 538.7, 'regrasps': 0, 'spilled': 0}
