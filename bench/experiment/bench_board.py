@@ -94,12 +94,12 @@ def main() -> int:
                          for name in FILES)
         same_verdicts = p['options'] == q['options']
         identical &= same_files and same_verdicts
-        span_a, span_b = run_span(p['run']), run_span(q['run'])
-        total_a, total_b, work_b = total_a + span_a, total_b + span_b, work_b + busy(q['run'])
+        span_a, span_b, busy_b = run_span(p['run']), run_span(q['run']), busy(q['run'])
+        total_a, total_b, work_b = total_a + span_a, total_b + span_b, work_b + busy_b
         n = sum(per_type(p['run'])[1].values())
         verdicts = ' '.join(f'{o["option"]}:{o["verdict"]}' for o in p['options'])
         print(f'  {p["name"][:48]:48s} {n:5d} {span_a:9.1f} {span_b:9.1f} '
-              f'{span_a / span_b:6.2f} {busy(q["run"]) / (span_b * b):8.0%}  {verdicts}'
+              f'{span_a / span_b:6.2f} {busy_b / (span_b * b):8.0%}  {verdicts}'
               + ('' if same_files and same_verdicts else '  DIFFERENT'))
     if total_b:
         print(f'  {"all parts":48s} {"":5s} {total_a:9.1f} {total_b:9.1f} '
