@@ -71,23 +71,37 @@ def test_the_time_ground_decides_on_the_bound_and_says_which():
     assert said.verdict == decisions.UNDECIDED and said.detail['over'] == 1
 
 
-def test_runs_the_vibration_limit_ended_early_in_the_interval_are_said_so():
+def test_runs_the_vibration_limit_ended_early_in_the_interval_are_censored():
     # KiCad's axial resistor on the board cell: 5 feeder runs of 80 ended at the 500-vibration
-    # limit after 8-9 picks, 9.6 min of cell time into the 240 min interval; "not
-    # emptied" alone read as if the interval had run out
+    # limit after 7-10 picks, 9.6 min of cell time into the 240 min interval, about 56 an
+    # hour (9 in 575 s here) where 20 empty the refill in it; read as "not emptied", the
+    # limit made the table NOT FEASIBLE, not the interval
     cell = Cell()
-    row = {'picks': 9, 'checks': 509, 'table_time': 538.7, 'regrasps': 0, 'spilled': 0}
-    runs = decisions.feeder_runs([{**row, 'emptied': False, 'stop': 'stop: vibration limit'},
-                                  {**row, 'emptied': False, 'stop': 'stop: vibration limit',
-                                   'table_time': 20000.0},
+    row = {'picks': 9, 'checks': 509, 'table_time': 538.7, 'regrasps': 0, 'spilled': 0,
+           'parts': 80}
+    cut = {**row, 'emptied': False, 'stop': 'stop: vibration limit'}
+    runs = decisions.feeder_runs([cut, {**cut, 'table_time': 20000.0},
                                   {**row, 'emptied': True, 'stop': 'stop: empty'}], cell)
     assert [r['limited'] for r in runs] == [True, True, False]
     said = decisions.table_time(runs, 14400.0, 0.9)
-    assert '2 of 3 runs over the interval or not emptied' in said.reason
-    # the second ran past the interval: the interval ended it, not the limit
-    assert '1 of them stopped at the vibration limit (max_vibrations) with parts left, ' \
-        '9.6 min or less into the 240.0 min interval' in said.reason
+    # the second ran past the interval: over it, whatever ended it
+    assert said.detail['over'] == 1 and said.detail['censored'] == 1
+    assert '1 of 3 runs over the interval or not emptied' in said.reason
+    assert 'not counted: 1 run(s) stopped at the vibration limit (max_vibrations) with parts ' \
+        'left, 9.6 min or less into the 240.0 min interval: they picked 56.4 parts an hour ' \
+        'against the 20 that empty a refill of 80 in it' in said.reason
     assert 'vibration limit' not in decisions.table_time(runs[1:], 14400.0, 0.9).reason
+    # five such runs: NOT FEASIBLE as "not emptied", UNDECIDED as censored (counted over, the
+    # share is at most 100 %; counted within, at least 0 %); no Gumbel fit either way
+    five = decisions.feeder_runs([cut] * 5, cell)
+    limited = decisions.table_time(five, 14400.0, 0.9)
+    assert limited.verdict == decisions.UNDECIDED and limited.detail['over'] == 0
+    assert 'a run the vibration limit ended' in limited.reason and 'gumbel' not in limited.detail
+    # beside 29 runs that emptied within it, one censored run keeps FEASIBLE out of reach
+    # (1 of 30 counted over: at most 14.8 %), and would not with it counted within
+    quick = decisions.feeder_runs([{**row, 'emptied': True}] * 29, cell)
+    assert decisions.table_time(quick + five[:1], 14400.0, 0.9).verdict == decisions.UNDECIDED
+    assert decisions.table_time(quick, 14400.0, 0.9).verdict == decisions.FEASIBLE
 
 
 def test_spills_are_a_share_of_refills_decided_on_its_bounds():

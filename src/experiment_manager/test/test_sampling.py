@@ -12,7 +12,7 @@ from experiment_manager.analysis.headlines import headlines
 from experiment_manager.analysis.report import Run
 from experiment_manager.analysis.results import read_text_rows, ResultsWriter
 from experiment_manager.analysis.summary import Sampling, Summary
-from experiment_manager.analysis.verdicts import NOT_FEASIBLE, verdicts
+from experiment_manager.analysis.verdicts import NOT_FEASIBLE, UNDECIDED, verdicts
 from experiment_manager.analysis.wording import sampling_end
 from experiment_manager.running import sampling
 from experiment_manager.running.local_backend import LocalBackend
@@ -252,7 +252,8 @@ def read(directory: str) -> list[dict]:
     return read_text_rows(os.path.join(directory, 'iterations.csv'), drop=('wall_time',))
 
 
-# Feeder runs allowed one vibration cannot empty the feeder.
+# Feeder runs allowed one vibration cannot empty the feeder; with a refill interval of 3.6 ms
+# (`run`'s default) each is over it when the limit ends it, so each counts against the table.
 HOPELESS = ('id: stop_early\nseed: 3\npart: {model: radial_capacitor}\n'
             'gripper: {body_diameter_mm: 8, jaw_depth_mm: 3}\n'
             'experiments:\n'
@@ -261,9 +262,10 @@ HOPELESS = ('id: stop_early\nseed: 3\npart: {model: radial_capacitor}\n'
 
 
 def run(mode: str, directory: str, writer=ResultsWriter, resume: bool = False,
-        progress=None, required: float = 0.9) -> Summary:
+        progress=None, required: float = 0.9, interval_h: float = 1e-6) -> Summary:
     file = experiment_file.parse(HOPELESS + f'sampling: {{mode: {mode}, batch: 2}}\n'
-                        f'requirements: {{success_rate: {required}}}\n', SMALL)
+                        f'requirements: {{success_rate: {required}, '
+                        f'refill_interval_h: {interval_h:f}}}\n', SMALL)
     with LocalBackend() as backend, writer(directory, file.text, resume) as sink:
         return Runner(file, [backend], sink, progress).run()
 
@@ -290,6 +292,24 @@ def test_an_adaptive_run_stops_a_feeder_study_that_settled_and_keeps_the_fixed_c
     assert '[adaptive: 4 of 6 iterations, settled]' in headlines(summary)[0]
     assert '| `feeder` | 4 | 6 | 2 | settled |' in report.markdown(Run(summary))
     assert '## Sampling' not in report.markdown(Run(runs['fixed'][0]))
+
+
+def test_runs_the_vibration_limit_ended_early_stop_once_feasible_is_out_of_reach(tmp_path):
+    """The same hopeless runs against a 4 h refill interval: the limit ends each well inside
+    it (under a minute), so none says whether a refill empties within it (censored). Two of
+    them keep the table from FEASIBLE at any of the 6 iterations (2 of 6 counted over: at most
+    73 % at 95 %, against 10 % allowed): the run stops after its first batch, its time ground
+    UNDECIDED, and says why."""
+    summary = run('adaptive', str(tmp_path / 'limited'), interval_h=4.0)
+    s = summary.experiments['feeder']
+    assert (s.iterations, s.sampling.settled) == (2, True)
+    time = s.decision.time
+    assert (time.verdict, time.over, time.censored) == (UNDECIDED, 0, 2)
+    assert 'not counted: 2 run(s) stopped at the vibration limit' in time.reason
+    # the option's verdict rests on its grounds (here also the 12 parts loaded, fewer than a
+    # refill): the time ground says what would settle it
+    reasons = ' '.join(verdicts(summary)[1].reasons)
+    assert 'runs at this vibration limit cannot settle it' in reasons
 
 
 def test_an_interrupted_adaptive_run_resumes_to_the_same_batches_and_results(tmp_path):

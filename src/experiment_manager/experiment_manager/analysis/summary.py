@@ -56,6 +56,8 @@ class Decision(_Record):
     spilled: int | None = None
     # the table's time to empty a refill
     over: int | None = None
+    censored: int | None = Field(None, description='feeder runs the vibration limit ended with '
+                                 'the refill interval unspent: neither within it nor over')
     refill_s: float | None = None
     coverage: float | None = None
     times_s: list[float | None] | None = None

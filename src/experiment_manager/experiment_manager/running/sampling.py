@@ -17,7 +17,16 @@ What settles each decision, looked at after every batch:
   cell's time to empty a refill against the refill interval (its tolerance bound) and the
   share of refills spilling at most requirements.max_spilled_parts (its exact bounds: with no
   spill, 66 runs at the interim 99.9 %, 29 at the last look's 95 %); settled when one ground
-  is NOT FEASIBLE or every ground FEASIBLE. An iteration left
+  is NOT FEASIBLE or every ground FEASIBLE, or when FEASIBLE is out of reach for a run the
+  vibration limit ended with the interval unspent (censored: decisions.table_time): counted
+  over the interval for FEASIBLE, it keeps the last look's 95 % upper bound of the share over
+  at or above 1 - success_rate even if every iteration left emptied within it, so more runs
+  cannot make the table FEASIBLE (a stop for futility: Snapinn et al., "Assessment of
+  futility in clinical trials", Pharmaceutical Statistics 5(4), 2006). Its verdict is what the
+  runs made say: UNDECIDED, with the limit named and the pace the censored runs picked at, or
+  NOT FEASIBLE. Without it a feeder whose runs all reach the limit would run every iteration
+  (30 in the board cell) to it, where the paper's reading, not emptied, settled it in one
+  batch. An iteration left
   out of the figures (a physics fault) settles bins and feeder too: the verdict is NOT
   FEASIBLE then.
 - bin_static, a race: a bin leaves it when it is known to lie below the leading bin (the
@@ -60,7 +69,7 @@ L x 0.1 %.
 """
 
 import numpy as np
-from pick_common.stats import difference_bound, interval
+from pick_common.stats import binomial_bounds, difference_bound, interval
 
 from ..analysis import decisions, metrics
 from ..experiment_file import (
@@ -131,8 +140,21 @@ def _emptying_unsettled(file: ExperimentFile, exp: BinEmptyingExperiment, kept: 
 def _feeder_unsettled(file: ExperimentFile, exp: FeederEmptyingExperiment, kept: list[dict],
                       checks: list[dict]) -> tuple[list[int], list[int]]:
     grounds = metrics.table_grounds(file.ran, kept, INTERIM_CONFIDENCE)
-    return ([] if decisions.combined([g.verdict for g in grounds.values()])
-            != decisions.UNDECIDED else groups(exp)), []
+    settled = (decisions.combined([g.verdict for g in grounds.values()]) != decisions.UNDECIDED
+               or out_of_reach(grounds['time'], exp.iterations, file.requirements.success_rate))
+    return ([] if settled else groups(exp)), []
+
+
+def out_of_reach(time: decisions.Decision, iterations: int, required: float) -> bool:
+    """The table's time ground (decisions.table_time) holds a censored run and cannot be
+    FEASIBLE at `iterations` runs even if every one left emptied within the interval: its
+    last look's upper bound of the share over, censored runs counted over, reaches
+    1 - `required`."""
+    cut = time.detail.get('censored', 0)
+    if not cut:
+        return False
+    over = time.detail['over'] + cut
+    return binomial_bounds(over, max(iterations, time.runs))[1] >= 1.0 - required
 
 
 def rate_settled(successes: int, n: int, required: float,
