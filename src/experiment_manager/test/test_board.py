@@ -378,6 +378,51 @@ def test_a_board_run_again_keeps_the_parts_done_with_the_same_file_and_writes_it
     _valid_against_the_published_schema(data)
 
 
+def test_a_part_an_earlier_board_run_left_interrupted_resumes_in_its_run_directory(tmp_path):
+    """A board run cut in a part's run: the board run again resumes that run directory (the
+    newest of the part's file that holds iterations and no summary), losing at most the
+    iteration in flight, where it ran the part anew."""
+    import argparse
+
+    from experiment_manager.commands import run
+    path = _board_file(tmp_path)
+    out = tmp_path / 'out'
+
+    def goals(adaptive: bool = False) -> dict:
+        args = argparse.Namespace(experiment_files=[path], resume=None, output=str(out),
+                                  iterations=None, adaptive=adaptive, board=None, boards=[],
+                                  workers=2)
+        return next(g for g, _, given, _ in run._goals(args, temporary)
+                    if RESISTOR.replace('.', '_') in given)
+
+    def run_dir(name: str, text: bytes, finished: bool = False):
+        d = out / name
+        d.mkdir()
+        (d / 'experiment.yaml').write_bytes(text)
+        (d / 'iterations.csv').write_text('experiment,group,iteration\n')
+        if finished:
+            (d / 'summary.json').write_text('{}')
+        return d
+
+    temporary = []
+    first = goals()
+    assert not first.resume and first.output_dir == str(out)
+    with open(first.experiment_file, 'rb') as f:
+        text = f.read()
+    file_id = yaml.safe_load(text)['id']
+    cut = run_dir(f'{file_id}_20261130-010000', text)
+    run_dir(f'{file_id}_20261130-020000', text, finished=True)        # newer, finished
+    run_dir(f'{file_id}_20261130-030000', text + b'# changed\n')      # newer, another file
+    run_dir(f'other_{file_id}_20261130-040000', text)                  # another part's id
+    again = goals()
+    assert again.resume and again.output_dir == str(cut)
+    # with --adaptive the run is of a reduced copy: that run of the whole file is not it
+    reduced = goals(adaptive=True)
+    assert not reduced.resume and reduced.output_dir == str(out)
+    for p in temporary:
+        os.remove(p)
+
+
 def _valid_against_the_published_schema(data: dict) -> None:
     import json
 

@@ -134,6 +134,32 @@ def expand_boards(files: list[str], args: argparse.Namespace,
     return out
 
 
+def interrupted(directory: str, file_id: str, path: str) -> str | None:
+    """The newest run directory in `directory` of the file at `path` (id `file_id`: a board's
+    part, as it is to run) that was interrupted: it holds iterations.csv and no summary.json,
+    and its experiment.yaml is the file's text to the byte (a run resumes only the file it
+    ran). None when there is none: the part runs anew."""
+    with open(path, 'rb') as f:
+        text = f.read()
+    try:
+        names = sorted(os.listdir(directory), reverse=True)
+    except OSError:
+        return None
+    for name in names:
+        run_dir = os.path.join(directory, name)
+        if not name.startswith(f'{file_id}_') or not os.path.isfile(
+                os.path.join(run_dir, 'iterations.csv')) or os.path.exists(
+                os.path.join(run_dir, 'summary.json')):
+            continue
+        try:
+            with open(os.path.join(run_dir, 'experiment.yaml'), 'rb') as f:
+                if f.read() == text:
+                    return run_dir
+        except OSError:
+            continue
+    return None
+
+
 def _done_before(path: str) -> dict[str, dict]:
     """The parts an earlier run of the board decided (its <id>_board.json at `path`), by
     name, each whose run directory still holds its summary.json; {} when there is none."""

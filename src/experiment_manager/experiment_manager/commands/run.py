@@ -48,7 +48,7 @@ from ..analysis import wording
 from ..analysis.headlines import headlines
 from ..analysis.verdicts import verdicts
 from . import interrupt
-from .boards import board_file, BoardRun, cell_file, decided, expand_boards
+from .boards import board_file, BoardRun, cell_file, decided, expand_boards, interrupted
 from .claim import claim, NamespaceInUse
 from .supervisor import Graph, report_dead, spin_until, start_graph
 
@@ -190,7 +190,7 @@ def _goals(args: argparse.Namespace,
     files = args.experiment_files or [os.path.join(args.resume, 'experiment.yaml')
                                       if args.resume else default_file()]
     for given in expand_boards(_board_given(args) or files, args, args.boards):
-        path = os.path.abspath(given)
+        path = part = os.path.abspath(given)
         try:
             file = next((b.read[path] for b in args.boards if path in b.read), None) \
                 or experiment_file.load(path)
@@ -204,9 +204,12 @@ def _goals(args: argparse.Namespace,
             temporary.append(path)
             with os.fdopen(fd, 'w') as f:
                 f.write(experiment_file.reduced(file, args.iterations, args.adaptive))
-        output = os.path.abspath(os.path.expanduser(args.resume or args.output
+        # a board's part that an earlier run of the board left interrupted resumes there
+        board = next((b for b in args.boards if part in b.by_path), None)
+        cut = board and not args.resume and interrupted(board.directory, file.id, path)
+        output = os.path.abspath(os.path.expanduser(args.resume or cut or args.output
                                                     or file.output_dir))
-        goals.append((RunExperiment.Goal(experiment_file=path, resume=bool(args.resume),
+        goals.append((RunExperiment.Goal(experiment_file=path, resume=bool(args.resume or cut),
                                          output_dir=output), file.part.mesh_path, given,
                       args.adaptive or file.sampling.adaptive))
     return goals
