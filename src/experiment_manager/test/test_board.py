@@ -380,8 +380,9 @@ def test_a_board_run_again_keeps_the_parts_done_with_the_same_file_and_writes_it
 
 def test_a_part_an_earlier_board_run_left_interrupted_resumes_in_its_run_directory(tmp_path):
     """A board run cut in a part's run: the board run again resumes that run directory (the
-    newest of the part's file that holds iterations and no summary), losing at most the
-    iteration in flight, where it ran the part anew."""
+    newest of the part's file that holds iterations; its summary.json, written after each
+    experiment, says nothing), losing at most the iterations in flight, where it ran the part
+    anew."""
     import argparse
 
     from experiment_manager.commands import run
@@ -395,13 +396,13 @@ def test_a_part_an_earlier_board_run_left_interrupted_resumes_in_its_run_directo
         return next(g for g, _, given, _ in run._goals(args, temporary)
                     if RESISTOR.replace('.', '_') in given)
 
-    def run_dir(name: str, text: bytes, finished: bool = False):
+    def run_dir(name: str, text: bytes, iterations: bool = True):
         d = out / name
         d.mkdir()
         (d / 'experiment.yaml').write_bytes(text)
-        (d / 'iterations.csv').write_text('experiment,group,iteration\n')
-        if finished:
-            (d / 'summary.json').write_text('{}')
+        (d / 'summary.json').write_text('{}')      # as after the run's first experiment
+        if iterations:
+            (d / 'iterations.csv').write_text('experiment,group,iteration\n')
         return d
 
     temporary = []
@@ -411,7 +412,7 @@ def test_a_part_an_earlier_board_run_left_interrupted_resumes_in_its_run_directo
         text = f.read()
     file_id = yaml.safe_load(text)['id']
     cut = run_dir(f'{file_id}_20261130-010000', text)
-    run_dir(f'{file_id}_20261130-020000', text, finished=True)        # newer, finished
+    run_dir(f'{file_id}_20261130-020000', text, iterations=False)     # newer, no iteration
     run_dir(f'{file_id}_20261130-030000', text + b'# changed\n')      # newer, another file
     run_dir(f'other_{file_id}_20261130-040000', text)                  # another part's id
     again = goals()

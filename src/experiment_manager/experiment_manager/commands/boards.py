@@ -136,9 +136,11 @@ def expand_boards(files: list[str], args: argparse.Namespace,
 
 def interrupted(directory: str, file_id: str, path: str) -> str | None:
     """The newest run directory in `directory` of the file at `path` (id `file_id`: a board's
-    part, as it is to run) that was interrupted: it holds iterations.csv and no summary.json,
-    and its experiment.yaml is the file's text to the byte (a run resumes only the file it
-    ran). None when there is none: the part runs anew."""
+    part not decided before, as it is to run): it holds iterations.csv, and its
+    experiment.yaml is the file's text to the byte (a run resumes only the file it ran). Its
+    summary.json says nothing here: a run rewrites it after each experiment, so an interrupted
+    one has it too; and resuming a run that had finished only summarises it again. None when
+    there is none: the part runs anew."""
     with open(path, 'rb') as f:
         text = f.read()
     try:
@@ -148,8 +150,7 @@ def interrupted(directory: str, file_id: str, path: str) -> str | None:
     for name in names:
         run_dir = os.path.join(directory, name)
         if not name.startswith(f'{file_id}_') or not os.path.isfile(
-                os.path.join(run_dir, 'iterations.csv')) or os.path.exists(
-                os.path.join(run_dir, 'summary.json')):
+                os.path.join(run_dir, 'iterations.csv')):
             continue
         try:
             with open(os.path.join(run_dir, 'experiment.yaml'), 'rb') as f:
