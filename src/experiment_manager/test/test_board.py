@@ -356,26 +356,46 @@ def test_a_board_run_again_keeps_the_parts_done_with_the_same_file_and_writes_it
     assert len(first) == 4                     # the four parts with a STEP model
     assert set(boards[0].read) == set(first)   # as settle read them: run reads them no more
     part = next(p for p in first if RESISTOR.replace('.', '_') in p)
-    run_dir = tmp_path / 'out' / 'resistor_run'
-    run_dir.mkdir()
-    (run_dir / 'summary.json').write_text('{}')   # a finished run of the part, as run leaves it
-    decided(boards, part, [('vibrating table', 'FEASIBLE', 'all emptied')], str(run_dir))
+    run_dir = _a_run(tmp_path / 'out' / 'resistor_run')     # a finished run, real records
+    decided(boards, part, [('vibrating table', 'FEASIBLE', 'all emptied')], run_dir)
     page = (tmp_path / 'out' / 'ecc83_board.md').read_text()
     assert '| R_Axial_DIN0207_L6.3mm_D2.5mm_P7.62mm_Horizontal | 4 | R1 R2 R3 R4 | ' \
            '**FEASIBLE** | vibrating table |' in page
     assert '](resistor_run/part.png)' in page and '## Not decided' in page
     assert (tmp_path / 'out' / 'ecc83_board.html').is_file()
-    # the same board again: the resistor is kept, the other three run
+    # the same board again: the resistor is kept, the other three run; its options are
+    # decided again from its run's records by today's rules, not copied from the answer
     again = []
     second = expand_boards([path], args, again)
     assert part not in second and len(second) == 3
-    assert again[0].decided[RESISTOR] == [('vibrating table', 'FEASIBLE', 'all emptied')]
+    kept = {option: (verdict, why) for option, verdict, why in again[0].decided[RESISTOR]}
+    assert kept['vibrating table'][0] == 'NOT FEASIBLE' and 'fewer than' in kept[
+        'vibrating table'][1]
+    # a run directory that no longer reads: the part runs again
+    os.remove(os.path.join(run_dir, 'iterations.csv'))
+    assert part in expand_boards([path], args, [])
     # a changed file (another mass) runs the part again
     changed = _board_file(tmp_path, parts={RESISTOR: {'mass_g': 0.2}})
     assert any(RESISTOR.replace('.', '_') in p for p in expand_boards([changed], args, []))
     data = json.loads((tmp_path / 'out' / 'ecc83_board.json').read_text())
     assert {p['status'] for p in data['parts']} >= {'refused', 'not through-hole'}
     _valid_against_the_published_schema(data)
+
+
+def _a_run(directory) -> str:
+    """A finished run directory of a small file (2 feeder runs of 12 parts, each ended at
+    its one vibration: the table NOT FEASIBLE, 12 parts fewer than a refill)."""
+    from experiment_manager.analysis.results import ResultsWriter
+    from experiment_manager.running.local_backend import LocalBackend
+    from experiment_manager.running.scheduler import Runner
+    text = ('id: kept\nseed: 3\npart: {model: radial_capacitor}\n'
+            'gripper: {body_diameter_mm: 8, jaw_depth_mm: 3}\nexperiments:\n'
+            '  - {id: feeder, type: feeder_emptying, iterations: 2, parts: 12, '
+            'optimal_range: [4, 8], max_vibrations: 1}\n')
+    file = experiment_file.parse(text, str(directory) + '.yaml')
+    with LocalBackend() as backend, ResultsWriter(str(directory), file.text) as sink:
+        Runner(file, [backend], sink).run()
+    return str(directory)
 
 
 def test_a_part_an_earlier_board_run_left_interrupted_resumes_in_its_run_directory(tmp_path):

@@ -12,7 +12,10 @@ import sys
 from pick_common.errors import InvalidArgument
 import yaml
 
+from ..analysis.redecide import redecide
 from ..analysis.report.board import write_board_page
+from ..analysis.summary import Summary
+from ..analysis.verdicts import verdicts
 from ..experiment_file.board import (
     answer,
     Board,
@@ -114,9 +117,10 @@ def expand_boards(files: list[str], args: argparse.Namespace,
                 run.shas[name] = hashlib.sha256(f.read()).hexdigest()
             run.left[name] = dropped
             before = done.get(name)
-            if before is not None and before['file_sha256'] == run.shas[name]:
-                run.decided[name] = [(o['option'], o['verdict'], o['reason'])
-                                     for o in before['options']]
+            kept = (options_of(before['run']) if before is not None
+                    and before['file_sha256'] == run.shas[name] else None)
+            if kept is not None:
+                run.decided[name] = kept
                 run.runs[name] = before['run']
                 run.said[name] = f'done before: {before["run"]}'
                 continue
@@ -132,6 +136,23 @@ def expand_boards(files: list[str], args: argparse.Namespace,
                                   'table above says why of each)')
         boards.append(run)
     return out
+
+
+def options(summary: Summary) -> list[tuple[str, str, str]]:
+    """A part's options from its run's summary, as the board's answer lists them: (option,
+    verdict, the first reason)."""
+    return [(v.kind, v.verdict, v.reasons[0]) for v in verdicts(summary)]
+
+
+def options_of(run_dir: str) -> list[tuple[str, str, str]] | None:
+    """A part decided before: its options as today's decisions give them from its run
+    directory's records (redecide), so that a board run again after an update answers by
+    today's rules, not by those its parts ran under; None when the directory no longer
+    reads (the part runs again)."""
+    try:
+        return options(redecide(run_dir))
+    except (InvalidArgument, ValueError, OSError):
+        return None
 
 
 def interrupted(directory: str, file_id: str, path: str) -> str | None:

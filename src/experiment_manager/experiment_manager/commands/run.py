@@ -46,9 +46,16 @@ from .. import experiment_file
 from ..analysis import summary as summary_model
 from ..analysis import wording
 from ..analysis.headlines import headlines
-from ..analysis.verdicts import verdicts
 from . import interrupt
-from .boards import board_file, BoardRun, cell_file, decided, expand_boards, interrupted
+from .boards import (
+    board_file,
+    BoardRun,
+    cell_file,
+    decided,
+    expand_boards,
+    interrupted,
+    options,
+)
 from .claim import claim, NamespaceInUse
 from .supervisor import Graph, report_dead, spin_until, start_graph
 
@@ -342,7 +349,7 @@ def _run(node: Node, client: LockedActionClient, goal, given: str, graph: Graph,
         print(f'report:    {result.report_path}')
     summary = summary_model.validate(summary_model.migrate(json.loads(result.summary_json)))
     print('\n'.join(headlines(summary)))
-    decided(boards, given, [(v.kind, v.verdict, v.reasons[0]) for v in verdicts(summary)],
+    decided(boards, given, options(summary),
             result.results_path)
     # the manager's decisions in one table, each with the stage that stops most parts and
     # its first reason (the report gives them all)
