@@ -305,13 +305,19 @@ def test_the_built_in_cell_leaves_out_for_a_part_what_cannot_run_and_says_why(tm
     assert 'left out for this part' in open(files['Altech_AK300_1x02_P5.00mm_45-Degree']).read()
     # its run's verdicts: the bin its refill does not fit was not analysed, so it reads as
     # left out (with why below the table), not as a verdict
+    # a gripper left out for a part (the disc's cup) has no option in its run: out too
     lines = answer(board, {}, {'Altech_AK300_1x02_P5.00mm_45-Degree': [
         ('static bin', 'not analysed', 'no bin_emptying experiment in the file'),
         ('vibrating table', 'FEASIBLE', 'ok'), ('vibrating table, gripper cup', 'UNDECIDED',
-                                                'runs straddle')]},
-        {'Altech_AK300_1x02_P5.00mm_45-Degree': left})
+                                                'runs straddle')],
+        'C_Disc_D4.7mm_W2.5mm_P5.00mm': [('static bin', 'NOT FEASIBLE', '0 of 5'),
+                                         ('vibrating table', 'NOT FEASIBLE', '5 of 5')]},
+        {'Altech_AK300_1x02_P5.00mm_45-Degree': left,
+         'C_Disc_D4.7mm_W2.5mm_P5.00mm': {'gripper cup': 'no flat patch'}})
     row = next(line for line in lines if line.startswith('  Altech'))
     assert row.split()[-4:] == ['out', 'yes', '?', '[2]']          # the best: the first feasible
+    disc = next(line for line in lines if line.startswith('  C_Disc'))
+    assert disc.split()[-4:] == ['no', 'no', 'out', 'none']
     assert any('emptying left out: ' in line for line in lines)
     assert any('[3] UNDECIDED: runs straddle' in line for line in lines)
     assert not any('not analysed' in line for line in lines[1:])
@@ -503,9 +509,16 @@ def test_the_board_page_says_an_option_left_out_for_a_part_and_why():
                          'reason': 'no bin_emptying experiment in the file'},
                         {'option': 'vibrating table', 'verdict': 'UNDECIDED',
                          'reason': 'runs straddle'}]}
-    page = board_markdown({'board': 'b.kicad_pcb', 'boards_per_hour': 60, 'parts': [part]},
-                          '.')
-    assert '| TB | 4 | J1 | **left out** | **UNDECIDED** | none |' in page
+    # a second part whose cup was left out: its run has no cup option at all
+    disc = {**part, 'name': 'C', 'references': ['C2'], 'left_out': {'gripper cup': 'no patch'},
+            'options': [{'option': 'vibrating table', 'verdict': 'NOT FEASIBLE',
+                         'reason': '5 of 5'}]}
+    tb = {**part, 'options': part['options'] + [
+        {'option': 'vibrating table, gripper cup', 'verdict': 'FEASIBLE', 'reason': 'ok'}]}
+    page = board_markdown({'board': 'b.kicad_pcb', 'boards_per_hour': 60,
+                           'parts': [tb, disc]}, '.')
+    assert '| TB | 4 | J1 | **left out** | **UNDECIDED** | **FEASIBLE** | none |' in page
+    assert '| C | 4 | C2 | - | **NOT FEASIBLE** | left out | none |' in page
     assert '- static bin: **left out** (below)' in page
     assert '- emptying left out: 960 parts do not fit the bin' in page
     assert 'not analysed' not in page and 'no bin_emptying' not in page

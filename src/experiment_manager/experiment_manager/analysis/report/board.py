@@ -4,7 +4,7 @@ part.png of its run) beside what decided each option, and the parts not decided 
 
 import os
 
-from ...experiment_file.board import shown
+from ...experiment_file.board import absent, shown
 from .page import to_html
 
 
@@ -25,7 +25,8 @@ def board_markdown(record: dict, directory: str) -> str:
             got = {o['option']: shown(o['verdict'], p['left_out']) for o in p['options']}
             lines.append(f"| {p['name']} | {p['quantity']} | "
                          f"{' '.join(p['references'])} | "
-                         + ' | '.join(f'**{got[o]}**' if o in got else '-' for o in options)
+                         + ' | '.join(f'**{got[o]}**' if o in got
+                                      else absent(o, p['left_out']) or '-' for o in options)
                          + f" | {p['best'] or 'none'} |")
         lines.append('')
     for p in parts:

@@ -320,6 +320,12 @@ SHORT = {'FEASIBLE': 'yes', 'NOT FEASIBLE': 'no', 'UNDECIDED': '?', 'not analyse
          'left out': 'out'}
 
 
+def absent(option: str, left_out: Mapping[str, str]) -> str:
+    """An option a part's run does not list: 'left out' when it is of a gripper left out for
+    the part (`left_out`, settle's: none of that gripper's experiments ran), else ''."""
+    return 'left out' if any(g in option for g in left_out) else ''
+
+
 def shown(verdict: str, left_out: Mapping[str, str]) -> str:
     """An option's verdict as the board says it: an option a part's run did not analyse
     because its experiment was left out for the part (`left_out`, settle's) is 'left out'."""
@@ -343,7 +349,8 @@ def answer(board: Board, said: Mapping[str, str],
     for p in board.parts:
         gone = (left or {}).get(p.name, {})
         got = {o: (shown(v, gone), why) for o, v, why in decided.get(p.name, [])}
-        cells = [SHORT.get(got[o][0], got[o][0]) if o in got else '' for o in options]
+        cells = [SHORT.get(got[o][0], got[o][0]) if o in got else
+                 SHORT.get(absent(o, gone), '') if p.name in decided else '' for o in options]
         best = next((f'[{i + 1}]' for i, o in enumerate(options)
                      if got.get(o, ('',))[0] == 'FEASIBLE'), '')
         if p.name not in decided:
