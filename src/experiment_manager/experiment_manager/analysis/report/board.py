@@ -4,7 +4,7 @@ part.png of its run) beside what decided each option, and the parts not decided 
 
 import os
 
-from ...experiment_file.board import absent, shown
+from ...experiment_file.board.answer import absent, shown
 from .page import to_html
 
 
