@@ -8,6 +8,7 @@ from experiment_manager.experiment_file.model import Cell
 import numpy as np
 from pick_common.stats import binomial_bounds
 import pytest
+from scipy import stats
 
 
 def test_the_gumbel_fit_finds_the_location_and_scale_it_was_drawn_with():
@@ -97,6 +98,26 @@ def test_runs_the_vibration_limit_ended_early_in_the_interval_are_censored():
     limited = decisions.table_time(five, 14400.0, 0.9)
     assert limited.verdict == decisions.UNDECIDED and limited.detail['over'] == 0
     assert 'a run the vibration limit ended' in limited.reason and 'gumbel' not in limited.detail
+    # the pace: 45 picks in 48 min of cell time, at most 79 an hour (95 %, Poisson), at which
+    # a refill of 80 empties within 4 h: it cannot be NOT FEASIBLE on it either
+    assert limited.detail['pace']['picks'] == 45
+    assert limited.detail['pace']['upper_per_h'] == pytest.approx(
+        stats.chi2.ppf(0.95, 92) / 2 / (5 * runs[0]['busy']) * 3600)
+    assert limited.detail['pace']['emptied_share_at_most'] > 0.99
+    # the terminal block's jaws: no pick in 5 runs of 9.4 min; at most 3.8 picks an hour, and
+    # at that pace no refill of 80 empties within 4 h: NOT FEASIBLE on the pace
+    none = decisions.feeder_runs([{**cut, 'picks': 0, 'table_time': 520.0}] * 5, cell)
+    stuck = decisions.table_time(none, 14400.0, 0.9)
+    assert stuck.verdict == decisions.NOT_FEASIBLE and stuck.detail['over'] == 0
+    assert stuck.detail['pace']['emptied_share_at_most'] < 1e-6
+    assert 'the pace: 0 picks in ' in stuck.reason
+    # one such run of 8.7 min says so too: at most 20.7 an hour, 83 in 4 h, which would empty
+    # a refill of 80 at most 64 % of the time; a run of 2 min is too short to: at most 90
+    one = decisions.table_time(none[:1], 14400.0, 0.9)
+    assert one.verdict == decisions.NOT_FEASIBLE
+    assert one.detail['pace']['emptied_share_at_most'] == pytest.approx(0.642, abs=1e-3)
+    short = decisions.feeder_runs([{**cut, 'picks': 0, 'table_time': 120.0}], cell)
+    assert decisions.table_time(short, 14400.0, 0.9).verdict == decisions.UNDECIDED
     # beside 29 runs that emptied within it, one censored run keeps FEASIBLE out of reach
     # (1 of 30 counted over: at most 14.8 %), and would not with it counted within
     quick = decisions.feeder_runs([{**row, 'emptied': True}] * 29, cell)

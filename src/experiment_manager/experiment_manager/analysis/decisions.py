@@ -38,6 +38,17 @@ confidence (`table_time`):
   over) is below 1 - success_rate (with none over, 29 runs at 90 %), NOT FEASIBLE when its
   lower bound (censored runs counted within) is above it. Used alone when the fitted bound
   cannot be (a run over the interval or censored, or the fit rejected).
+- the pace, beside it when no run emptied within the interval and the limit ended one
+  (`pace`): the runs' picks over their cell time as a Poisson count, its one-sided upper
+  bound at `confidence` (Garwood 1936: chi-square with 2 picks + 2 degrees of freedom, over
+  2 x the time), and at that rate the chance that a refill's parts are all picked within the
+  interval (a Poisson count reaching them). NOT FEASIBLE when even that chance is below
+  success_rate; it never makes the table FEASIBLE. It rests on picks coming no faster later
+  in a run than in the part the runs saw: the table holds its load from the feeder while
+  the feeder has parts, and fewer parts on it later pick no faster (the coupon collector's
+  tail). A table that picks nothing in its runs to the limit is NOT FEASIBLE on it when that
+  time is long enough against the interval, as the paper's stop rule read it; one that picks
+  at a pace that could empty the refill stays UNDECIDED.
   Where this rests on an assumption: the fitted bound takes a run that would not empty as the
   Gumbel's own far tail. A feeder that jams now and then for a reason of its own (a part
   that wedges) is a second mode the fit cannot see in 3 runs that emptied; only the
@@ -61,6 +72,7 @@ import math
 from feeder_controller.policy import NAMES, STOP_VIBRATION_LIMIT
 import numpy as np
 from pick_common.stats import binomial_bounds
+from scipy import stats as scipy_stats
 
 FEASIBLE, NOT_FEASIBLE, UNDECIDED = 'FEASIBLE', 'NOT FEASIBLE', 'UNDECIDED'
 CONFIDENCE = 0.95
@@ -184,12 +196,19 @@ def table_time(runs: list[dict], refill: float, coverage: float,
     b_high = binomial_bounds(over + len(cut), n, confidence)[1]
     free = (f'{over} of {n} runs over the interval or not emptied: their share at most '
             f'{_pc(b_high)} ({_one_sided(confidence)}, distribution-free), allowed '
-            f'{_pc(1 - coverage)}' + _limited(cut, refill))
+            f'{_pc(1 - coverage)}')
     free_verdict = (FEASIBLE if b_high < 1 - coverage else
                     NOT_FEASIBLE if b_low > 1 - coverage else UNDECIDED)
     detail = {'over': over, 'censored': len(cut), 'refill_s': refill, 'coverage': coverage,
               'times_s': [t if math.isfinite(t) else None for t in times.tolist()],
               'distribution_free': {'verdict': free_verdict, 'share_bounds': [b_low, b_high]}}
+    paced = bool(cut) and not (times <= refill).any()
+    free += _limited(cut, refill, said_pace=not paced)
+    if paced:
+        detail['pace'] = pace(runs, refill, confidence)
+        if free_verdict == UNDECIDED and detail['pace']['emptied_share_at_most'] < coverage:
+            free_verdict = detail['distribution_free']['verdict'] = NOT_FEASIBLE
+        free += _paced(detail['pace'], coverage, confidence)
     fit = _gumbel(times, coverage, confidence) if over == 0 and not cut and n >= 3 else None
     if fit is not None:
         detail['gumbel'] = fit
@@ -213,20 +232,41 @@ def table_time(runs: list[dict], refill: float, coverage: float,
                     f'{free} ({why})', detail)
 
 
+def pace(runs: list[dict], refill: float, confidence: float = CONFIDENCE) -> dict:
+    """The runs' picks over their cell time (feeder_runs' `picks`, `busy`), s: the upper
+    bound of that rate at `confidence` (Garwood's exact Poisson bound) and, at it, the chance
+    that the refill's parts (the runs' `parts`) are all picked within `refill`, s."""
+    picks = int(sum(r['picks'] for r in runs))
+    busy = float(sum(r['busy'] for r in runs))
+    upper = scipy_stats.chi2.ppf(confidence, 2 * picks + 2) / 2.0 / busy     # per s
+    parts = max((r['parts'] or 0) for r in runs)
+    share = float(scipy_stats.poisson.sf(parts - 1, upper * refill)) if parts else 1.0
+    return {'picks': picks, 'cell_h': busy / 3600.0, 'upper_per_h': float(upper * 3600.0),
+            'parts': parts, 'emptied_share_at_most': share}
+
+
+def _paced(p: dict, coverage: float, confidence: float) -> str:
+    return (f'; the pace: {p["picks"]} picks in {p["cell_h"] * 60:.1f} min of cell time, at '
+            f'most {p["upper_per_h"]:.3g} an hour ({_one_sided(confidence)}, Poisson), at '
+            f'which at most {_pc(p["emptied_share_at_most"])} of refills of {p["parts"]} '
+            f'would empty within the interval, required {_pc(coverage)}')
+
+
 def censored(runs: list[dict], refill: float) -> list[dict]:
     """The runs (feeder_runs) that the vibration limit ended with parts left before the refill
     interval, `refill`, s, was spent: neither within the interval nor over it."""
     return [r for r in runs if r.get('limited') and r['busy'] <= refill]
 
 
-def _limited(cut: list[dict], refill: float) -> str:
+def _limited(cut: list[dict], refill: float, said_pace: bool = True) -> str:
     """Said of the censored runs (`censored`): how far into the interval the limit ended them,
-    and the pace they picked at against the pace that empties a refill within it."""
+    and (`said_pace`, where `pace` does not bound it) the pace they picked at against the pace
+    that empties a refill within it."""
     if not cut:
         return ''
     busy = sum(r['busy'] for r in cut)
     pace = (f': they picked {3600.0 * sum(r["picks"] for r in cut) / busy:.3g} parts an hour'
-            if busy > 0 else '')
+            if busy > 0 and said_pace else '')
     parts = cut[0]['parts']
     if pace and parts:
         pace += f' against the {3600.0 * parts / refill:.3g} that empty a refill of {parts} in it'

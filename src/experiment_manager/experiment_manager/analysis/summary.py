@@ -36,6 +36,16 @@ class GumbelFit(_Record):
     estimate: float
 
 
+class PaceBound(_Record):
+    """The feeder runs' pace when none emptied within the interval (decisions.pace)."""
+    picks: int
+    cell_h: float
+    upper_per_h: float = Field(description='one-sided upper bound of picks per hour, Poisson')
+    parts: int = Field(description="a refill's parts")
+    emptied_share_at_most: float = Field(description='of refills, within the interval, at '
+                                         'that pace')
+
+
 class FreeBound(_Record):
     verdict: VERDICT
     share_bounds: list[float]   # of the share of runs over the interval, one-sided
@@ -62,6 +72,7 @@ class Decision(_Record):
     coverage: float | None = None
     times_s: list[float | None] | None = None
     distribution_free: FreeBound | None = None
+    pace: PaceBound | None = None
     gumbel: GumbelFit | None = None
 
 
