@@ -202,7 +202,7 @@ def table_time(runs: list[dict], refill: float, coverage: float,
     detail = {'over': over, 'censored': len(cut), 'refill_s': refill, 'coverage': coverage,
               'times_s': [t if math.isfinite(t) else None for t in times.tolist()],
               'distribution_free': {'verdict': free_verdict, 'share_bounds': [b_low, b_high]}}
-    paced = bool(cut) and not (times <= refill).any()
+    paced = bool(cut) and not (times <= refill).any() and sum(r['busy'] for r in runs) > 0
     free += _limited(cut, refill, said_pace=not paced)
     if paced:
         detail['pace'] = pace(runs, refill, confidence)
@@ -233,7 +233,7 @@ def table_time(runs: list[dict], refill: float, coverage: float,
 
 
 def pace(runs: list[dict], refill: float, confidence: float = CONFIDENCE) -> dict:
-    """The runs' picks over their cell time (feeder_runs' `picks`, `busy`), s: the upper
+    """The runs' picks over their cell time (feeder_runs' `picks`, `busy`, s; some): the upper
     bound of that rate at `confidence` (Garwood's exact Poisson bound) and, at it, the chance
     that the refill's parts (the runs' `parts`) are all picked within `refill`, s."""
     picks = int(sum(r['picks'] for r in runs))
