@@ -234,8 +234,9 @@ def table_time(runs: list[dict], refill: float, coverage: float,
 
 def pace(runs: list[dict], refill: float, confidence: float = CONFIDENCE) -> dict:
     """The runs' picks over their cell time (feeder_runs' `picks`, `busy`, s; some time in
-    all): the upper bound of that rate at `confidence` (Garwood's exact Poisson bound) and, at it, the chance
-    that the refill's parts (the runs' `parts`) are all picked within `refill`, s."""
+    all): the upper bound of that rate at `confidence` (Garwood's exact Poisson bound) and,
+    at it, the chance that the refill's parts (the runs' `parts`) are all picked within
+    `refill`, s."""
     picks = int(sum(r['picks'] for r in runs))
     busy = float(sum(r['busy'] for r in runs))
     upper = scipy_stats.chi2.ppf(confidence, 2 * picks + 2) / 2.0 / busy     # per s
