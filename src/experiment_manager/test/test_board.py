@@ -323,7 +323,7 @@ def test_the_built_in_cell_leaves_out_for_a_part_what_cannot_run_and_says_why(tm
     assert not any('not analysed' in line for line in lines[1:])
 
 
-# Datasheet weights of three families, each of a part as supplied, with its leads' count,
+# Datasheet weights of five families, each of a part as supplied, with its leads' count,
 # least length and diameter (mm) from the same datasheet: KiCad's model has its leads formed
 # and cut to the board, so the comparison is the model's body and the datasheet's leads, of
 # the leads' density (pick_common/parts/solids.py).
@@ -334,6 +334,16 @@ DATASHEETS = [
     # Diodes Inc. 1N4001-1N4007 (DS28002): DO-41 "0.30 grams (approx)", leads 25.40 mm min,
     # 0.71 to 0.864 mm (https://dtsheet.com/doc/260565/diodes-1n4006)
     ('Diode_THT.3dshapes/D_DO-41_SOD81_P12.70mm_Horizontal.step', 0.30, 2, 25.4, 0.787),
+    # Diodes Inc. PR1501-PR1505 (DS26011 Rev. 4-2): DO-15 "Weight: 0.4 grams (approximate)",
+    # leads 25.40 mm min, 0.686 to 0.889 mm
+    # (https://azmanual.top/manuals/305176/diodes-pr1501_s-pr1505_s.html)
+    ('Diode_THT.3dshapes/D_DO-15_P10.16mm_Horizontal.step', 0.4, 2, 25.4, 0.788),
+    # Comchip 1N5400-G thru 1N5408-G (QW-BG015): DO-201AD "Weight: 1.2 grams", leads 25.40
+    # mm min, 1.22 to 1.32 mm (https://dtsheet.com/doc/1434594/qw-bg015-1n5400-g-thru.-1n5408);
+    # Synsemi's 1N5400-08 give 0.929 g (https://dtsheet.com/doc/712847/synsemi-1n5408),
+    # Diodes Inc.'s 1N5400G-08G 1.12 g (https://pdf.datasheet.world/d7ab8e14/diodes.com/
+    # 1N5404G-T.txt): the model's 0.936 g lies within 30 % of each
+    ('Diode_THT.3dshapes/D_DO-201AD_P15.24mm_Horizontal.step', 1.2, 2, 25.4, 1.27),
     # Vishay 2N3904 (document 88113): TO-92 "Weight: approx. 0.18g", leads 12.5 mm min,
     # 0.55 mm max (https://dtsheet.com/doc/433575/etc-2n3904-e6)
     ('Package_TO_SOT_THT.3dshapes/TO-92.step', 0.18, 3, 12.5, 0.55),
