@@ -23,7 +23,7 @@ What settles each decision, looked at after every batch:
   at or above 1 - success_rate even if every iteration left emptied within it, so more runs
   cannot make the table FEASIBLE (a stop for futility: Snapinn et al., "Assessment of
   futility in clinical trials", Pharmaceutical Statistics 5(4), 2006). Its verdict is what the
-  runs made say: UNDECIDED, with the limit named and the pace the censored runs picked at, or
+  runs so far say: UNDECIDED, with the limit named and the pace the censored runs picked at, or
   NOT FEASIBLE. Without it a feeder whose runs all reach the limit would run every iteration
   (30 in the board cell) to it, where the paper's reading, not emptied, settled it in one
   batch. An iteration left
@@ -141,11 +141,11 @@ def _feeder_unsettled(file: ExperimentFile, exp: FeederEmptyingExperiment, kept:
                       checks: list[dict]) -> tuple[list[int], list[int]]:
     grounds = metrics.table_grounds(file.ran, kept, INTERIM_CONFIDENCE)
     settled = (decisions.combined([g.verdict for g in grounds.values()]) != decisions.UNDECIDED
-               or out_of_reach(grounds['time'], exp.iterations, file.requirements.success_rate))
+               or _out_of_reach(grounds['time'], exp.iterations, file.requirements.success_rate))
     return ([] if settled else groups(exp)), []
 
 
-def out_of_reach(time: decisions.Decision, iterations: int, required: float) -> bool:
+def _out_of_reach(time: decisions.Decision, iterations: int, required: float) -> bool:
     """The table's time ground (decisions.table_time) holds a censored run and cannot be
     FEASIBLE at `iterations` runs even if every one left emptied within the interval: its
     last look's upper bound of the share over, censored runs counted over, reaches
