@@ -72,7 +72,7 @@ def record(board: 'Board', said: Mapping[str, str],
            runs: Mapping[str, str] | None = None,
            shas: Mapping[str, str] | None = None) -> dict:
     """The board's answer as data (`<output>/<board id>_board.json`, its model and schema in
-    `record`): per distinct part its model, references, quantity, status with its reason,
+    `board_json`): per distinct part its model, references, quantity, status with its reason,
     its mass's account, what was left out for it and why, its run directory, the SHA-256 of
     the experiment file it ran (a board run again keeps a part done only when its file is the
     same), and its options' verdicts with the first reason and the best option (`answer`'s
