@@ -108,14 +108,21 @@ def feeder_runs(rows: list[dict], cell) -> list[dict]:
     max_vibrations) with parts left."""
     out = []
     for r in rows:
-        busy = (r['picks'] * cell.pick_time + r['checks'] * cell.image_time + r['table_time']
-                + r.get('regrasps', 0) * cell.regrasp_time)
+        busy = cell_time(r, cell)
         out.append({'time': busy if r['emptied'] else math.inf, 'spilled': r['spilled'],
                     'emptied': bool(r['emptied']), 'busy': busy, 'picks': r['picks'],
                     'parts': r.get('parts'),
                     'limited': not r['emptied']
                     and r.get('stop') == NAMES[STOP_VIBRATION_LIMIT]})
     return out
+
+
+def cell_time(row: dict, cell) -> float:
+    """The cell's time a feeder run took, s: its picks (`cell.pick_time` each), its checks (an
+    image of `cell.image_time` each), its regrasps (`cell.regrasp_time` each) and the table's
+    feeds and vibrations until the parts rested (simulated, `table_time`)."""
+    return (row['picks'] * cell.pick_time + row['checks'] * cell.image_time + row['table_time']
+            + row.get('regrasps', 0) * cell.regrasp_time)
 
 
 def iterations_to_decide(successes: int, n: int, required: float, most: int = 10_000

@@ -254,12 +254,9 @@ def throughputs(cell, rows: list[dict]) -> list[float]:
 
 
 def cell_throughput(cell, row: dict) -> float:
-    """The parts per hour a feeder run's cell would pick: its picks over the time they take
-    (each pick `cell.pick_time`, each check an image of `cell.image_time`) plus the time the
-    table's feeds and vibrations took until the parts rested (simulated, `table_time`)."""
-    busy = (row['picks'] * cell.pick_time + row['checks'] * cell.image_time
-            + row['table_time'] + row.get('regrasps', 0) * cell.regrasp_time)
-    return 3600.0 * row['picks'] / busy
+    """The parts per hour a feeder run's cell would pick: its picks over the cell's time the
+    run took (decisions.cell_time)."""
+    return 3600.0 * row['picks'] / decisions.cell_time(row, cell)
 
 
 def gripper_sweep(exp: GripperSweepExperiment, rows: list[dict], checks: list[dict],
