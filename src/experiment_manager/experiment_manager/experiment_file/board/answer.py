@@ -17,8 +17,11 @@ SHORT = {'FEASIBLE': 'yes', 'NOT FEASIBLE': 'no', 'UNDECIDED': '?', 'not analyse
 
 def absent(option: str, left_out: Mapping[str, str]) -> str:
     """An option a part's run does not list: 'left out' when it is of a gripper left out for
-    the part (`left_out`, settle's: none of that gripper's experiments ran), else ''."""
-    return 'left out' if any(g in option for g in left_out) else ''
+    the part (`left_out`, settle's, a key 'gripper <name>': none of that gripper's experiments
+    ran; an option of it ends ', gripper <name>'), else ''. A left-out experiment's id is no
+    gripper, whatever option's name it happens to be part of."""
+    return 'left out' if any(g.startswith('gripper ') and option.endswith(f', {g}')
+                             for g in left_out) else ''
 
 
 def shown(verdict: str, left_out: Mapping[str, str]) -> str:
