@@ -79,7 +79,7 @@ def test_runs_the_vibration_limit_ended_early_in_the_interval_are_censored():
     # limit made the table NOT FEASIBLE, not the interval
     cell = Cell()
     row = {'picks': 9, 'checks': 509, 'table_time': 538.7, 'regrasps': 0, 'spilled': 0,
-           'parts': 80}
+           'parts': 80, 'vibrations': 500}
     cut = {**row, 'emptied': False, 'stop': 'stop: vibration limit'}
     runs = decisions.feeder_runs([cut, {**cut, 'table_time': 20000.0},
                                   {**row, 'emptied': True, 'stop': 'stop: empty'}], cell)
@@ -91,6 +91,11 @@ def test_runs_the_vibration_limit_ended_early_in_the_interval_are_censored():
     assert 'not counted: 1 run(s) stopped at the vibration limit (max_vibrations) with parts ' \
         'left, 9.6 min or less into the 240.0 min interval: they picked 56.4 parts an hour ' \
         'against the 20 that empty a refill of 80 in it' in said.reason
+    # and the limit that would have let it reach the interval: 500 vibrations in its 575 s,
+    # 12,521 in 240 min, rounded up to a hundred
+    reach = 100 * math.ceil(500 * 14400.0 / runs[0]['busy'] / 100)
+    assert reach == 12600
+    assert f'a max_vibrations of {reach} would let each run reach the interval' in said.reason
     assert 'vibration limit' not in decisions.table_time(runs[1:], 14400.0, 0.9).reason
     # five such runs: NOT FEASIBLE as "not emptied", UNDECIDED as censored (counted over, the
     # share is at most 100 %; counted within, at least 0 %); no Gumbel fit either way

@@ -104,14 +104,14 @@ def feeder_runs(rows: list[dict], cell) -> list[dict]:
     """Per feeder run (rows of iterations.csv, typed, of feeder_emptying): `time`, the cell's
     time to empty the feeder, s (inf for a run that did not empty), `spilled`, `busy`, the
     cell's time the run took, s, emptied or not, `picks`, `parts` (its refill; None in rows
-    without it), and `limited`: it ended at the vibration limit (the experiment's
-    max_vibrations) with parts left."""
+    without it), `vibrations` (None in rows without it), and `limited`: it ended at the
+    vibration limit (the experiment's max_vibrations) with parts left."""
     out = []
     for r in rows:
         busy = cell_time(r, cell)
         out.append({'time': busy if r['emptied'] else math.inf, 'spilled': r['spilled'],
                     'emptied': bool(r['emptied']), 'busy': busy, 'picks': r['picks'],
-                    'parts': r.get('parts'),
+                    'parts': r.get('parts'), 'vibrations': r.get('vibrations'),
                     'limited': not r['emptied']
                     and r.get('stop') == NAMES[STOP_VIBRATION_LIMIT]})
     return out
@@ -281,7 +281,21 @@ def _limited(cut: list[dict], refill: float, said_pace: bool = True) -> str:
     return (f'; not counted: {len(cut)} run(s) stopped at the vibration limit '
             f'(max_vibrations) with parts left, {_min(max(r["busy"] for r in cut))} or less '
             f'into the {_min(refill)} interval{pace}; the limit ended them, not the interval, '
-            'so they count as over it for FEASIBLE and as within it for NOT FEASIBLE')
+            'so they count as over it for FEASIBLE and as within it for NOT FEASIBLE'
+            + _reaching(cut, refill))
+
+
+def _reaching(cut: list[dict], refill: float) -> str:
+    """The max_vibrations at which the censored runs (`censored`) would have reached the
+    interval, `refill`, s, at the vibrations per second of cell time each ran at (the most
+    of them, rounded up to a hundred), in words; '' where the rows do not say their
+    vibrations. From cell time only, so the same runs say the same figure on any machine."""
+    rates = [r['vibrations'] / r['busy'] for r in cut if r.get('vibrations') and r['busy'] > 0]
+    if not rates:
+        return ''
+    most = 100 * math.ceil(max(rates) * refill / 100.0)
+    return (f'; a max_vibrations of {most} would let each run reach the interval (each '
+            f'simulating up to its {_min(refill)} of cell time)')
 
 
 def gumbel_fit(values) -> tuple[float, float]:

@@ -210,7 +210,8 @@ def _more(decision: Decision, required: float) -> str:
                                      'seen, which is the requirement itself'))
     if decision.censored:
         return ('; not settled: runs at this vibration limit cannot settle it; with a higher '
-                "max_vibrations (the experiment's) a run empties or outlasts the interval")
+                "max_vibrations (the experiment's; the ground says how high) a run empties or "
+                'outlasts the interval')
     if decision.runs < 3:
         return '; not settled: 3 runs give the fitted bound'
     return '; not settled: more runs narrow the bound (run --adaptive runs until it is settled)'
