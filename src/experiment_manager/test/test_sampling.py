@@ -14,6 +14,7 @@ from experiment_manager.analysis.results import read_text_rows, ResultsWriter
 from experiment_manager.analysis.summary import Sampling, Summary
 from experiment_manager.analysis.verdicts import NOT_FEASIBLE, UNDECIDED, verdicts
 from experiment_manager.analysis.wording import sampling_end
+from experiment_manager.experiment_file import plan
 from experiment_manager.running import sampling
 from experiment_manager.running.local_backend import LocalBackend
 from experiment_manager.running.scheduler import Runner
@@ -161,8 +162,14 @@ def test_a_race_between_bins_that_tie_within_bin_tie_ends_in_the_tie(monkeypatch
     assert sampling.unsettled(file, exp, tied) == [1, 2]
 
 
+def unread(file: experiment_file.ExperimentFile) -> experiment_file.ExperimentFile:
+    """The file without its feeder runs: no one reads its sweep's range (plan.held)."""
+    return replace(file, experiments=tuple(e for e in file.experiments
+                                           if e.type != 'feeder_emptying'))
+
+
 def test_a_sweep_is_settled_when_the_optimum_s_interval_lies_inside_its_range():
-    file = small()
+    file = unread(small())
     exp = replace(file.experiment('sweep'), counts=tuple(range(10, 101, 10)), margin=5)
     rng = np.random.default_rng(1)
 
@@ -181,7 +188,7 @@ def test_a_sweep_is_settled_when_the_optimum_s_interval_lies_inside_its_range():
 def test_a_sweep_with_a_flat_top_is_settled_when_any_n_star_of_its_interval_yields_the_same():
     # Valid parts rise to 20 at n = 40 and stay there: n* may be anywhere in 40-100, so its
     # interval never lies within +-5, but every range in it yields within 5 % of the best.
-    file = small()
+    file = unread(small())
     exp = replace(file.experiment('sweep'), counts=tuple(range(10, 101, 10)), margin=5)
     rng = np.random.default_rng(2)
     flat = [row(c, i, valid=min(20.0, c / 2) + rng.normal(0, 3.0))
@@ -200,12 +207,52 @@ def test_a_sweep_with_a_flat_top_is_settled_when_any_n_star_of_its_interval_yiel
     assert sampling.unsettled(file, exp, hump) == list(exp.counts)
 
 
+def test_a_sweep_stops_once_no_feeder_run_reading_its_range_could_run_otherwise():
+    """A broad hump about 70 parts, too noisy for its n* to settle within +-5 on 3 drops a
+    count: the small file's feeder runs (12 parts, their range the sweep's) put every part on
+    the table for any range from n*'s interval, so the sweep is settled; with 60 parts they
+    would not be, nor with no feeder reading it. It says so in its sampling."""
+    file = small()
+    exp = replace(file.experiment('sweep'), counts=tuple(range(10, 101, 10)), margin=5,
+                  extend=True)
+    file = replace(file, experiments=tuple(exp if e.id == 'sweep' else e
+                                           for e in file.experiments))
+    rng = np.random.default_rng(3)
+    hump = [row(c, i, valid=20 - (c - 70) ** 2 / 180 + rng.normal(0, 4.0))
+            for c in exp.counts for i in range(3)]
+    assert file.experiment('feeder').parts == 12
+    assert sampling.unsettled(file, exp, hump) == []
+    assert sampling.range_unread(file, exp, hump) == 12
+    more = replace(file, experiments=tuple(replace(e, parts=60) if e.id == 'feeder' else e
+                                           for e in file.experiments))
+    assert sampling.range_unread(more, exp, hump) is None
+    assert sampling.unsettled(more, exp, hump) == list(exp.counts)
+    assert sampling.unsettled(unread(file), exp, hump) == list(exp.counts)
+    # before every count has two drops, nothing is known of n*'s interval
+    assert sampling.range_unread(file, exp, [r for r in hump if r['iteration'] == 0]) is None
+    # a sweep still rising at its last count is not extended for feeder runs of 12: its range
+    # starts at 95 whatever more counts would show; for runs of 120 it would be
+    rising = metrics.table_sweep(file.ran, exp, [row(c, i, valid=c / 10 + i)
+                                                 for c in exp.counts for i in range(2)])
+    assert rising.n_star == 100 and rising.optimal_range[0] == 95
+    assert plan.extended(file, exp, rising) is None
+    more = replace(file, experiments=tuple(replace(e, parts=120) if e.id == 'feeder' else e
+                                           for e in file.experiments))
+    assert plan.extended(more, exp, rising).counts[-1] > 100
+    said = SimpleNamespace(sampling=Sampling(mode='adaptive', batch=5, batches=1,
+                                             iterations_run=30, most=100, settled=True,
+                                             held=12))
+    assert sampling_end(said) == ('settled: its range starts at or above the 12 parts its '
+                                  'feeder runs hold, which they put on the table whatever the '
+                                  'range')
+
+
 def test_a_sweep_places_its_next_drops_where_they_narrow_n_star_most():
     """Looks as the scheduler makes them, on rows drawn from a known curve (n* = 50; 20 %
     lower 20 parts away, so that it is no flat top, and noisy): the placed batches settle n* with
     fewer parts dropped than a batch at every count, never drop more at a look, and never ask
     for a count that has no iterations left."""
-    file = small(mode='adaptive', batch=5)
+    file = unread(small(mode='adaptive', batch=5))
     exp = replace(file.experiment('sweep'), counts=tuple(range(10, 101, 10)), margin=5,
                   iterations=40)
     drawn = {c: 8 - (c - 50) ** 2 / 250 + np.random.default_rng(c).normal(0, 3, 40)

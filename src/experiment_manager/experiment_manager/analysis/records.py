@@ -72,3 +72,7 @@ class Sampling(_Record):
     tie_within: float | None = None
     race_confidence: float | None = Field(None, description=(  # version 0: 99.9 % intervals
         "one-sided confidence of the bound of a bin's difference from the leader"))
+    held: int | None = Field(None, description=(
+        'a table_sweep settled because its range starts at or above the parts of every '
+        'feeder run that reads it (each puts them all on the table whatever the range): '
+        'those parts'))

@@ -24,6 +24,9 @@ def sampling_end(experiment) -> str:
     bound = (f'one-sided {100 * a.race_confidence:g} % bounds of the differences'
              if a.race_confidence is not None else '99.9 % intervals')
     if a.settled:
+        if a.held is not None:
+            return (f'settled: its range starts at or above the {a.held} parts its feeder '
+                    'runs hold, which they put on the table whatever the range')
         if not a.tie:
             return 'settled'
         return (f'settled: bins {_bins(experiment, a.tie)} mm tie within '

@@ -53,16 +53,34 @@ class Unit:
 EXTEND_STEPS = 3    # counts a table_sweep adds at a time while its fit still rises at its last
 
 
+def held(file: ExperimentFile, exp: Experiment) -> int | None:
+    """The most parts a feeder run holds among the feeder_emptying experiments that take
+    their optimal range from `exp` (a table_sweep); None when none does.
+
+    Such a feeder puts a shortfall on the table only while the table holds fewer than the
+    range's min* (feeder_controller.policy): with min* at or above the parts it holds, it puts
+    every part on the table (or doses them all, with max_feed) whatever the range is, so its
+    runs are the same for any such range. A sweep whose optimum is known to give such a range
+    needs no more drops, nor more counts, for them (sampling.range_unread)."""
+    parts = [e.parts for e in file.experiments if getattr(e, 'range_from', '') == exp.id]
+    return max(parts) if parts else None
+
+
 def extended(file: ExperimentFile, exp: Experiment, summary) -> Experiment | None:
     """A table_sweep whose n* (`summary`, its metrics) sits at its last count, with up to
     EXTEND_STEPS more counts at its step, as many as fit the tray with the sweep's margin
     (containers' packing rule) and the per-instance limit; None when n* lies inside its counts,
-    no part was valid, no more fit, or the sweep says `extend: false`."""
+    no part was valid, no more fit, the sweep says `extend: false`, or its range already
+    starts at or above the parts of every feeder run that reads it (`held`: a higher n* would
+    change none of their runs)."""
     if (not kind_of(exp).extends or not exp.extend or summary.no_valid
             or summary.n_star is None):
         return None
     last = exp.counts[-1]
     if summary.n_star < last:
+        return None
+    most_held = held(file, exp)
+    if most_held is not None and summary.optimal_range[0] >= most_held:
         return None
     step = exp.counts[1] - exp.counts[0] if len(exp.counts) > 1 else 1
     most = MAX_PARTS_PER_INSTANCE

@@ -51,7 +51,12 @@ What settles each decision, looked at after every batch:
   peak, so wherever in it the optimum lies, the range at n* gives the feeder runs at least
   95 % of the best valid parts per check (a feeder's checks to empty grow about as their
   inverse: at most about 5 % more). 5 % is our choice, not a source's; on PTH0's flat top
-  (n* 72, its interval 70-100 on all 4,000 drops) the margin alone never settles. Every
+  (n* 72, its interval 70-100 on all 4,000 drops) the margin alone never settles. Or when
+  no feeder run that reads its range could run otherwise (`range_unread`): n* and its
+  interval's low end, less the margin, reach the parts each holds (plan.held), so each puts
+  all its parts on the table whatever the range; nor is it extended then (plan.extended). A
+  board's refill of 8 DIPs had its sweep run 160 drops, extended past 100 parts, for an
+  optimum of 133 that no feeder run of 8 reads. Every
   count gets the first batch (the fit needs its whole curve); each later look places as many
   parts' worth of drops as a batch at every count would, where they narrow n* most
   (_sweep_batches), so a sweep takes about as many looks as with a batch at every count.
@@ -89,7 +94,7 @@ from ..experiment_file import (
     TableSweepExperiment,
 )
 from ..experiment_file.kinds import kind_of
-from ..experiment_file.plan import groups
+from ..experiment_file.plan import groups, held
 
 INTERIM_CONFIDENCE = 0.999
 # a bin's difference from the leader, one-sided: the tail of each INTERIM_CONFIDENCE interval
@@ -109,15 +114,21 @@ def unsettled(file: ExperimentFile, exp: Experiment, rows: list[dict],
 def ended(file: ExperimentFile, exp: Experiment, rows: list[dict],
           checks: list[dict] = ()) -> tuple[list[int], list[int]]:
     """(unsettled's groups, the bins of a tie that settled a bin_static race: race)."""
-    rows = sorted(rows, key=lambda r: (r['group'], r['iteration']))
-    out = metrics.left_out(rows)
+    kept, out = _kept(rows)
     if out and kind_of(exp).left_out_settles:
         return [], []       # a left-out iteration makes the option NOT FEASIBLE: settled
-    kept = [r for r in rows if (r['group'], r['iteration']) not in out]
     if kind_of(exp).uses_checks:
         kept_keys = {(r['group'], r['iteration']) for r in kept}
         checks = [c for c in checks if (c['group'], c['iteration']) in kept_keys]
     return DECISIONS[exp.type](file, exp, kept, checks)
+
+
+def _kept(rows: list[dict]) -> tuple[list[dict], set]:
+    """The rows a look reads, in (group, iteration) order, without those left out of the
+    figures (metrics.left_out), and the keys of those left out."""
+    rows = sorted(rows, key=lambda r: (r['group'], r['iteration']))
+    out = metrics.left_out(rows)
+    return [r for r in rows if (r['group'], r['iteration']) not in out], out
 
 
 def _drops_unsettled(file: ExperimentFile, exp: DropTestExperiment, kept: list[dict],
@@ -193,22 +204,18 @@ def race(exp: BinStaticExperiment, rows: list[dict]) -> tuple[list[int], list[in
 
 def _sweep_unsettled(file: ExperimentFile, exp: TableSweepExperiment,
                      rows: list[dict]) -> list[int]:
-    """[] when the sweep's n* is settled (its bootstrap interval at INTERIM_CONFIDENCE lies
-    inside n* +- margin, or the fit is flat across it: FLAT_TOP), else where the next look's
-    drops go (_sweep_batches). The counts' rows and the fit are made once for both."""
-    by_count = [np.array([r['valid'] for r in rows if r['group'] == n], dtype=float)
-                for n in exp.counts]
-    if any(len(v) < 2 for v in by_count):      # also every row left out: nothing to fit
+    """[] when the sweep's n* is settled (no feeder run reading it could run otherwise:
+    range_unread; its bootstrap interval at INTERIM_CONFIDENCE lies inside n* +- margin; or
+    the fit is flat across it: FLAT_TOP), else where the next look's drops go
+    (_sweep_batches). The counts' rows and the fit are made once for all."""
+    by_count, fitted, low, high = _sweep_look(file, exp, rows)
+    if fitted is None:              # also every row left out: nothing to fit
         return _sweep_batches(file, exp, by_count, None)
-    first, last = exp.counts[0], exp.counts[-1]
-    fitted = metrics.fit_optimum([r['group'] for r in rows], [r['valid'] for r in rows],
-                                 first, last, exp.margin)
-    if fitted.order < 1:
+    if low is None:
         return []           # one count: n* is that count
+    if _above(file, exp, fitted, low) is not None:
+        return []
     best = fitted.n_star
-    low, high = metrics.n_star_interval(exp.counts, by_count, fitted.order, first, last,
-                                        INTERIM_CONFIDENCE,
-                                        np.random.default_rng([file.seed, len(rows)]))
     if best - exp.margin <= low and high <= best + exp.margin:
         return []
     peak = fitted.fit_max
@@ -216,6 +223,51 @@ def _sweep_unsettled(file: ExperimentFile, exp: TableSweepExperiment,
             >= (1.0 - FLAT_TOP) * peak:
         return []           # a flat top: any n* of its interval yields within FLAT_TOP
     return _sweep_batches(file, exp, by_count, fitted)
+
+
+def _sweep_look(file: ExperimentFile, exp: TableSweepExperiment, rows: list[dict]
+                ) -> tuple[list[np.ndarray], metrics.Fit | None, int | None, int | None]:
+    """What a look at a sweep's rows (in _kept's order) sees: each count's valid parts, the
+    fit (None while a count has fewer than two iterations) and n*'s bootstrap interval at
+    INTERIM_CONFIDENCE, seeded by the file's seed and the rows (None, None for a fit of one
+    count)."""
+    by_count = [np.array([r['valid'] for r in rows if r['group'] == n], dtype=float)
+                for n in exp.counts]
+    if any(len(v) < 2 for v in by_count):
+        return by_count, None, None, None
+    first, last = exp.counts[0], exp.counts[-1]
+    fitted = metrics.fit_optimum([r['group'] for r in rows], [r['valid'] for r in rows],
+                                 first, last, exp.margin)
+    if fitted.order < 1:
+        return by_count, fitted, None, None
+    low, high = metrics.n_star_interval(exp.counts, by_count, fitted.order, first, last,
+                                        INTERIM_CONFIDENCE,
+                                        np.random.default_rng([file.seed, len(rows)]))
+    return by_count, fitted, low, high
+
+
+def range_unread(file: ExperimentFile, exp: TableSweepExperiment, rows: list[dict]
+                 ) -> int | None:
+    """The parts of the feeder runs that read `exp`'s range (plan.held) when the sweep's
+    range is known, at INTERIM_CONFIDENCE, to start at or above them (as a look at `rows`
+    sees it: _sweep_look): its fit's n* and the low end of n*'s bootstrap interval, less the
+    margin, both reach them. Every feeder run then puts all its parts on the table whatever
+    more drops would make of n*, so they read nothing more of the sweep (a refill of 8 DIPs
+    on a sweep whose optimum is 133). None otherwise."""
+    if held(file, exp) is None:
+        return None
+    _, fitted, low, _ = _sweep_look(file, exp, _kept(rows)[0])
+    return None if low is None else _above(file, exp, fitted, low)
+
+
+def _above(file: ExperimentFile, exp: TableSweepExperiment, fitted: metrics.Fit, low: int
+           ) -> int | None:
+    """plan.held's parts when the fit's n* and `low` (n*'s interval's low end), less the
+    margin, both reach them; else None."""
+    parts = held(file, exp)
+    if parts is None or min(fitted.n_star, low) - exp.margin < parts:
+        return None
+    return parts
 
 
 def _sweep_batches(file: ExperimentFile, exp: TableSweepExperiment, by_count: list[np.ndarray],

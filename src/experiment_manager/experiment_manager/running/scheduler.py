@@ -245,6 +245,8 @@ class Runner:
         elif tie:                                       # bins known to tie within BIN_TIE
             race = {'tie': tie, 'tie_within': sampling.BIN_TIE,
                     'race_confidence': sampling.RACE_CONFIDENCE}
+        if not left and kind_of(exp).extends:
+            race = {'held': sampling.range_unread(self.file, exp, rows)}
         return Sampling(mode=self.file.sampling.mode, batch=self.file.sampling.batch,
                         batches=self._looks[exp.id], iterations_run=len(rows),
                         most=experiment_iterations(exp), settled=not left, **race)
