@@ -100,6 +100,26 @@ def test_feeder_runs_settle_on_their_time_to_empty_and_their_spills():
     assert sampling.unsettled(file, exp, tunnelled) == []
 
 
+def test_runs_the_limit_ends_stop_once_neither_verdict_is_in_reach_or_after_five():
+    """Feeder runs that the vibration limit ends 9 min into the 4 h interval (censored): one
+    keeps FEASIBLE out of reach of 30 runs. Where they picked 6 each, 12 in 2 runs is at least
+    18 an hour at 99.9 %, which empties a refill of 12 within 4 h: the pace will not say NOT
+    FEASIBLE either, and 2 runs settle it (so does 1). Where they picked nothing, NOT FEASIBLE stays in
+    reach and the runs go on, to LIMITED_RUNS (5), as one batch of the default 5 did."""
+    file = small()
+    exp = replace(file.experiment('feeder'), iterations=30)
+    limited = dict(emptied=False, stop='stop: vibration limit', parts=12)
+    picking = [feeder_run(i, 500.0, picks=6, **limited) for i in range(2)]
+    assert sampling.unsettled(file, exp, picking) == []
+    # one run of 6 is clear too (at least 10 an hour); one of 1 pick is not
+    assert sampling.unsettled(file, exp, picking[:1]) == []
+    assert sampling.unsettled(file, exp, [dict(picking[0], picks=1)]) == [0]
+    idle = [feeder_run(i, 500.0, picks=0, **limited) for i in range(5)]
+    for k in range(1, sampling.LIMITED_RUNS):
+        assert sampling.unsettled(file, exp, idle[:k]) == [0]
+    assert sampling.LIMITED_RUNS == 5 and sampling.unsettled(file, exp, idle) == []
+
+
 def four_bins() -> tuple:
     """The small file and its bins experiment with 4 bins."""
     file = small()
@@ -345,8 +365,9 @@ def test_runs_the_vibration_limit_ended_early_stop_once_feasible_is_out_of_reach
     """The same hopeless runs against a 4 h refill interval: the limit ends each well inside
     it (under a minute), so none says whether a refill empties within it (censored). Two of
     them keep the table from FEASIBLE at any of the 6 iterations (2 of 6 counted over: at most
-    73 % at 95 %, against 10 % allowed): the run stops after its first batch, its time ground
-    UNDECIDED, and says why."""
+    73 % at 95 %, against 10 % allowed), and their pace (15 picks in 1.1 min of cell time) from
+    NOT FEASIBLE: the run stops after its first batch, its time ground UNDECIDED, and says
+    why."""
     summary = run('adaptive', str(tmp_path / 'limited'), interval_h=4.0)
     s = summary.experiments['feeder']
     assert (s.iterations, s.sampling.settled) == (2, True)
