@@ -104,8 +104,9 @@ def test_runs_the_limit_ends_stop_once_neither_verdict_is_in_reach_or_after_five
     """Feeder runs that the vibration limit ends 9 min into the 4 h interval (censored): one
     keeps FEASIBLE out of reach of 30 runs. Where they picked 6 each, 12 in 2 runs is at least
     18 an hour at 99.9 %, which empties a refill of 12 within 4 h: the pace will not say NOT
-    FEASIBLE either, and 2 runs settle it (so does 1). Where they picked nothing, NOT FEASIBLE stays in
-    reach and the runs go on, to LIMITED_RUNS (5), as one batch of the default 5 did."""
+    FEASIBLE either, and 2 runs settle it (so does 1). Where they picked nothing, NOT FEASIBLE
+    stays in reach and the runs go on, to LIMITED_RUNS (5), as one batch of the default 5
+    did."""
     file = small()
     exp = replace(file.experiment('feeder'), iterations=30)
     limited = dict(emptied=False, stop='stop: vibration limit', parts=12)
