@@ -56,9 +56,58 @@ class GraspFit:
         return ''
 
 
+# m: how far outside a triangle's shadow a line may pass and still be tested (`Caster`); far
+# beyond the 1e-9 of an edge that `crossings` lets a crossing lie outside a triangle
+SHADOW_SLACK = 1e-9
+
+
+class Caster:
+    """`crossings` along one direction, many times: each triangle's shadow (its bounding box
+    in the plane square to `direction`) is made once, and a line is tested only against the
+    triangles whose shadow holds its foot (within SHADOW_SLACK). A triangle whose shadow does
+    not hold it cannot be crossed by the line, so the crossings are those of `crossings` on
+    every triangle, to the bit: the same arithmetic on the same triangles. A cup's seal casts
+    about 80 lines straight down onto the part; on KiCad's D-sub 9 (its surface of tens of
+    thousands of triangles) each crossed them all."""
+
+    def __init__(self, triangles: np.ndarray, direction: np.ndarray) -> None:
+        self.triangles = np.asarray(triangles, dtype=np.float64)
+        self.direction = np.asarray(direction, dtype=np.float64)
+        d = self.direction / np.linalg.norm(self.direction)
+        a = np.eye(3)[int(np.argmin(np.abs(d)))]
+        self._axes = np.stack([np.cross(d, a), np.cross(d, np.cross(d, a))])
+        self._axes /= np.linalg.norm(self._axes, axis=1)[:, None]
+        shadow = self.triangles @ self._axes.T                  # (T, 3, 2)
+        self._low = shadow.min(axis=1) - SHADOW_SLACK
+        self._high = shadow.max(axis=1) + SHADOW_SLACK
+
+    def crossings(self, origin: np.ndarray) -> np.ndarray:
+        """`crossings(triangles, origin, direction)`."""
+        return self.crossings_of(np.asarray(origin, dtype=np.float64)[None])[0]
+
+    def crossings_of(self, origins: np.ndarray) -> list[np.ndarray]:
+        """`crossings(triangles, origin, direction)` for each of `origins` (N, 3), in one
+        pass over the (line, triangle) pairs whose shadow holds the line's foot."""
+        feet = origins @ self._axes.T                                       # (N, 2)
+        held = ((self._low[None] <= feet[:, None]) & (feet[:, None] <= self._high[None])
+                ).all(axis=2)                                               # (N, T)
+        line, near = np.nonzero(held)
+        t, hit = _crossed(self.triangles[near], origins[line], self.direction)
+        return np.split(t[hit], np.cumsum(np.bincount(line[hit], minlength=len(origins)))[:-1])
+
+
 def crossings(triangles: np.ndarray, origin: np.ndarray, direction: np.ndarray) -> np.ndarray:
     """Where the line origin + t * direction crosses the triangles (T, 3, 3): the t of each
     crossing (Moeller-Trumbore, both faces, the whole line)."""
+    t, hit = _crossed(triangles, origin, direction)
+    return t[hit]
+
+
+def _crossed(triangles: np.ndarray, origin: np.ndarray, direction: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """Moeller-Trumbore for each triangle (T, 3, 3) and the line from `origin` (3,) or each
+    triangle's own (T, 3): the line's t at the triangle's plane, and whether it crosses the
+    triangle."""
     a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
     e1, e2 = b - a, c - a
     p = np.cross(direction, e2)
@@ -71,7 +120,7 @@ def crossings(triangles: np.ndarray, origin: np.ndarray, direction: np.ndarray) 
     v = (q @ direction) * inv
     t = np.einsum('ij,ij->i', e2, q) * inv
     hit = ok & (u >= -1e-9) & (v >= -1e-9) & (u + v <= 1.0 + 1e-9)
-    return t[hit]
+    return t, hit
 
 
 def surface(part: PartGeometry) -> np.ndarray:

@@ -32,7 +32,7 @@ from pick_common.parts.aspects import part_aspects
 from pick_common.parts.geometry import PartGeometry
 import trimesh
 
-from .grasp_fit import crossings, round_axis, surface
+from .grasp_fit import Caster, crossings, round_axis, surface
 from .grasps import GraspPose, SuctionGrasp
 from .suction import holding, seal
 
@@ -251,9 +251,10 @@ def _cup_grasps(part: PartGeometry, cup: 'SuctionCup') -> tuple[Proposal, ...]:
         e1 = _snap(np.cross(up, np.eye(3)[int(np.argmin(np.abs(up)))]))
         e2 = np.cross(up, e1)
         top = 2 * part.radius + float(np.linalg.norm(centre))
+        down = Caster(triangles, -up)
         for i, j in offsets:
             base = centre + step * (i * e1 + j * e2)
-            t = crossings(triangles, base + top * up, -up)
+            t = down.crossings(base + top * up)
             t = t[t >= 0]
             if not len(t):
                 continue

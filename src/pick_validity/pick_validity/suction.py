@@ -35,7 +35,7 @@ import numpy as np
 from pick_common.parts.geometry import PartGeometry
 from pick_common.states import perpendicular
 
-from .grasp_fit import crossings, surface
+from .grasp_fit import Caster, surface
 from .grasps import CupGrasp
 
 if TYPE_CHECKING:
@@ -87,13 +87,12 @@ def _basis(up: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return a, np.cross(up, a)
 
 
-def _heights(triangles: np.ndarray, points: np.ndarray, up: np.ndarray, top: float
-             ) -> np.ndarray:
+def _heights(down: Caster, points: np.ndarray, up: np.ndarray, top: float) -> np.ndarray:
     """Per point (in the plane through the grasp point), the height along `up` of the first
-    surface a line coming down from `top` above it meets; nan where the line misses."""
+    surface a line coming down from `top` above it meets (`down`: the part's surface cast
+    along -up); nan where the line misses."""
     out = np.full(len(points), np.nan)
-    for i, p in enumerate(points):
-        t = crossings(triangles, p + top * up, -up)
+    for i, t in enumerate(down.crossings_of(np.asarray(points) + top * up)):
         t = t[t >= 0.0]
         if len(t):
             out[i] = top - float(t.min())
@@ -102,8 +101,8 @@ def _heights(triangles: np.ndarray, points: np.ndarray, up: np.ndarray, top: flo
 
 def seal(part: PartGeometry, cup: 'SuctionCup', grasp: CupGrasp) -> Seal:
     """Does the cup's rim seal on the part at `grasp` (module docstring)."""
-    triangles = surface(part)
     up, point = grasp.up, grasp.point
+    down = Caster(surface(part), -up)
     e1, e2 = _basis(up)
     radius = cup.cup_diameter / 2
     top = 2.0 * part.radius + float(np.linalg.norm(point)) + radius
@@ -111,14 +110,14 @@ def seal(part: PartGeometry, cup: 'SuctionCup', grasp: CupGrasp) -> Seal:
     ring = np.cos(angles)[:, None] * e1 + np.sin(angles)[:, None] * e2
     give = LIP_GIVE * cup.cup_height
     mm = 1000.0
-    centre = _heights(triangles, point[None], up, top)[0]
+    centre = _heights(down, point[None], up, top)[0]
     if math.isnan(centre) or abs(centre) > ON_SURFACE:
         where = ('the line along the approach through it misses the part' if math.isnan(centre)
                  else f'the first surface along the approach lies {centre * mm:+.2f} mm from '
                  'it along up_axis')
         return Seal(f"the grasp point is not on the part's surface: {where}", math.nan, give,
                     np.full((RIM_POINTS, 3), np.nan))
-    rim_z = _heights(triangles, point + radius * ring, up, top)
+    rim_z = _heights(down, point + radius * ring, up, top)
     rim = point + radius * ring + rim_z[:, None] * up
     if np.isnan(rim_z).any():
         k = int(np.flatnonzero(np.isnan(rim_z))[0])
@@ -129,7 +128,7 @@ def seal(part: PartGeometry, cup: 'SuctionCup', grasp: CupGrasp) -> Seal:
              for s in INNER_RINGS for a in np.linspace(0.0, 2 * math.pi,
                                                       max(1, int(RIM_POINTS * s)),
                                                       endpoint=False)]
-    inner_z = _heights(triangles, np.array(inner), up, top)
+    inner_z = _heights(down, np.array(inner), up, top)
     if np.isnan(inner_z).any():
         return Seal('a line inside the ring meets no surface: a hole or an edge lies inside '
                     'the cup', math.nan, give, rim)

@@ -12,6 +12,7 @@ from pick_common.parts.spec import PartSpec
 from pick_common.specs import SceneSpec
 from pick_sim_world.world import World
 from pick_validity.config import PlaceSpec, Setup
+from pick_validity.grasp_fit import Caster, crossings
 from pick_validity.grasps import GraspPose, SuctionGrasp
 from pick_validity.grippers import check_grasps, Jaws, SuctionCup
 from pick_validity.naive import naive_check
@@ -159,3 +160,27 @@ def test_the_cup_s_check_equals_the_naive_loop_on_settled_scenes(container, coun
             assert "'side' at" in r.reason
         if r.grasp_index >= 0:
             assert DIP_GRASPS[r.grasp_index].name != 'side'
+
+
+def test_a_caster_crosses_what_every_triangle_crosses_to_the_bit():
+    """Caster tests a line only against the triangles whose shadow holds it: on a box cut
+    into small triangles and a cylinder of 256 facets, lines along the axes through the
+    triangles' corners and edges (where a crossing sits on the tolerance) and along a slanted
+    direction find exactly the crossings of every triangle, one line at a time or many."""
+    box = trimesh.creation.box(extents=(0.02, 0.012, 0.004))
+    box = box.subdivide().subdivide()
+    cylinder = trimesh.creation.cylinder(radius=0.003, height=0.01, sections=256)
+    rng = np.random.default_rng(5)
+    for mesh in (box, cylinder):
+        triangles = np.asarray(mesh.triangles)
+        corners = triangles.reshape(-1, 3)[:200]
+        for direction in (np.array([0.0, 0.0, -1.0]), np.array([1.0, 0.0, 0.0]),
+                          np.array([0.0, 1.0, 0.0]), rng.normal(size=3)):
+            caster = Caster(triangles, direction)
+            origins = np.concatenate([corners, (corners[:-1] + corners[1:]) / 2,
+                                      rng.uniform(-0.012, 0.012, (200, 3))])
+            every = [crossings(triangles, origin, direction) for origin in origins]
+            assert all(np.array_equal(caster.crossings(o), t) for o, t in zip(origins, every, strict=True))
+            batch = caster.crossings_of(origins)
+            assert len(batch) == len(every)
+            assert all(np.array_equal(b, t) for b, t in zip(batch, every, strict=True))
