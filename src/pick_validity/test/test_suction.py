@@ -180,7 +180,8 @@ def test_a_caster_crosses_what_every_triangle_crosses_to_the_bit():
             origins = np.concatenate([corners, (corners[:-1] + corners[1:]) / 2,
                                       rng.uniform(-0.012, 0.012, (200, 3))])
             every = [crossings(triangles, origin, direction) for origin in origins]
-            assert all(np.array_equal(caster.crossings(o), t) for o, t in zip(origins, every, strict=True))
+            assert all(np.array_equal(caster.crossings(o), t)
+                       for o, t in zip(origins, every, strict=True))
             batch = caster.crossings_of(origins)
             assert len(batch) == len(every)
             assert all(np.array_equal(b, t) for b, t in zip(batch, every, strict=True))
