@@ -67,8 +67,8 @@ class Caster:
     triangles whose shadow holds its foot (within SHADOW_SLACK). A triangle whose shadow does
     not hold it cannot be crossed by the line, so the crossings are those of `crossings` on
     every triangle, to the bit: the same arithmetic on the same triangles. A cup's seal casts
-    about 80 lines straight down onto the part; on KiCad's D-sub 9 (its surface of tens of
-    thousands of triangles) each crossed them all."""
+    89 lines straight down onto the part; on KiCad's D-sub 9 (its surface of 10,410
+    triangles) each crossed them all."""
 
     def __init__(self, triangles: np.ndarray, direction: np.ndarray) -> None:
         self.triangles = np.asarray(triangles, dtype=np.float64)

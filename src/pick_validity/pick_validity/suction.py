@@ -151,13 +151,20 @@ def seal(part: PartGeometry, cup: 'SuctionCup', grasp: CupGrasp) -> Seal:
     return Seal('', deviation, give, rim)
 
 
+def lift(part: PartGeometry, cup: 'SuctionCup') -> tuple[float, float]:
+    """(the vacuum's force on the cup's area, the force the part needs: its weight and the
+    robot's acceleration over the friction, times the safety factor), N; the same at every
+    grasp, so where the first is the smaller no grasp holds (module docstring)."""
+    force = cup.vacuum * math.pi * (cup.cup_diameter / 2) ** 2
+    return force, part.mass * (GRAVITY + cup.acceleration / cup.cup_friction) * cup.safety_factor
+
+
 def holding(part: PartGeometry, cup: 'SuctionCup', grasp: CupGrasp) -> Holding:
     """The cup's holding force and margin at `grasp` (module docstring)."""
     centre = part.mass_centre
     radius = cup.cup_diameter / 2
-    force = cup.vacuum * math.pi * radius ** 2
+    force, needed = lift(part, cup)
     m = part.mass
-    needed = m * (GRAVITY + cup.acceleration / cup.cup_friction) * cup.safety_factor
     arm = centre - grasp.point
     depth = max(0.0, -float(arm @ grasp.up))
     offset = float(np.linalg.norm(arm - (arm @ grasp.up) * grasp.up))
