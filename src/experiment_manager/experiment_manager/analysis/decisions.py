@@ -246,11 +246,25 @@ def pace(runs: list[dict], refill: float, confidence: float = CONFIDENCE) -> dic
     `refill`, s."""
     picks = int(sum(r['picks'] for r in runs))
     busy = float(sum(r['busy'] for r in runs))
-    upper = scipy_stats.chi2.ppf(confidence, 2 * picks + 2) / 2.0 / busy     # per s
+    upper = pace_bound(picks, busy, confidence)
     parts = max((r['parts'] or 0) for r in runs)
-    share = float(scipy_stats.poisson.sf(parts - 1, upper * refill)) if parts else 1.0
     return {'picks': picks, 'cell_h': busy / 3600.0, 'upper_per_h': float(upper * 3600.0),
-            'parts': parts, 'emptied_share_at_most': share}
+            'parts': parts, 'emptied_share_at_most': emptied_share(upper, parts, refill)}
+
+
+def pace_bound(picks: int, busy: float, confidence: float, upper: bool = True) -> float:
+    """Garwood's exact one-sided bound at `confidence` of the rate of `picks` in `busy` s of
+    cell time, per s: the upper (chi-square with 2 picks + 2 degrees of freedom), or the lower
+    (2 picks; 0 with no pick), over 2 x the time."""
+    if upper:
+        return float(scipy_stats.chi2.ppf(confidence, 2 * picks + 2) / 2.0 / busy)
+    return float(scipy_stats.chi2.ppf(1.0 - confidence, 2 * picks) / 2.0 / busy) if picks else 0.0
+
+
+def emptied_share(rate: float, parts: int, refill: float) -> float:
+    """The chance that a refill's `parts` are all picked within `refill` s at `rate` picks a
+    second (a Poisson count reaching them); 1 with no parts."""
+    return float(scipy_stats.poisson.sf(parts - 1, rate * refill)) if parts else 1.0
 
 
 def _paced(p: dict, coverage: float, confidence: float) -> str:

@@ -81,7 +81,6 @@ L x 0.1 %.
 
 import numpy as np
 from pick_common.stats import binomial_bounds, difference_bound, interval
-from scipy import stats
 
 from ..analysis import decisions, metrics
 from ..experiment_file import (
@@ -174,10 +173,12 @@ def _pace_clear(time: decisions.Decision, required: float) -> bool:
     INTERIM_CONFIDENCE lower bound (Garwood), empties at least `required` of refills within
     the interval: more runs will not make it say NOT FEASIBLE."""
     p = time.detail.get('pace')
-    if not p or not p['picks']:
+    if not p:
         return False
-    low = stats.chi2.ppf(1.0 - INTERIM_CONFIDENCE, 2 * p['picks']) / 2.0 / (3600.0 * p['cell_h'])
-    return float(stats.poisson.sf(p['parts'] - 1, low * time.detail['refill_s'])) >= required
+    low = decisions.pace_bound(p['picks'], 3600.0 * p['cell_h'], INTERIM_CONFIDENCE,
+                               upper=False)
+    return low > 0 and decisions.emptied_share(low, p['parts'], time.detail['refill_s']) \
+        >= required
 
 
 def _out_of_reach(time: decisions.Decision, iterations: int, required: float) -> bool:
