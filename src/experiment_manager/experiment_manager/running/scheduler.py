@@ -239,17 +239,17 @@ class Runner:
         """How an adaptive experiment was sampled: its batches, iterations, whether its
         decision settled, and the bins left tied or known to tie (sampling.ended)."""
         left, tie = sampling.ended(self.file, exp, rows, checks)
-        race = {}
+        said = {}
         if left and kind_of(exp).groups_are_bins:       # the bins that could not be told apart
-            race = {'tied_bins': left, 'race_confidence': sampling.RACE_CONFIDENCE}
+            said = {'tied_bins': left, 'race_confidence': sampling.RACE_CONFIDENCE}
         elif tie:                                       # bins known to tie within BIN_TIE
-            race = {'tie': tie, 'tie_within': sampling.BIN_TIE,
+            said = {'tie': tie, 'tie_within': sampling.BIN_TIE,
                     'race_confidence': sampling.RACE_CONFIDENCE}
         if not left and kind_of(exp).extends:
-            race = {'held': sampling.range_unread(self.file, exp, rows)}
+            said = {'held': sampling.range_unread(self.file, exp, rows)}
         return Sampling(mode=self.file.sampling.mode, batch=self.file.sampling.batch,
                         batches=self._looks[exp.id], iterations_run=len(rows),
-                        most=experiment_iterations(exp), settled=not left, **race)
+                        most=experiment_iterations(exp), settled=not left, **said)
 
     def _extend(self, exp: Experiment, wider: Experiment) -> None:
         """Run a table_sweep on at more counts (plan.extended): the file holds `wider` from
