@@ -261,9 +261,9 @@ def _cup_grasps(part: PartGeometry, cup: 'SuctionCup') -> tuple[Proposal, ...]:
         e2 = np.cross(up, e1)
         top = 2 * part.radius + float(np.linalg.norm(centre))
         down = Caster(triangles, -up)
-        for i, j in offsets:
-            base = centre + step * (i * e1 + j * e2)
-            t = down.crossings(base + top * up)
+        sealing = None      # the surface cast along the checked grasp's -up, as seal casts it
+        bases = [centre + step * (i * e1 + j * e2) for i, j in offsets]
+        for base, t in zip(bases, down.crossings_of(np.array(bases) + top * up), strict=True):
             t = t[t >= 0]
             if not len(t):
                 continue
@@ -271,7 +271,10 @@ def _cup_grasps(part: PartGeometry, cup: 'SuctionCup') -> tuple[Proposal, ...]:
             grasp = SuctionGrasp(f'cup_up{_name(up)}', tuple(float(v) for v in up),
                                  tuple(float(v) for v in point))
             checked = cup.check_grasp(grasp, f'grasps.{grasp.name}', grasp.name)
-            found = seal(part, cup, checked)
+            if sealing is None:
+                sealing = (down if np.array_equal(checked.up, -down.direction)
+                           else Caster(triangles, -checked.up))
+            found = seal(part, cup, checked, sealing)
             if found.ok and holding(part, cup, checked).ok:
                 out.append(Proposal(grasp, found.deviation))
                 break

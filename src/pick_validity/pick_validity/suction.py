@@ -99,10 +99,13 @@ def _heights(down: Caster, points: np.ndarray, up: np.ndarray, top: float) -> np
     return out
 
 
-def seal(part: PartGeometry, cup: 'SuctionCup', grasp: CupGrasp) -> Seal:
-    """Does the cup's rim seal on the part at `grasp` (module docstring)."""
+def seal(part: PartGeometry, cup: 'SuctionCup', grasp: CupGrasp,
+         down: Caster | None = None) -> Seal:
+    """Does the cup's rim seal on the part at `grasp` (module docstring). `down`: the part's
+    surface cast along -up (a search for a seal casts many with one)."""
     up, point = grasp.up, grasp.point
-    down = Caster(surface(part), -up)
+    if down is None:
+        down = Caster(surface(part), -up)
     e1, e2 = _basis(up)
     radius = cup.cup_diameter / 2
     top = 2.0 * part.radius + float(np.linalg.norm(point)) + radius

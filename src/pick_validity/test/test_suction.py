@@ -165,8 +165,9 @@ def test_the_cup_s_check_equals_the_naive_loop_on_settled_scenes(container, coun
 def test_a_caster_crosses_what_every_triangle_crosses_to_the_bit():
     """Caster tests a line only against the triangles whose shadow holds it: on a box cut
     into small triangles and a cylinder of 256 facets, lines along the axes through the
-    triangles' corners and edges (where a crossing sits on the tolerance) and along a slanted
-    direction find exactly the crossings of every triangle, one line at a time or many."""
+    triangles' corners and edges (where a crossing sits on the tolerance), lines whose feet lie
+    on the borders of the caster's grid cells, and along a slanted direction find exactly the
+    crossings of every triangle, one line at a time or many."""
     box = trimesh.creation.box(extents=(0.02, 0.012, 0.004))
     box = box.subdivide().subdivide()
     cylinder = trimesh.creation.cylinder(radius=0.003, height=0.01, sections=256)
@@ -177,8 +178,10 @@ def test_a_caster_crosses_what_every_triangle_crosses_to_the_bit():
         for direction in (np.array([0.0, 0.0, -1.0]), np.array([1.0, 0.0, 0.0]),
                           np.array([0.0, 1.0, 0.0]), rng.normal(size=3)):
             caster = Caster(triangles, direction)
+            k = np.arange(caster._side + 1)[:, None]
+            borders = (caster._corner + k * caster._cell) @ caster._axes    # feet on borders
             origins = np.concatenate([corners, (corners[:-1] + corners[1:]) / 2,
-                                      rng.uniform(-0.012, 0.012, (200, 3))])
+                                      rng.uniform(-0.012, 0.012, (200, 3)), borders])
             every = [crossings(triangles, origin, direction) for origin in origins]
             assert all(np.array_equal(caster.crossings(o), t)
                        for o, t in zip(origins, every, strict=True))
