@@ -97,6 +97,35 @@ def _quat_mul(a: np.ndarray, b: Sequence[float]) -> np.ndarray:
                     axis=1)
 
 
+# The last part's marker shapes (`_shapes`): (its primitives, their shapes).
+_shapes_of: tuple[tuple, list] = ((), [])
+
+
+def _shapes(primitives: tuple) -> list:
+    """Per primitive: marker type, scale and points, shared by every part's marker and by
+    every call for the same primitives (a world node's part): a CAD part's hulls hold
+    thousands of points (KiCad's DIP-28 socket 11,604), which built anew after each operation
+    took more of a feeder run's world than its physics."""
+    global _shapes_of
+    cached, shapes = _shapes_of
+    if cached is primitives:
+        return shapes
+    shapes = []
+    for p in primitives:
+        if isinstance(p, Box):
+            shapes.append((Marker.CUBE, Vector3(x=2 * p.half[0], y=2 * p.half[1],
+                                                z=2 * p.half[2]), []))
+        elif isinstance(p, Cylinder):
+            shapes.append((Marker.CYLINDER, Vector3(x=2 * p.radius, y=2 * p.radius,
+                                                    z=p.length), []))
+        else:
+            shapes.append((Marker.TRIANGLE_LIST, Vector3(x=1.0, y=1.0, z=1.0),
+                           [Point(x=float(x), y=float(y), z=float(z))
+                            for x, y, z in p.vertices[p.faces.reshape(-1)]]))
+    _shapes_of = (primitives, shapes)
+    return shapes
+
+
 def markers_msg(world: World, states: PartStates, stamp: Time, prefix: str) -> MarkerArray:
     """Containers and parts as markers in their instance frames: one marker per collision
     primitive (CUBE, CYLINDER) or hull (TRIANGLE_LIST). Starts with DELETEALL.
@@ -119,18 +148,7 @@ def markers_msg(world: World, states: PartStates, stamp: Time, prefix: str) -> M
     if not len(states.ids):
         return out
     primitives = world.part.primitives
-    shapes = []     # per primitive: marker type, scale and points, shared by every part
-    for p in primitives:
-        if isinstance(p, Box):
-            shapes.append((Marker.CUBE, Vector3(x=2 * p.half[0], y=2 * p.half[1],
-                                                z=2 * p.half[2]), []))
-        elif isinstance(p, Cylinder):
-            shapes.append((Marker.CYLINDER, Vector3(x=2 * p.radius, y=2 * p.radius,
-                                                    z=p.length), []))
-        else:
-            shapes.append((Marker.TRIANGLE_LIST, Vector3(x=1.0, y=1.0, z=1.0),
-                           [Point(x=float(x), y=float(y), z=float(z))
-                            for x, y, z in p.vertices[p.faces.reshape(-1)]]))
+    shapes = _shapes(primitives)
     q = states.poses[:, 3:]
     # (N, K, 3) positions and (N, K, 4) orientations of primitive k of part n.
     positions = np.stack([states.poses[:, :3] + rotate(q, np.asarray(p.position, dtype=float))

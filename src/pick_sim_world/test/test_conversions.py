@@ -10,6 +10,7 @@ from pick_sim_world import conversions as conv
 from pick_sim_world.world import World
 import pybullet as pb
 import pytest
+import trimesh
 from visualization_msgs.msg import Marker
 
 
@@ -49,3 +50,29 @@ def test_each_part_marker_is_its_primitive_placed_by_the_part_pose(model):
                 (0.1, 0.3, 0.8) if inside else (0.9, 0.1, 0.1))
             if isinstance(p, Hull):
                 assert len(m.points) == 3 * len(p.faces)
+
+
+def test_a_part_s_marker_shapes_are_built_once_and_follow_the_world_s_part(tmp_path):
+    """The points of a part's hulls are built once for its primitives (a CAD part's run
+    rebuilt thousands after every operation), and a world of another part gets its own: each
+    call's markers equal those built with nothing kept."""
+    specs = []
+    for name, mesh in (('ball', trimesh.creation.icosphere(subdivisions=1, radius=0.003)),
+                       ('rod', trimesh.creation.cylinder(radius=0.002, height=0.008))):
+        mesh.export(str(tmp_path / f'{name}.stl'))
+        specs.append(PartSpec(model='mesh', mesh_path=str(tmp_path / f'{name}.stl'),
+                              mass=0.001))
+    built = []
+    for spec in (specs[0], specs[1], specs[0]):
+        with World(SceneSpec(ContainerSpec.tray(), spec, seed=4)) as world:
+            world.drop(3)
+            states = world.snapshot()
+            kept = conv.markers_msg(world, states, Time(sec=3), 'w/')
+            again = conv.markers_msg(world, states, Time(sec=3), 'w/')
+            conv._shapes_of = ((), [])
+            fresh = conv.markers_msg(world, states, Time(sec=3), 'w/')
+        assert kept == fresh and again == fresh
+        hulls = [m for m in kept.markers if m.type == Marker.TRIANGLE_LIST]
+        assert len(hulls) == 3
+        built.append(hulls[0].points)
+    assert built[0] == built[2] and built[0] != built[1]
