@@ -31,7 +31,8 @@ class TrayMotion:
 
 @dataclass(frozen=True)
 class Progress:
-    """Sent once per settle check. phase: 'dropping', 'vibrating' or 'settling'.
+    """Made at each settle check (the world node sends one at most every FEEDBACK_PERIOD
+    of wall time). phase: 'dropping', 'vibrating' or 'settling'.
 
     sim_time: s since the operation started. parts_moving: parts not at rest over the settle
     window. max_displacement: largest position change of a part over the window, m. tray: while
