@@ -50,10 +50,9 @@ from .world import World
 
 ZONES = {DropParts.Goal.ZONE_CONTAINER: 'container', DropParts.Goal.ZONE_FEEDER: 'feeder'}
 SHUTDOWN_WAIT = 10.0   # s a shutdown waits for a running physics operation
-# s of wall time between an action's feedback messages, at most (the first settle check's goes
-# at once): tqdm's mininterval, the rate a progress display redraws at. A settle check comes
-# every 50 ms of simulated time, hundreds a second of wall time on a few parts, and each
-# feedback message costs the world and its client a round of the executor.
+# s of wall time at least between an action's feedback messages (the first check's goes at
+# once): tqdm's mininterval, a progress display's redraw. Settle checks come hundreds a second
+# on a few parts, each message a round of the world's and its client's executors.
 FEEDBACK_PERIOD = 0.1
 
 
