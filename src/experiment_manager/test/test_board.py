@@ -279,6 +279,35 @@ def test_a_disc_capacitor_with_no_flat_faces_and_no_round_body_gets_grasps_acros
     assert all(np.allclose(p.grasp.grasp_point, np.round(part.mass_centre, 5)) for p in found)
 
 
+@pytest.mark.parametrize('tray, counts', [([120, 100, 20], (10, 70)), ([100, 80, 16], None)])
+def test_a_sweep_whose_last_count_does_not_fit_runs_on_the_counts_that_do(tmp_path, tray,
+                                                                          counts):
+    # the terminal block (1,268 mm^3): 75 fit a 120 x 100 x 20 mm tray within the packing
+    # limit 0.4, so the cell's sweep of 10..100 runs on 10..70 (70 + its margin 5 fit), and
+    # the feeder reading its range still runs; in a 100 x 80 x 16 mm tray 40 fit: 10..35 are
+    # fewer than the 4th-order fit's 5 counts, and the sweep is left out with its feeders
+    # (5 boards an hour: a refill of 80 fits the bin, which stays)
+    cell = yaml.safe_load(open(os.path.join(BOARDS, '..', 'board_cell.yaml')))
+    cell['board'] = {'pcb': os.path.abspath(PCB), 'models': os.path.abspath(MODELS),
+                     'boards_per_hour': 5}
+    cell['tray_mm'] = tray
+    path = tmp_path / 'cell.yaml'
+    path.write_text(yaml.safe_dump(cell))
+    files = write_parts(load_board(str(path)), str(tmp_path / 'parts'))
+    file, left = settle(files['Altech_AK300_1x02_P5.00mm_45-Degree'])
+    sweeps = {e.id: e.counts for e in file.experiments if e.id.startswith('sweep')}
+    if counts is None:
+        assert not sweeps and {e.id for e in file.experiments} == {
+            'emptying', 'emptying_station', 'emptying_cup'}
+        assert 'at most 40 within' in left['sweep'] and left['feeder'] == 'it names sweep'
+        return
+    assert sweeps == {s: tuple(range(counts[0], counts[1] + 1, 10))
+                      for s in ('sweep', 'sweep_cup') if s in sweeps} and 'sweep' in sweeps
+    assert 'feeder' in {e.id for e in file.experiments} and 'sweep' not in left
+    text = open(files['Altech_AK300_1x02_P5.00mm_45-Degree']).read()
+    assert '# sweep: counts.last 100 cut to 70: at most 75 of these parts fit' in text
+
+
 def test_the_built_in_cell_leaves_out_for_a_part_what_cannot_run_and_says_why(tmp_path):
     cell = yaml.safe_load(open(os.path.join(BOARDS, '..', 'board_cell.yaml')))
     cell['board'] = {'pcb': os.path.abspath(PCB), 'models': os.path.abspath(MODELS),

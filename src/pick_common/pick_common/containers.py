@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from .errors import check_vector, InvalidArgument, Limit
+from .errors import check_vector, DoesNotFit, InvalidArgument, Limit
 
 BIN = 'bin'
 TRAY = 'tray'
@@ -112,14 +112,14 @@ def check_container(spec: ContainerSpec) -> ContainerSpec:
 def check_fits(field: str, count: int, part_volume: float, spec: ContainerSpec) -> None:
     """The packing rule, for the world and the experiment file alike: `count` parts of
     `part_volume` m^3 may fill at most PACKING_LIMIT of the container's inner volume. Raises
-    InvalidArgument naming field, the count and the most that fit otherwise."""
+    DoesNotFit (an InvalidArgument) naming field, the count and the most that fit otherwise."""
     inner = math.prod(spec.inner_size)
     if count * part_volume > PACKING_LIMIT * inner:
         most = int(PACKING_LIMIT * inner / part_volume)
         size = ' x '.join(f'{s * 1000:g}' for s in spec.inner_size)
-        raise InvalidArgument(field, count, (
+        raise DoesNotFit(field, count, (
             f'parts do not fit a container of {size} mm: {part_volume * 1e9:.4g} mm^3 each, '
-            f'at most {most} within the packing limit {PACKING_LIMIT:g}'))
+            f'at most {most} within the packing limit {PACKING_LIMIT:g}'), most)
 
 
 def wall_boxes(spec: ContainerSpec) -> list[tuple[tuple[float, float, float],

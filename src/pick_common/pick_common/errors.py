@@ -40,6 +40,15 @@ class InvalidArgument(PickError):
         super().__init__(f'{field}: {value!r} {rule}')
 
 
+class DoesNotFit(InvalidArgument):
+    """Parts that do not fit their container (containers.check_fits); `most` is the most of
+    them that fit."""
+
+    def __init__(self, field: str, value: object, rule: str, most: int) -> None:
+        super().__init__(field, value, rule)
+        self.most = most
+
+
 class UnknownInstance(PickError):
     """An instance id that the scene does not have."""
 

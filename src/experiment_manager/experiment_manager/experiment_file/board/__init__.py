@@ -29,13 +29,14 @@ import re
 from typing import Any
 
 import numpy as np
-from pick_common.errors import InvalidArgument, MeshError
+from pick_common.errors import DoesNotFit, InvalidArgument, MeshError
 from pick_common.parts.solids import solid_mass, SolidMass
 from pydantic import BaseModel, ConfigDict
 import yaml
 
 from .. import loading
 from ..errors import read as read_keys
+from ..experiment_keys import Counts, TableSweepKeys
 from ..kinds import keys_model
 from ..model import MAX_FILE_BYTES, Requirements
 from ..schema import NamedGripper, RequirementsSection
@@ -48,6 +49,9 @@ from .parts import board_parts, BoardPart, DECIDE, NOT_THROUGH_HOLE, REFUSED
 # The experiments that hold a refill of the part: their `parts`, left out in a board file, is
 # each part's own refill.
 REFILLED = ('bin_emptying', 'feeder_emptying')
+# The fewest counts a table_sweep cut to what fits keeps: its 4th-order fit's five
+# (analysis.metrics.FIT_ORDER + 1); with fewer it is left out.
+FEWEST_COUNTS = 5
 
 __all__ = ['answer', 'Board', 'BoardPart', 'cut_side_by_side', 'DECIDE', 'expand', 'is_board',
            'load_board', 'NOT_THROUGH_HOLE', 'placement', 'record', 'REFUSED', 'settle',
@@ -265,10 +269,12 @@ def settle(path: str) -> tuple[Any, dict[str, str]]:
     """A part's experiment file at `path` read as a run reads it, with what cannot run for
     this part left out: a named gripper that cannot pick it (a cup too large for a resistor's
     body) and its experiments, and an experiment the part cannot run (240 terminal blocks do
-    not fit the bin). Those options are not feasible for this part; the others still run.
-    Returns (the ExperimentFile, per gripper or experiment left out the error that left it
-    out); the file is rewritten without them. InvalidArgument (or InvalidFile) for an error of
-    the part itself, or when no experiment is left."""
+    not fit the bin). Those options are not feasible for this part; the others still run. A
+    table_sweep whose last count does not fit the tray runs on the counts that do
+    (`_cut_to_fit`), its file saying so. Returns (the ExperimentFile, per gripper or
+    experiment left out the error that left it out); the file is rewritten without them.
+    InvalidArgument (or InvalidFile) for an error of the part itself, or when no experiment is
+    left."""
     dropped: dict[str, str] = {}
     while True:
         try:
@@ -284,6 +290,10 @@ def settle(path: str) -> tuple[Any, dict[str, str]]:
         with open(path, encoding='utf-8') as f:
             data = yaml.safe_load(f)
         experiments = data['experiments']
+        cut = _cut_to_fit(experiments, found)
+        if cut:                     # what it cuts may be all that was wrong: read it again
+            _rewrite(path, head + ''.join(f'# {note}\n' for note in cut), data)
+            continue
         left: set[str] = set()
         for m, e in found:
             if m.group(1):
@@ -312,6 +322,33 @@ def settle(path: str) -> tuple[Any, dict[str, str]]:
         data['experiments'] = kept
         if not data.get('grippers'):
             data.pop('grippers', None)
-        with open(path, 'w', encoding='utf-8') as f:
-            f.write(head + f'# left out for this part: {", ".join(sorted(left))}\n'
-                    + yaml.safe_dump(data, sort_keys=False))
+        _rewrite(path, head + f'# left out for this part: {", ".join(sorted(left))}\n', data)
+
+
+def _rewrite(path: str, head: str, data: Any) -> None:
+    with open(path, 'w', encoding='utf-8') as f:
+        f.write(head + yaml.safe_dump(data, sort_keys=False))
+
+
+def _cut_to_fit(experiments: list, found: list) -> list[str]:
+    """The table_sweeps of `experiments` whose last count does not fit the tray (`found`'s
+    DoesNotFit on their counts.last) cut to the last of their counts that fits with their
+    margin, when at least FEWEST_COUNTS are left: the sweep of a part too large for the
+    cell's counts runs on the counts that fit it (and a feeder reading its range, whose max
+    is checked the same way, holds no more than they). Returns a note per sweep cut."""
+    notes = []
+    for m, e in found:
+        if not (m.group(2) and isinstance(e, DoesNotFit) and e.field.endswith('.counts.last')):
+            continue
+        exp = experiments[int(m.group(2))]
+        counts = exp.get('counts') or {}
+        first = counts.get('first', Counts().first)
+        step = counts.get('step', Counts().step)
+        top = e.most - exp.get('margin', TableSweepKeys.model_fields['margin'].default)
+        last = first + (top - first) // step * step
+        if top < first or (last - first) // step + 1 < FEWEST_COUNTS:
+            continue
+        exp['counts'] = {**counts, 'first': first, 'last': last, 'step': step}
+        notes.append(f'{exp["id"]}: counts.last {e.value} cut to {last}: at most {e.most} of '
+                     'these parts fit the tray within the packing limit, with the margin')
+    return notes
