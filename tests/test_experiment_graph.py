@@ -141,9 +141,10 @@ def test_every_recorded_message_decodes_and_matches_the_results(graph_run):
         assert offers and {(o['reliability'], o['durability']) for o in offers} == {
             ('reliable', want)}, (c.topic, offers)
     tf_static = [msg for topic, _, msg in messages if topic == '/tf_static']
+    tf = [msg for topic, _, msg in messages if topic == '/tf']
     by_topic: dict[str, list] = {}
     for topic, _, msg in messages:
-        if topic != '/tf_static':
+        if topic not in ('/tf_static', '/tf'):
             by_topic.setdefault(topic[len(NS):], []).append(msg)
     workers = [f'/worker_{k}' for k in range(WORKERS)]
     assert set(by_topic) <= {'/progress', '/verdicts'} | {f'{w}/{t}' for w in workers for t in (
@@ -163,6 +164,23 @@ def test_every_recorded_message_decodes_and_matches_the_results(graph_run):
                 assert (scene.header.frame_id, inst.frame_id, inst.transform.translation.x,
                         inst.transform.translation.y, inst.transform.translation.z) in static
     assert len(tf_static) == len(iterations)
+    # /tf moves each part's frame, in which its markers are drawn (frame-locked), to its pose
+    # in every parts message.
+    poses = {(p.pose.header.frame_id, p.pose.header.frame_id.replace(
+        f'instance_{p.instance}', f'part_{p.id}'), round(p.pose.pose.position.x, 9))
+        for w in workers for m in by_topic[f'{w}/parts'] for p in m.parts}
+    assert poses == {(t.header.frame_id, t.child_frame_id, round(t.transform.translation.x, 9))
+                     for m in tf for t in m.transforms if t.child_frame_id.startswith(NS[1:])}
+    for w in workers:
+        drawn = [m for msg in by_topic[f'{w}/markers'] for m in msg.markers
+                 if m.ns.startswith('part_')]
+        assert drawn and all(m.frame_locked and m.header.frame_id == f'{NS[1:]}{w}/{m.ns}'
+                             for m in drawn)
+        # no more markers than parts messages, each drawing the parts of one of them
+        shown = {frozenset(p.id for p in m.parts) for m in by_topic[f'{w}/parts']}
+        assert len(by_topic[f'{w}/markers']) <= len(by_topic[f'{w}/parts'])
+        assert all(frozenset(int(m.ns[5:]) for m in msg.markers if m.ns.startswith('part_'))
+                   in shown for msg in by_topic[f'{w}/markers'])
     progress = by_topic['/progress'][-1]
     assert progress.iterations_done == progress.iterations_total == len(iterations)
 

@@ -111,6 +111,9 @@ def test_drop_50_parts_then_read_them_vibrate_and_remove(cell, client):
     kinds = [m.ns.split('_')[0] for m in markers[-1].markers[1:]]
     assert markers[-1].markers[0].action == Marker.DELETEALL
     assert kinds.count('container') == 5 and kinds.count('part') == 50 * 2  # body + leads
+    # each part's markers in its own frame, which /tf moves (frame-locked)
+    assert all(m.frame_locked and m.header.frame_id == FRAME.replace('instance_', m.ns)
+               for m in markers[-1].markers[1:] if m.ns != 'container')
 
     vibrate = cell.run(Vibrate, Vibrate.Goal())   # zeros: the node's default vibration
     assert vibrate.error_code == OK, vibrate.error_msg

@@ -1,16 +1,18 @@
 """What the world node's messages cost to build and serialise after each operation.
 
-The world publishes `parts` and `markers` after every drop, vibration and removal (a feeder run
-of the paper's test case makes about 600 of them). For capacitors settled on the tray (30) and
-in a 300 x 300 x 26 mm bin (480), prints the median time to build each message from a snapshot
-and to serialise it, and the markers' total as a multiple of the parts message's (same run).
+The world publishes `parts` and the parts' frames on `/tf` after every drop, vibration and
+removal (a feeder run of the paper's test case makes about 600 of them), `markers` when the
+parts change (they were published after each operation too). For capacitors settled on the tray
+(30) and in a 300 x 300 x 26 mm bin (480), prints the median time to build each message from a
+snapshot and to serialise it, and the markers' and the frames' totals as multiples of the parts
+message's (same run).
 
     tools/ws python -m bench.graph.bench_conversions [--repeat 30] [--part-file FILE [--count 8]]
 
 --part-file FILE: instead, `--count` parts of the experiment file's part (a board's part file,
 a CAD model whose collision pieces are hulls of thousands of points) settled on the tray; the
 markers are built with the part's shapes kept (as the world node builds them after its first
-operation) and built anew each call (as it did before), in one run.
+operation) and built anew each call (as it did before), and the parts' frames, in one run.
 """
 
 import argparse
@@ -58,14 +60,15 @@ def main() -> None:
             totals = {}
             for kind, build in (
                     ('parts', partial(common.states_to_msg, states, stamp, 'world', 'w/')),
-                    ('markers', partial(conv.markers_msg, world, states, stamp, 'w/'))):
+                    ('markers', partial(conv.markers_msg, world, states, stamp, 'w/')),
+                    ('tf', partial(conv.parts_tf_msg, states, stamp, 'w/'))):
                 build_ms, msg = median_ms(build, args.repeat)
                 serialize_ms, data = median_ms(partial(serialize_message, msg), args.repeat)
                 totals[kind] = build_ms + serialize_ms
                 print(f'{name}: {kind:<8} build {build_ms:7.2f} ms, serialise '
                       f'{serialize_ms:6.2f} ms, {len(data):8d} bytes')
             print(f'{name}: markers cost {totals["markers"] / totals["parts"]:.2f} x the parts '
-                  'message')
+                  f'message, the frames {totals["tf"] / totals["parts"]:.2f} x')
 
 
 def part_markers(args: argparse.Namespace, stamp: Time) -> None:
@@ -87,6 +90,10 @@ def part_markers(args: argparse.Namespace, stamp: Time) -> None:
             print(f'{args.count} parts, markers {label:<11}: build {build_ms:7.2f} ms, '
                   f'serialise {serialize_ms:6.2f} ms, {len(data):8d} bytes')
         print(f'{points} points in all')
+        build_ms, msg = median_ms(partial(conv.parts_tf_msg, states, stamp, 'w/'), args.repeat)
+        serialize_ms, data = median_ms(partial(serialize_message, msg), args.repeat)
+        print(f'{args.count} parts, frames on /tf     : build {build_ms:7.2f} ms, '
+              f'serialise {serialize_ms:6.2f} ms, {len(data):8d} bytes')
 
 
 if __name__ == '__main__':

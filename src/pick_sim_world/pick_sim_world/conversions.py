@@ -5,7 +5,6 @@ in pick_common.conversions.
 No rclpy here: messages are plain Python classes. Times are passed in as builtin Time messages.
 """
 
-from collections.abc import Sequence
 import copy
 
 from builtin_interfaces.msg import Time
@@ -15,7 +14,7 @@ from pick_common import containers
 from pick_common.conversions import contact_to_msg, container_to_msg, instance_frame, pose_msg
 from pick_common.parts.geometry import PartGeometry
 from pick_common.parts.primitives import Box, Cylinder
-from pick_common.states import PartStates, rotate
+from pick_common.states import PartStates
 from pick_msgs.msg import Instance as InstanceMsg
 from pick_msgs.msg import PartModel, Scene
 from shape_msgs.msg import Mesh, MeshTriangle, SolidPrimitive
@@ -88,15 +87,6 @@ _PART_COLOR = ColorRGBA(r=0.1, g=0.3, b=0.8, a=1.0)
 _ESCAPED_COLOR = ColorRGBA(r=0.9, g=0.1, b=0.1, a=1.0)
 
 
-def _quat_mul(a: np.ndarray, b: Sequence[float]) -> np.ndarray:
-    """Quaternion products a * b: a (N, 4), b (4,), xyzw; returns (N, 4)."""
-    ax, ay, az, aw = a.T
-    bx, by, bz, bw = b
-    return np.stack([aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
-                     aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz],
-                    axis=1)
-
-
 # The last part's marker shapes (`_shapes`): (its primitives, their shapes).
 _shapes_of: tuple[tuple, list] = ((), [])
 
@@ -126,18 +116,48 @@ def _shapes(primitives: tuple) -> list:
     return shapes
 
 
-def markers_msg(world: World, states: PartStates, stamp: Time, prefix: str) -> MarkerArray:
-    """Containers and parts as markers in their instance frames: one marker per collision
-    primitive (CUBE, CYLINDER) or hull (TRIANGLE_LIST). Starts with DELETEALL.
+def part_frame(prefix: str, part_id: int) -> str:
+    """Name of part `part_id`'s frame: its pose from its instance frame on /tf
+    (`parts_tf_msg`), its markers drawn in it."""
+    return f'{prefix}part_{part_id}'
 
-    The world publishes this after every operation, so the primitives' poses are computed for
-    all parts at once, and the parts' markers are copies of one per instance, colour and
-    primitive that share its header, scale, colour and hull points."""
+
+def parts_tf_msg(states: PartStates, stamp: Time, prefix: str) -> TFMessage:
+    """Each part's frame (`part_frame`) from its instance frame, for /tf: what moves the
+    parts' frame-locked markers after each operation (a few hundred bytes a part, where
+    markers of their hulls' points are megabytes)."""
+    headers: dict[int, Header] = {}
+    out = TFMessage()
+    for pid, inst, pose in zip(states.ids.tolist(), states.instances.tolist(),
+                               states.poses.tolist(), strict=True):
+        header = headers.get(inst)
+        if header is None:
+            header = headers[inst] = Header(stamp=stamp, frame_id=instance_frame(prefix, inst))
+        out.transforms.append(TransformStamped(
+            header=header, child_frame_id=part_frame(prefix, pid), transform=Transform(
+                translation=Vector3(x=pose[0], y=pose[1], z=pose[2]),
+                rotation=Quaternion(x=pose[3], y=pose[4], z=pose[5], w=pose[6]))))
+    return out
+
+
+def drawn(states: PartStates) -> tuple[bytes, bytes]:
+    """What the parts' markers show (`markers_msg`): which parts there are and which are
+    inside their container. Markers need publishing again only when it changes."""
+    return states.ids.tobytes(), states.inside.tobytes()
+
+
+def markers_msg(world: World, states: PartStates, stamp: Time, prefix: str) -> MarkerArray:
+    """Containers in their instance frames and parts in their own frames (`part_frame`,
+    frame-locked: a viewer moves them with the part's frame on /tf, `parts_tf_msg`): one
+    marker per collision primitive (CUBE, CYLINDER) or hull (TRIANGLE_LIST) at its pose in
+    the part. Starts with DELETEALL. Publish it again when `drawn` changes.
+
+    A part's markers are copies of one per colour and primitive that share its scale,
+    colour, pose and hull points."""
     out = MarkerArray(markers=[Marker(action=Marker.DELETEALL)])
-    headers = {}
     marker_id = 0
     for inst in world.instances:
-        header = headers[inst.id] = Header(stamp=stamp, frame_id=instance_frame(prefix, inst.id))
+        header = Header(stamp=stamp, frame_id=instance_frame(prefix, inst.id))
         for half, center in containers.wall_boxes(world.scene.container):
             out.markers.append(Marker(
                 header=header, ns='container', id=marker_id, type=Marker.CUBE,
@@ -149,29 +169,21 @@ def markers_msg(world: World, states: PartStates, stamp: Time, prefix: str) -> M
         return out
     primitives = world.part.primitives
     shapes = _shapes(primitives)
-    q = states.poses[:, 3:]
-    # (N, K, 3) positions and (N, K, 4) orientations of primitive k of part n.
-    positions = np.stack([states.poses[:, :3] + rotate(q, np.asarray(p.position, dtype=float))
-                          for p in primitives], axis=1).tolist()
-    orientations = np.stack([_quat_mul(q, p.orientation) for p in primitives], axis=1).tolist()
-    # Per instance, colour and primitive, one marker to copy: a copy shares the fields every
-    # part's marker has in common and skips the type checks a Marker built from keywords makes
-    # on each (building 1.8 to 2.2 times faster: bench/graph/bench_conversions.py).
-    templates: dict[tuple[int, bool, int], Marker] = {}
-    for pid, inst, inside, part_positions, part_orientations in zip(
-            states.ids.tolist(), states.instances.tolist(), states.inside.tolist(), positions,
-            orientations, strict=True):
+    # Per colour and primitive, one marker to copy: a copy shares the fields every part's
+    # marker has in common and skips the type checks a Marker built from keywords makes on
+    # each (building 1.8 to 2.2 times faster: bench/graph/bench_conversions.py).
+    templates = {(inside, k): Marker(
+        id=k, type=kind, scale=scale, points=points, frame_locked=True,
+        pose=pose_msg(p.position, p.orientation),
+        color=_PART_COLOR if inside else _ESCAPED_COLOR)
+        for inside in (True, False) for k, (p, (kind, scale, points))
+        in enumerate(zip(primitives, shapes, strict=True))}
+    for pid, inside in zip(states.ids.tolist(), states.inside.tolist(), strict=True):
+        header = Header(stamp=stamp, frame_id=part_frame(prefix, pid))
         ns = f'part_{pid}'
-        for k, (position, orientation) in enumerate(zip(part_positions, part_orientations,
-                                                        strict=True)):
-            template = templates.get((inst, inside, k))
-            if template is None:
-                kind, scale, points = shapes[k]
-                template = templates[inst, inside, k] = Marker(
-                    header=headers[inst], id=k, type=kind, scale=scale, points=points,
-                    color=_PART_COLOR if inside else _ESCAPED_COLOR)
-            marker = copy.copy(template)
+        for k in range(len(primitives)):
+            marker = copy.copy(templates[inside, k])
+            marker.header = header
             marker.ns = ns
-            marker.pose = pose_msg(position, orientation)
             out.markers.append(marker)
     return out

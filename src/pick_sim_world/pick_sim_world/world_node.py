@@ -1,8 +1,8 @@
 """The `world` node: a thin ROS 2 wrapper around `pick_sim_world.world.World`.
 
-Topics `parts`, `scene` (latched), `markers` (latched); actions `drop_parts`, `vibrate`,
-`remove_parts`; services `reset_scene`, `get_parts`. All names are relative: run it under a
-namespace (`--ros-args -r __ns:=/worker_1`) to make a worker.
+Topics `parts`, `scene` (latched), `markers` (latched, in the parts' frames on /tf); actions
+`drop_parts`, `vibrate`, `remove_parts`; services `reset_scene`, `get_parts`. Names are
+relative: run it under a namespace (`--ros-args -r __ns:=/worker_1`) to make a worker.
 
 One physics operation runs at a time. A goal or reset that arrives while one runs is answered
 at once with error BUSY (not queued); `get_parts` answers from the last settled snapshot and
@@ -75,8 +75,10 @@ class WorldNode(Node):
                                                   qos_overriding_options=qos_options)
         self._reports_pub = self.create_publisher(SettleReportMsg, 'settle_reports', 10,
                                                   qos_overriding_options=qos_options)
-        # Absolute, as tf2_ros's static broadcaster: every worker's frames on the one topic.
+        # Absolute, as tf2_ros's broadcasters: every worker's frames on the one topic each.
         self._tf_static_pub = self.create_publisher(TFMessage, '/tf_static', LATCHED)
+        self._tf_pub = self.create_publisher(TFMessage, '/tf', 100)   # tf2_ros's depth
+        self._drawn = None          # what the last markers showed (conversions.drawn)
         self.create_service(ResetScene, 'reset_scene', self._reset_scene, callback_group=group)
         self.create_service(GetParts, 'get_parts', self._get_parts, callback_group=group)
         for action_type, name, execute in ((DropParts, 'drop_parts', self._drop_parts),
@@ -217,8 +219,8 @@ class WorldNode(Node):
                           '(its horizontal part turned by a random angle per vibration) or '
                           f'{CENTRE} (its horizontal part toward the tray centre from the '
                           "parts' centroid)"))
-        self._publish_markers = get('publish_markers', True, 'publish `markers` after each '
-                                    'operation')
+        self._publish_markers = get('publish_markers', True, 'publish `markers` when the '
+                                    'parts change, their frames on /tf after each operation')
         self._mesh_dirs = declare_mesh_dirs(self)
         return scene, physics, check_vibration(vibration)
 
@@ -227,15 +229,17 @@ class WorldNode(Node):
         """Publish the current snapshot (and the scene when it changed); return the parts."""
         stamp = self.get_clock().now().to_msg()
         if scene_changed:
-            self._scene_msg = conv.scene_to_msg(self._world, stamp, self._frame_id,
-                                                self._prefix)
+            self._scene_msg = conv.scene_to_msg(self._world, stamp, self._frame_id, self._prefix)
             self._scene_pub.publish(self._scene_msg)
             self._tf_static_pub.publish(conv.tf_static_msg(self._scene_msg))
         parts = common.states_to_msg(self._states, stamp, self._frame_id, self._prefix)
         self._parts_pub.publish(parts)
         if self._publish_markers:
-            self._markers_pub.publish(conv.markers_msg(self._world, self._states, stamp,
-                                                       self._prefix))
+            self._tf_pub.publish(conv.parts_tf_msg(self._states, stamp, self._prefix))
+            if scene_changed or conv.drawn(self._states) != self._drawn:
+                self._drawn = conv.drawn(self._states)
+                self._markers_pub.publish(conv.markers_msg(self._world, self._states, stamp,
+                                                           self._prefix))
         return parts
 
     def _parts_msg(self, instances) -> PartArray:
@@ -263,11 +267,9 @@ class WorldNode(Node):
             if request.keep_scene:
                 self._world.reset(seed=request.seed)
             else:
-                self._world.reset(SceneSpec(
-                    common.container_from_msg(request.container),
-                    common.part_spec_from_msg(request.part_model, self._mesh_dirs),
-                    request.instance_count,
-                    request.seed))
+                part = common.part_spec_from_msg(request.part_model, self._mesh_dirs)
+                self._world.reset(SceneSpec(common.container_from_msg(request.container), part,
+                                            request.instance_count, request.seed))
 
         if self._guarded(reset, response):
             self._states = self._world.snapshot()
@@ -318,8 +320,7 @@ class WorldNode(Node):
 
         ok = self._guarded(lambda: settle.append(operation(progress)), result)
         if self._stopping:
-            # Shutting down: the context may be gone, and with it every publisher; rclpy
-            # reports the goal aborted if it still can.
+            # shutting down: the context and its publishers may be gone (rclpy aborts the goal)
             return result
         if ok:
             report = settle[0]
@@ -360,9 +361,8 @@ class WorldNode(Node):
 
         def vibrate(progress) -> SettleReport:
             vibration = common.vibration_from_msg(goal.vibration, self._vibration)
-            return self._world.vibrate(
-                vibration, instances,
-                common.or_default('max_settle_time', goal.max_settle_time, None), progress)
+            return self._world.vibrate(vibration, instances, common.or_default(
+                'max_settle_time', goal.max_settle_time, None), progress)
 
         return self._execute(Vibrate, goal_handle, Vibrate.Result(), vibrate, instances)
 

@@ -21,6 +21,7 @@ RECORDED = (('parts', PartArray), ('scene', Scene), ('markers', MarkerArray),
             ('settle_reports', SettleReport), ('results', ValidityReport),
             ('feeder/state', FeederState))
 TF_STATIC = '/tf_static'
+TF = '/tf'              # the parts' frames, in which the worlds draw their markers
 QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 DRAIN_QUIET = 0.3       # s without a message before a recording is handed back
 DRAIN_LIMIT = 3.0       # s at most spent waiting for the last messages
@@ -28,8 +29,8 @@ DRAIN_LIMIT = 3.0       # s at most spent waiting for the last messages
 
 class TopicRecorder:
     """Subscribes to the RECORDED topics of each worker added (a namespace relative to
-    `namespace`) and to /tf_static, and writes what arrives to the recorder given to start(),
-    until stop()."""
+    `namespace`) and to /tf_static and /tf, and writes what arrives to the recorder given to
+    start(), until stop()."""
 
     def __init__(self, name: str, namespace: str, context=None) -> None:
         # Not the process's global arguments: launch names a node with `-r __node:=NAME`,
@@ -41,10 +42,12 @@ class TopicRecorder:
         self._recorder: Recorder | None = None
         self._last = 0.0
         self._since = 0           # ns, system time: when the recording started
-        # The instance frames of every worker (each world publishes its own): one topic.
-        self.node.create_subscription(TFMessage, TF_STATIC,
-                                      self._callback(TF_STATIC, type_name(TFMessage)), QOS,
-                                      raw=True)
+        # The instance and part frames of every worker (each world publishes its own): one
+        # topic each.
+        for topic in (TF_STATIC, TF):
+            self.node.create_subscription(TFMessage, topic,
+                                          self._callback(topic, type_name(TFMessage)), QOS,
+                                          raw=True)
         self._executor = SingleThreadedExecutor(context=context)
         self._executor.add_node(self.node)
         self._thread = threading.Thread(target=self._spin, name=name, daemon=True)
