@@ -4,7 +4,7 @@ operation ended, and its progress. Shared by the world, its conversions and the 
 Pure: numpy only. Poses are (N, 7) float64, xyz in metres then an xyzw unit quaternion.
 """
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -36,14 +36,20 @@ class Progress:
 
     sim_time: s since the operation started. parts_moving: parts not at rest over the settle
     window. max_displacement: largest position change of a part over the window, m. tray: while
-    vibrating, the motion the tray delivered so far (None otherwise).
+    vibrating, the motion the tray delivered so far (None otherwise), fitted to every step so far
+    when read (`delivered`): read it at the check, as the world node does for the one check in
+    many it sends, and no other check pays for the fit.
     """
 
     phase: str
     sim_time: float
     parts_moving: int
     max_displacement: float
-    tray: TrayMotion | None = None
+    delivered: Callable[[], TrayMotion | None] | None = field(default=None, repr=False)
+
+    @property
+    def tray(self) -> TrayMotion | None:
+        return None if self.delivered is None else self.delivered()
 
 
 @dataclass

@@ -396,5 +396,6 @@ class World:
 
 
 def _with_tray(progress: ProgressCallback, drive: TrayDrive, p: Progress) -> bool:
-    """Tell `progress` of a vibration's step with the motion the trays delivered so far."""
-    return progress(replace(p, tray=drive.motion()))
+    """Tell `progress` of a vibration's step with the motion the trays delivered so far (fitted
+    if it reads it: Progress.tray)."""
+    return progress(replace(p, delivered=drive.motion))

@@ -17,7 +17,7 @@ from pick_common.states import quaternion_angles, rotate
 from pick_sim_world import spawning
 from pick_sim_world.config import PhysicsConfig
 from pick_sim_world.stepping import speed_limit
-from pick_sim_world.tray import centring_share, vibration_amplitude
+from pick_sim_world.tray import centring_share, TrayDrive, vibration_amplitude
 from pick_sim_world.world import World
 import pytest
 import trimesh
@@ -101,6 +101,34 @@ def test_vibration_scatters_and_turns_parts_and_the_tray_returns_home():
     assert np.median(moved) > 0.005, 'a vibration must move most parts by millimetres'
     assert (turned > math.radians(90)).sum() >= 1, 'some parts must turn over'
     assert np.allclose(home, tray.origin, atol=1e-4)
+
+
+def test_a_vibration_fits_the_delivered_motion_only_for_the_checks_that_read_it(monkeypatch):
+    """The motion delivered so far is fitted to every step so far: at each settle check that
+    was most of a feeder run's bookkeeping, for the one check in many the world node sends."""
+    fits = []
+    motion = TrayDrive.motion
+
+    def counted(drive):
+        fits.append(1)
+        return motion(drive)
+
+    monkeypatch.setattr(TrayDrive, 'motion', counted)
+    vibration = Vibration(amplitude=(0.002, 0.0, 0.002), frequency=26.0, duration=0.5,
+                          direction=FIXED)
+    with _world(ContainerSpec.tray()) as world:
+        world.drop(5)
+        checks, read = [], []
+        report = world.vibrate(vibration, progress=lambda p: checks.append(p.phase) or True)
+        assert checks.count('vibrating') >= 5 and len(fits) == 1    # the report's, at the end
+        fits.clear()
+        world.vibrate(vibration, progress=lambda p: read.append((p.phase, p.tray)) or True)
+    shaking = [t for phase, t in read if phase == 'vibrating']
+    shaken = [t for t in shaking if t is not None]         # None before three steps
+    assert len(fits) == len(shaking) + 1 and len(shaken) >= 4
+    assert all(t is None for phase, t in read if phase != 'vibrating')
+    assert all(t.amplitude == pytest.approx(report.tray.amplitude) for t in shaken)
+    assert shaken[-1].error < 0.05
 
 
 @pytest.mark.parametrize('time_step', [1 / 240, 1 / 480, 1 / 1000])
