@@ -396,6 +396,5 @@ class World:
 
 
 def _with_tray(progress: ProgressCallback, drive: TrayDrive, p: Progress) -> bool:
-    """Tell `progress` of a vibration's step with the motion the trays delivered so far (fitted
-    if it reads it: Progress.tray)."""
+    """Tell `progress` of a vibration's step with the trays' motion so far (Progress.tray)."""
     return progress(replace(p, delivered=drive.motion))
