@@ -180,7 +180,7 @@ def markers_msg(world: World, states: PartStates, stamp: Time, prefix: str) -> M
         in enumerate(zip(primitives, shapes, strict=True))}
     for pid, inside in zip(states.ids.tolist(), states.inside.tolist(), strict=True):
         header = Header(stamp=stamp, frame_id=part_frame(prefix, pid))
-        ns = f'part_{pid}'
+        ns = part_frame('', pid)            # the namespace: the frame's name, unprefixed
         for k in range(len(primitives)):
             marker = copy.copy(templates[inside, k])
             marker.header = header
