@@ -1,6 +1,7 @@
 """GraphBackend, the manager's side of a worker, against real node processes over DDS."""
 
 import threading
+import uuid
 
 from experiment_manager import experiment_file
 from experiment_manager.graph.graph_backend import GraphBackend, WorkerGone
@@ -62,3 +63,39 @@ def test_a_world_started_again_between_two_calls_ends_the_iteration(backend):
     graph.reset(bin_spec, seed=5)
     again, _ = graph.drop(10, 'container')
     assert again.poses.tolist() == states.poses.tolist()
+
+
+class AskingForAnotherGoal:
+    """The client's handle, asking for the result of a goal id the server never had: what it
+    answers a goal it dropped after result_timeout (tests/test_action_result.py)."""
+
+    def __init__(self, handle) -> None:
+        self._handle = handle
+
+    def send_result_request(self, request):
+        request.goal_id.uuid = list(uuid.uuid4().bytes)
+        return self._handle.send_result_request(request)
+
+    def __getattr__(self, name):
+        return getattr(self._handle, name)
+
+    def __enter__(self):
+        return self._handle.__enter__()
+
+    def __exit__(self, *exc):
+        return self._handle.__exit__(*exc)
+
+
+def test_a_result_the_world_no_longer_had_ends_the_iteration(backend):
+    """The world did the operation, but its answer is an empty result (status UNKNOWN) that
+    would read as a success with no parts: the iteration must run again (WorkerGone)."""
+    graph, _ = backend
+    graph.reset(experiment_file.load(SMALL).experiment('bins').bins[0], seed=5)
+    states, _ = graph.drop(3, 'container')
+    client = graph._remove
+    client._client_handle = AskingForAnotherGoal(client._client_handle)
+    try:
+        with pytest.raises(WorkerGone, match='remove_parts: the server no longer had the goal'):
+            graph.remove([int(states.ids[0])])
+    finally:
+        client._client_handle = client._client_handle._handle

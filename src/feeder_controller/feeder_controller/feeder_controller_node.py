@@ -13,6 +13,7 @@ from pick_common.errors import CodedError, InvalidArgument
 from pick_common.node_runner import (
     answer_error,
     declare,
+    goal_result,
     LATCHED,
     probe,
     PROBE_WAIT,
@@ -102,12 +103,14 @@ class FeederControllerNode(Node):
 
     async def _world(self, client: LockedActionClient, goal, name: str):
         """Send a goal to the world's action `name` and await its result. Raises CodedError
-        with the world's own error code, or INTERNAL when it is not there or leaves."""
+        with the world's own error code, or INTERNAL when it is not there, leaves, or no longer
+        has the goal when its result is asked for (node_runner.goal_result)."""
         ids = await self._answering(client, name)
         handle = await self._watched(client.send_goal_async(goal), {client: ids}, name)
         if not handle.accepted:
             raise CodedError(ERROR_INTERNAL, f'the world rejected {name}')
-        result = (await self._watched(handle.get_result_async(), {client: ids}, name)).result
+        result = goal_result(await self._watched(handle.get_result_async(), {client: ids}, name),
+                             f'world {name}')
         if result.error_code != ERROR_NONE:
             raise CodedError(result.error_code, f'world {name}: {result.error_msg}')
         return result

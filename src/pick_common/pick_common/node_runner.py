@@ -12,6 +12,7 @@ import time
 import traceback
 import uuid
 
+from action_msgs.msg import GoalStatus
 from action_msgs.srv import CancelGoal
 from rcl_interfaces.msg import (
     FloatingPointRange,
@@ -83,6 +84,20 @@ def server_ready(client) -> bool:
 def serving(node: Node, clients: Iterable) -> dict:
     """client -> the DDS ids of its servers now (server_ids), to hand a ServerWatch."""
     return {c: server_ids(node, c) for c in clients}
+
+
+def goal_result(response, what: str):
+    """The result of an action's get_result answer `response`. Raises CodedError (INTERNAL)
+    when the server no longer had the goal: rclpy drops a finished goal RESULT_KEEP s after it
+    ended (its server's result_timeout) and answers a later request with status UNKNOWN and
+    an empty result, whose error_code 0 would read as a success with no parts and no report
+    (rclpy's ActionServer._execute_get_result_request; tests/test_action_result.py)."""
+    if response.status == GoalStatus.STATUS_UNKNOWN:
+        raise CodedError(ERROR_INTERNAL, (
+            f'{what}: the server no longer had the goal when its result was asked for (a server '
+            'keeps a finished goal for its result_timeout; ours keep one '
+            f'{RESULT_KEEP:g} s): the request came too late, or the server was started again'))
+    return response.result
 
 
 class ServerWatch:

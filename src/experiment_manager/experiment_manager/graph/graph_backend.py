@@ -17,6 +17,7 @@ from pick_common.containers import ContainerSpec
 from pick_common.errors import CodedError, PhysicsFault
 from pick_common.node_runner import (
     endpoint_name,
+    goal_result,
     GONE_AFTER,
     handshake,
     server_ready,
@@ -194,10 +195,14 @@ class GraphBackend:
         if not handle.accepted:
             raise GraphError(CheckParts.Response.INTERNAL, f'{what}: the goal was rejected')
         try:
-            result = self._wait(handle.get_result_async(), client, what).result
+            answer = self._wait(handle.get_result_async(), client, what)
         except GraphError:
             handle.cancel_goal_async()
             raise
+        try:
+            result = goal_result(answer, what)
+        except CodedError as exc:   # the goal ran, its answer is lost: run the iteration again
+            raise WorkerGone(exc.code, str(exc)) from exc
         self._raise_on_error(result, what)
         return result
 
