@@ -1,8 +1,9 @@
 """An experiment file on the cores in this process (LocalBackend), through the graph with one
 worker and with two (the `run` command: node processes over DDS), in one run: wall time per
 iteration and type, the graph's ratio to the cores, the throughput of two workers against
-one, the peak memory of each worker's processes, and whether the result files of the three are
-identical (they must be).
+one, the peak memory of each worker's processes and the CPU time of each node over the run
+against the cores' (this process's), and whether the result files of the three are identical
+(they must be).
 
     tools/ws python -m bench.experiment.bench_experiment [FILE] [--iterations N] [--workers 1 2]
         [--rounds R] [--paper-case RUN_DIR ...]
@@ -60,31 +61,45 @@ def per_type(directory: str) -> tuple[dict[str, float], dict[str, int]]:
     return wall, count
 
 
+def span_times(directory: str) -> tuple[float, float]:
+    """When the run directory was made (experiment.yaml) and its last summary written: the
+    run's iterations without starting the processes or writing the report (epoch s)."""
+    return (os.path.getmtime(os.path.join(directory, 'experiment.yaml')),
+            os.path.getmtime(os.path.join(directory, 'summary.json')))
+
+
 def run_span(directory: str) -> float:
-    """From the run directory's creation (experiment.yaml) to the last summary: the run's
-    iterations without starting the processes or writing the report."""
-    return (os.path.getmtime(os.path.join(directory, 'summary.json'))
-            - os.path.getmtime(os.path.join(directory, 'experiment.yaml')))
+    """span_times' length, s."""
+    start, end = span_times(directory)
+    return end - start
 
 
-class PeakMemory:
-    """Polls the peak resident memory (VmHWM) of the node processes under `namespace`."""
+class NodeUsage:
+    """Polls the node processes under `namespace`: each one's peak resident memory (VmHWM, kB)
+    and its CPU time (utime + stime, s) at each poll, every POLL s (`cpu_between`)."""
+
+    POLL = 0.5
 
     def __init__(self, namespace: str) -> None:
         self.namespace, self.peak_kb = namespace, {}
+        self._cpu: dict[tuple[str, str], list[tuple[float, float]]] = {}
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._poll, daemon=True)
         self._thread.start()
 
     def _poll(self) -> None:
         pattern = re.compile(r'lib/\w+/(\w+) --ros-args -r __ns:=\S*?(/worker_\d+)?(?: |$)')
-        while not self._stop.wait(0.5):
+        tick = os.sysconf('SC_CLK_TCK')
+        while not self._stop.wait(self.POLL):
             for pid in os.listdir('/proc'):
                 try:
                     cmd = open(f'/proc/{pid}/cmdline', 'rb').read().replace(b'\0', b' ').decode()
                     if f'__ns:={self.namespace}' not in cmd:
                         continue
                     status = open(f'/proc/{pid}/status').read()
+                    # after the command's name in parentheses: utime and stime are the 12th
+                    # and 13th fields (proc(5): 14 and 15 of the whole line)
+                    stat = open(f'/proc/{pid}/stat').read().rsplit(')', 1)[1].split()
                 except (OSError, ValueError):
                     continue
                 m = pattern.search(cmd)
@@ -92,43 +107,54 @@ class PeakMemory:
                 if m and hwm:
                     key = ((m.group(2) or '').strip('/'), m.group(1))
                     self.peak_kb[key] = max(self.peak_kb.get(key, 0), int(hwm.group(1)))
+                    self._cpu.setdefault(key, []).append(
+                        (time.time(), (int(stat[11]) + int(stat[12])) / tick))
 
-    def stop(self) -> dict[tuple[str, str], int]:
+    def stop(self) -> 'NodeUsage':
         self._stop.set()
         self._thread.join()
-        return self.peak_kb
+        return self
+
+    def cpu_between(self, start: float, end: float) -> dict[tuple[str, str], float]:
+        """Each node's CPU time, s, from its last poll at or before `start` to its last at or
+        before `end` (epoch s): within a poll of the span at either end."""
+        def at(series: list, t: float) -> float:
+            return max((cpu for when, cpu in series if when <= t), default=0.0)
+        return {key: at(series, end) - at(series, start) for key, series in self._cpu.items()}
 
 
-def graph(path: str, work: str, workers: int) -> tuple[str, float, dict]:
+def graph(path: str, work: str, workers: int) -> tuple[str, float, dict, dict]:
     namespace = f'/bench_{os.getpid()}_{workers}'
-    memory = PeakMemory(namespace)
+    usage = NodeUsage(namespace)
     start = time.perf_counter()
     done = subprocess.run([executable('experiment_manager', 'run'), path, '--output',
                            os.path.join(work, f'graph_{workers}'), '--namespace', namespace,
                            '--workers', str(workers)], capture_output=True, text=True)
     wall = time.perf_counter() - start
-    peaks = memory.stop()
+    usage.stop()
     if done.returncode != 0:
         sys.exit(f'run --workers {workers} failed:\n{done.stderr}')
-    return re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1), wall, peaks
+    results = re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1)
+    return results, wall, usage.peak_kb, usage.cpu_between(*span_times(results))
 
 
 def one_round(file, path: str, work: str, a: int, b: int) -> dict:
     """The file on the cores, then through the graph with `a` and with `b` workers: wall time
     per type, spans, peak memory and whether the result files are identical."""
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     local_dir = os.path.join(work, 'local')
     with LocalBackend() as backend, ResultsWriter(local_dir, file.text) as writer:
         Runner(file, [backend], writer).run()
-    local_wall = time.perf_counter() - start
-    dir_a, wall_a, mem_a = graph(path, work, a)
-    dir_b, wall_b, mem_b = graph(path, work, b)
+    local_wall, local_cpu = time.perf_counter() - start, time.process_time() - cpu
+    dir_a, wall_a, mem_a, cpu_a = graph(path, work, a)
+    dir_b, wall_b, mem_b, cpu_b = graph(path, work, b)
     identical = all(rows(d, name, ('wall_time',)) == rows(local_dir, name, ('wall_time',))
                     for d in (dir_a, dir_b) for name in FILES)
     (g, count), (c, _) = per_type(dir_a), per_type(local_dir)
     return {'graph': g, 'cores': c, 'count': count, 'identical': identical,
             'span_a': run_span(dir_a), 'span_b': run_span(dir_b), 'local_wall': local_wall,
-            'wall_a': wall_a, 'wall_b': wall_b, 'mem_a': mem_a, 'mem_b': mem_b}
+            'wall_a': wall_a, 'wall_b': wall_b, 'mem_a': mem_a, 'mem_b': mem_b,
+            'local_cpu': local_cpu, 'cpu_a': cpu_a, 'cpu_b': cpu_b}
 
 
 def main() -> int:
@@ -213,6 +239,17 @@ def main() -> int:
         print(f'peak memory, {workers} worker(s): per worker (3 processes) '
               + ', '.join(f'{w} {kb / 1024:.0f} MiB' for w, kb in sorted(per_worker.items()))
               + f'; worker_0 and manager by node (MiB): {nodes}')
+    for workers, key in ((a, 'cpu_a'), (b, 'cpu_b')):
+        by_node: dict[str, float] = collections.defaultdict(float)
+        for x in rounds:
+            for (_, node), seconds in x[key].items():
+                by_node[node] += seconds
+        cores = sum(x['local_cpu'] for x in rounds)
+        total = sum(by_node.values())
+        print(f'CPU of the nodes over the run, {workers} worker(s), s (all workers): '
+              + ', '.join(f'{node} {s:.1f}' for node, s in sorted(by_node.items()))
+              + f'; {total:.1f} in all, x{total / cores:.2f} the {cores:.1f} of the cores (this '
+              'process, the same iterations)')
     print(f'result files identical (wall times aside): {identical}')
     if args.paper_case:
         print()
