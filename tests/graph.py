@@ -1,4 +1,5 @@
-"""Helpers for graph tests: node processes, a client node, a steady-clock wait.
+"""Helpers for graph tests: node processes, a client node, a steady-clock wait, a wrapper of
+an action client's rcl handle.
 
 Nodes run as real processes started from their installed executables (the path `ros2 run`
 uses) and talk to the test's client node over DDS on loopback.
@@ -55,6 +56,28 @@ def stop_all(procs) -> None:
     codes = [proc.stop() for proc in procs]
     for proc, code in zip(procs, codes, strict=True):
         assert code == 0, f'{proc.name} exited with {code} on SIGINT:\n{proc.output()}'
+
+
+class WrappedHandle:
+    """An action client's rcl handle (`client._client_handle`) passed through, for a test to
+    change one of its requests; `unwrap` puts the handle back."""
+
+    def __init__(self, handle) -> None:
+        self._handle = handle
+
+    def __getattr__(self, name):
+        return getattr(self._handle, name)
+
+    def __enter__(self):
+        return self._handle.__enter__()
+
+    def __exit__(self, *exc):
+        return self._handle.__exit__(*exc)
+
+    @staticmethod
+    def unwrap(client) -> None:
+        handle = client._client_handle
+        client._client_handle = handle._handle if isinstance(handle, WrappedHandle) else handle
 
 
 class Client:

@@ -7,6 +7,7 @@ LockedActionClient can go), the manager's LockedActionClient does not."""
 import threading
 import time
 
+from graph import WrappedHandle
 from pick_common.rclpy_adapter import LockedActionClient
 from pick_msgs.action import DropParts
 import pytest
@@ -17,26 +18,14 @@ from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 
 
-class SlowToRegister:
-    """The client's handle, pausing after each goal request is sent: the answer arrives and is
-    taken by the spinning thread before send_goal_async registers the request."""
-
-    def __init__(self, handle) -> None:
-        self._handle = handle
+class SlowToRegister(WrappedHandle):
+    """Pauses after each goal request is sent: the answer arrives and is taken by the spinning
+    thread before send_goal_async registers the request."""
 
     def send_goal_request(self, request):
         sequence = self._handle.send_goal_request(request)
         time.sleep(0.3)
         return sequence
-
-    def __getattr__(self, name):
-        return getattr(self._handle, name)
-
-    def __enter__(self):
-        return self._handle.__enter__()
-
-    def __exit__(self, *exc):
-        return self._handle.__exit__(*exc)
 
 
 @pytest.mark.parametrize('client_type, answered', [(ActionClient, False),
@@ -65,8 +54,7 @@ def test_a_goal_sent_while_another_thread_spins_gets_its_answer(client_type, ans
             time.sleep(0.01)
         assert future.done() == answered
     finally:
-        client._client_handle = getattr(client._client_handle, '_handle',
-                                        client._client_handle)
+        WrappedHandle.unwrap(client)
         executor.shutdown(timeout_sec=2.0)
         client.destroy()
         server.destroy()

@@ -83,4 +83,3 @@ def _done(future) -> bool:
     event = threading.Event()
     future.add_done_callback(lambda _: event.set())
     return event.wait(WAIT)
-

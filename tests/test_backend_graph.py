@@ -5,7 +5,7 @@ import uuid
 
 from experiment_manager import experiment_file
 from experiment_manager.graph.graph_backend import GraphBackend, WorkerGone
-from graph import NodeProcess, SMALL, stop_all, unique_namespace
+from graph import NodeProcess, SMALL, stop_all, unique_namespace, WrappedHandle
 import pytest
 import rclpy
 from rclpy.callback_groups import ReentrantCallbackGroup
@@ -65,25 +65,13 @@ def test_a_world_started_again_between_two_calls_ends_the_iteration(backend):
     assert again.poses.tolist() == states.poses.tolist()
 
 
-class AskingForAnotherGoal:
-    """The client's handle, asking for the result of a goal id the server never had: what it
-    answers a goal it dropped after result_timeout (tests/test_action_result.py)."""
-
-    def __init__(self, handle) -> None:
-        self._handle = handle
+class AskingForAnotherGoal(WrappedHandle):
+    """Asks for the result of a goal id the server never had: what it answers a goal it
+    dropped after result_timeout (tests/test_action_result.py)."""
 
     def send_result_request(self, request):
         request.goal_id.uuid = list(uuid.uuid4().bytes)
         return self._handle.send_result_request(request)
-
-    def __getattr__(self, name):
-        return getattr(self._handle, name)
-
-    def __enter__(self):
-        return self._handle.__enter__()
-
-    def __exit__(self, *exc):
-        return self._handle.__exit__(*exc)
 
 
 def test_a_result_the_world_no_longer_had_ends_the_iteration(backend):
@@ -98,4 +86,4 @@ def test_a_result_the_world_no_longer_had_ends_the_iteration(backend):
         with pytest.raises(WorkerGone, match='remove_parts: the server no longer had the goal'):
             graph.remove([int(states.ids[0])])
     finally:
-        client._client_handle = client._client_handle._handle
+        WrappedHandle.unwrap(client)

@@ -95,8 +95,8 @@ def goal_result(response, what: str):
     if response.status == GoalStatus.STATUS_UNKNOWN:
         raise CodedError(ERROR_INTERNAL, (
             f'{what}: the server no longer had the goal when its result was asked for (a server '
-            'keeps a finished goal for its result_timeout; ours keep one '
-            f'{RESULT_KEEP:g} s): the request came too late, or the server was started again'))
+            f'keeps a finished goal for its result_timeout, ours {RESULT_KEEP:g} s): the request '
+            'came too late, or the server was started again'))
     return response.result
 
 
