@@ -71,7 +71,7 @@ def test_a_result_asked_for_after_the_server_dropped_the_goal_is_an_error(privat
         rclpy.try_shutdown(context=context)
 
 
-def test_goal_result_passes_every_status_the_server_knows():
+def test_goal_result_passes_the_result_of_every_terminal_status():
     for status in (GoalStatus.STATUS_SUCCEEDED, GoalStatus.STATUS_ABORTED,
                    GoalStatus.STATUS_CANCELED):
         response = RemoveParts.Impl.GetResultService.Response(
