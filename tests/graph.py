@@ -1,13 +1,15 @@
-"""Helpers for graph tests: node processes, a client node, a steady-clock wait, a wrapper of
-an action client's rcl handle.
+"""Helpers for graph tests: node processes, a client node, a node spun by another thread, a
+steady-clock wait, a wrapper of an action client's rcl handle.
 
 Nodes run as real processes started from their installed executables (the path `ros2 run`
 uses) and talk to the test's client node over DDS on loopback.
 """
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+import contextlib
 import os
 import tempfile
+import threading
 import time
 
 from experiment_manager.commands import launcher
@@ -15,7 +17,7 @@ from pick_common.node_runner import handshake
 from pick_common.rclpy_adapter import LockedActionClient
 import rclpy
 from rclpy.context import Context
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.executors import MultiThreadedExecutor, SingleThreadedExecutor
 from rclpy.node import Node
 
 # The small file of every experiment type that the graph tests run.
@@ -56,6 +58,30 @@ def stop_all(procs) -> None:
     codes = [proc.stop() for proc in procs]
     for proc, code in zip(procs, codes, strict=True):
         assert code == 0, f'{proc.name} exited with {code} on SIGINT:\n{proc.output()}'
+
+
+@contextlib.contextmanager
+def spun_node(name: str, make: Callable[[Node], tuple]) -> Iterator[tuple]:
+    """A node in a context of its own with what `make(node)` makes on it (action servers and
+    clients), its MultiThreadedExecutor spun by a daemon thread once they exist (as the
+    manager's node, whose other threads call and wait while it spins). Yields make's
+    entities; after the block, stops the executor, then destroys them, the node and the
+    context."""
+    context = Context()
+    rclpy.init(context=context)
+    node = Node(name, context=context)
+    executor = MultiThreadedExecutor(context=context)
+    executor.add_node(node)
+    made = make(node)
+    threading.Thread(target=executor.spin, daemon=True).start()
+    try:
+        yield made
+    finally:
+        executor.shutdown(timeout_sec=2.0)
+        for entity in made:
+            entity.destroy()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
 
 
 class WrappedHandle:

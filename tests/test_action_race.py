@@ -4,18 +4,13 @@ for ever. The window is widened here by a send that pauses after the request is 
 ActionClient loses the answer (rclpy 7.1.6; when an rclpy update fixes it, that case fails and
 LockedActionClient can go), the manager's LockedActionClient does not."""
 
-import threading
 import time
 
-from graph import WrappedHandle
+from graph import spun_node, WrappedHandle
 from pick_common.rclpy_adapter import LockedActionClient
 from pick_msgs.action import DropParts
 import pytest
-import rclpy
 from rclpy.action import ActionClient, ActionServer
-from rclpy.context import Context
-from rclpy.executors import MultiThreadedExecutor
-from rclpy.node import Node
 
 
 class SlowToRegister(WrappedHandle):
@@ -32,31 +27,20 @@ class SlowToRegister(WrappedHandle):
                                                    (LockedActionClient, True)])
 def test_a_goal_sent_while_another_thread_spins_gets_its_answer(client_type, answered,
                                                                 private_ros_domain):
-    context = Context()
-    rclpy.init(context=context)
-    node = Node('action_race', context=context)
-    executor = MultiThreadedExecutor(context=context)
-    executor.add_node(node)
-
     def execute(goal_handle):
         goal_handle.succeed()
         return DropParts.Result()
-    server = ActionServer(node, DropParts, 'race_drop', execute_callback=execute)
-    client = client_type(node, DropParts, 'race_drop')
-    spinner = threading.Thread(target=executor.spin, daemon=True)
-    spinner.start()
-    try:
-        assert client.wait_for_server(timeout_sec=10.0)
-        client._client_handle = SlowToRegister(client._client_handle)
-        future = client.send_goal_async(DropParts.Goal(count=1))
-        deadline = time.monotonic() + 3.0
-        while not future.done() and time.monotonic() < deadline:
-            time.sleep(0.01)
-        assert future.done() == answered
-    finally:
-        WrappedHandle.unwrap(client)
-        executor.shutdown(timeout_sec=2.0)
-        client.destroy()
-        server.destroy()
-        node.destroy_node()
-        rclpy.try_shutdown(context=context)
+
+    with spun_node('action_race', lambda node: (
+            ActionServer(node, DropParts, 'race_drop', execute_callback=execute),
+            client_type(node, DropParts, 'race_drop'))) as (_, client):
+        try:
+            assert client.wait_for_server(timeout_sec=10.0)
+            client._client_handle = SlowToRegister(client._client_handle)
+            future = client.send_goal_async(DropParts.Goal(count=1))
+            deadline = time.monotonic() + 3.0
+            while not future.done() and time.monotonic() < deadline:
+                time.sleep(0.01)
+            assert future.done() == answered
+        finally:
+            WrappedHandle.unwrap(client)

@@ -9,38 +9,27 @@ import threading
 import time
 
 from action_msgs.msg import GoalStatus
+from graph import spun_node
 from pick_common.errors import CodedError
 from pick_common.node_runner import goal_result
 from pick_common.rclpy_adapter import LockedActionClient
 from pick_msgs.action import RemoveParts
 import pytest
-import rclpy
 from rclpy.action import ActionServer
-from rclpy.context import Context
-from rclpy.executors import MultiThreadedExecutor
-from rclpy.node import Node
 
 KEEP = 0.5          # s the test's server keeps a finished goal
 WAIT = 30.0         # s for each answer (a busy machine is slow, never this slow)
 
 
 def test_a_result_asked_for_after_the_server_dropped_the_goal_is_an_error(private_ros_domain):
-    context = Context()
-    rclpy.init(context=context)
-    node = Node('action_result', context=context)
-    executor = MultiThreadedExecutor(context=context)
-    executor.add_node(node)
-
     def execute(goal_handle):
         goal_handle.succeed()
         return RemoveParts.Result(removed_ids=[7])
 
-    server = ActionServer(node, RemoveParts, 'result_remove', execute_callback=execute,
-                          result_timeout=KEEP)
-    client = LockedActionClient(node, RemoveParts, 'result_remove')
-    spinner = threading.Thread(target=executor.spin, daemon=True)
-    spinner.start()
-    try:
+    with spun_node('action_result', lambda node: (
+            ActionServer(node, RemoveParts, 'result_remove', execute_callback=execute,
+                         result_timeout=KEEP),
+            LockedActionClient(node, RemoveParts, 'result_remove'))) as (_, client):
         assert client.wait_for_server(timeout_sec=WAIT)
         sent = client.send_goal_async(RemoveParts.Goal(part_ids=[7]))
         assert _done(sent), 'no answer to the goal'
@@ -63,12 +52,6 @@ def test_a_result_asked_for_after_the_server_dropped_the_goal_is_an_error(privat
         assert answer.result.error_code == 0 and not list(answer.result.removed_ids)
         with pytest.raises(CodedError, match='remove_parts: the server no longer had the goal'):
             goal_result(answer, 'remove_parts')
-    finally:
-        executor.shutdown(timeout_sec=2.0)
-        client.destroy()
-        server.destroy()
-        node.destroy_node()
-        rclpy.try_shutdown(context=context)
 
 
 def test_goal_result_passes_the_result_of_every_terminal_status():
