@@ -110,10 +110,9 @@ class NodeUsage:
                     self._cpu.setdefault(key, []).append(
                         (time.time(), (int(stat[11]) + int(stat[12])) / tick))
 
-    def stop(self) -> 'NodeUsage':
+    def stop(self) -> None:
         self._stop.set()
         self._thread.join()
-        return self
 
     def cpu_between(self, start: float, end: float) -> dict[tuple[str, str], float]:
         """Each node's CPU time, s, from its last poll at or before `start` to its last at or
