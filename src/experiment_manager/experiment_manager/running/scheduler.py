@@ -33,6 +33,7 @@ from . import sampling
 from .backend import Backend, WorkerLost
 from .estimate import Costs
 from .procedures import run_unit
+from .workers import Workers
 
 
 @dataclass(frozen=True)
@@ -65,18 +66,21 @@ class Runner:
     have finished (their metrics make its plan); the others run alongside, so a long iteration
     does not leave the other workers idle. When an experiment finishes, the sink puts the rows
     in plan order, so the results do not depend on how many workers ran them or which. `abort`
-    is set when the run fails, so that the other workers' calls stop.
+    is set when the run fails, so that the other workers' calls stop. Runs given the same
+    `workers` (workers.py) go on side by side on the backends they share, the first begun
+    first.
     """
 
     def __init__(self, file: ExperimentFile, backends: Sequence[Backend], sink: Sink,
                  progress: Callable[[Progress], None] | None = None,
-                 abort: threading.Event | None = None) -> None:
+                 abort: threading.Event | None = None, workers: Workers | None = None) -> None:
         if not backends:
             raise ValueError('a run needs at least one backend')
         self.file, self.backends, self.sink = file, list(backends), sink
         self._progress = progress or (lambda p: None)
         self._abort = abort or threading.Event()
-        self._cond = threading.Condition()
+        self._workers = workers or Workers()
+        self._cond = self._workers.cond      # shared with the runs beside it
         self._in_flight = 0
         self._rejoining = 0
         self._live = list(range(len(self.backends)))
@@ -105,13 +109,34 @@ class Runner:
     def run(self) -> Summary:
         """Run every experiment; returns the summary (also written to the sink). A worker
         missing at the start is left out; the run fails when all are."""
+        self._workers.join(self)
+        try:
+            self._run()
+        finally:
+            self._workers.leave(self)
+        if self._errors:
+            raise self._errors[0]
+        if self._waiting or any(self._left.values()):
+            raise AssertionError('the run ended with iterations left undone')
+        self._report(self.file.experiments[-1], 'done')
+        return metrics.file_summary(self.file.ran, self._ordered_summary())
+
+    def _run(self) -> None:
+        # A backend another run holds is started when this run first takes it (_work).
         missing = []
         for k, backend in enumerate(self.backends):
+            with self._cond:
+                if not self._workers.free(backend, self):
+                    continue
+                self._workers.take(backend, self)
             try:
                 backend.start(self.file)
+                self._workers.give(backend, (self, None, '', False))
             except WorkerLost as exc:
                 missing.append(exc)
                 self._live.remove(k)
+            finally:
+                self._workers.put_back(backend)
         if not self._live:
             raise missing[0]
         with self._cond:
@@ -125,12 +150,12 @@ class Runner:
                 t.start()
             for t in workers:
                 t.join()
-        if self._errors:
-            raise self._errors[0]
-        if self._waiting or any(self._left.values()):
-            raise AssertionError('the run ended with iterations left undone')
-        self._report(self.file.experiments[-1], 'done')
-        return metrics.file_summary(self.file.ran, self._ordered_summary())
+
+    def wants(self, backend) -> bool:
+        """Whether this run has an iteration ready that `backend` may run (Workers, under
+        the condition)."""
+        return (bool(self._ready) and not self._errors and not self._abort.is_set()
+                and any(b is backend for k, b in enumerate(self.backends) if k in self._live))
 
     def _ordered_summary(self) -> dict:
         return {e.id: self._summary[e.id] for e in self.file.experiments
@@ -277,26 +302,32 @@ class Runner:
     def _work(self, k: int) -> None:
         """Worker k's loop: take the first ready iteration, run it, write it. While others are
         in flight it waits rather than leave: their end may release an experiment, and a lost
-        worker's iteration comes back to the queue."""
-        backend = self.backends[k]
-        # what `backend` was last given: the scenario, the gripper and the station (None,
-        # '', False: the file's)
-        given = (None, '', False)
+        worker's iteration comes back to the queue. It takes the worker for the iteration
+        only (Workers): a run beside this one may run one of its own on it in between."""
+        backend, workers = self.backends[k], self._workers
         while True:
             with self._cond:
-                while not self._ready and self._in_flight and not self._errors:
+                while not self._errors and not self._abort.is_set() and (
+                        self._ready and not workers.free(backend, self)
+                        or not self._ready and self._in_flight):
                     self._cond.wait()
                 if self._errors or not self._ready or self._abort.is_set():
                     return
                 _, u = heapq.heappop(self._ready)
+                workers.take(backend, self)
                 self._in_flight += 1
                 self._report(u.experiment, f'{u.experiment.id}: {u.label}')
             try:
                 file = self.file.for_experiment(u.experiment)
-                wanted = (u.experiment.scenario, u.experiment.gripper, u.experiment.station)
-                if wanted[0] is not given[0] or wanted[1:] != given[1:]:
+                # what `backend` was last given: the run, the scenario, the gripper and the
+                # station (None, '', False: the file's)
+                wanted = (self, u.experiment.scenario, u.experiment.gripper,
+                          u.experiment.station)
+                given = workers.given(backend)
+                if (given is None or wanted[0] is not given[0] or wanted[1] is not given[1]
+                        or wanted[2:] != given[2:]):
                     backend.start(file)
-                    given = wanted
+                    workers.give(backend, wanted)
                 record = run_unit(file, u, backend)
             except WorkerLost as exc:
                 with self._cond:
@@ -307,6 +338,7 @@ class Runner:
                     self._cond.notify_all()
                 back = backend.rejoin(self._over)
                 with self._cond:
+                    workers.put_back(backend)
                     self._rejoining -= 1
                     if back and not self._over():
                         self._live.append(k)
@@ -319,12 +351,14 @@ class Runner:
                 return
             except BaseException as exc:
                 with self._cond:
+                    workers.put_back(backend)
                     self._errors.append(exc)
                     self._abort.set()
                     self._in_flight -= 1
                     self._cond.notify_all()
                 return
             with self._cond:
+                workers.put_back(backend)
                 self._in_flight -= 1
                 self._costs.add(u.experiment, u.parts, record.iteration['wall_time'])
                 self._guarded(self._written, u, record)
