@@ -113,3 +113,58 @@ def test_a_later_run_fills_the_worker_an_earlier_one_leaves_idle(tmp_path):
     assert events['b_ran'].is_set() and set(summaries) == {'a', 'b'}
     assert read(str(tmp_path / 'a')) == _alone(a_text, str(tmp_path / 'a1'))
     assert read(str(tmp_path / 'b')) == _alone(b_text, str(tmp_path / 'b1'))
+
+
+class Held(LocalBackend):
+    """A worker in this process whose resets wait until `release` is set, counting those
+    waiting in `waiting` (a semaphore released once per reset begun)."""
+
+    def __init__(self, release: threading.Event, waiting: threading.Semaphore) -> None:
+        super().__init__()
+        self.release, self.waiting = release, waiting
+
+    def reset(self, container, seed) -> None:
+        self.waiting.release()
+        if not self.release.wait(HANG):
+            raise AssertionError('never released')
+        super().reset(container, seed)
+
+
+def test_a_run_waiting_for_a_worker_ends_at_once_when_stopped(tmp_path):
+    release, waiting = threading.Event(), threading.Semaphore(0)
+    workers = Workers()
+    backends = [Held(release, waiting) for _ in range(2)]
+    files = {name: experiment_file.parse(FILE.format(id=name, seed=k, n=4))
+             for k, name in enumerate(('a', 'b'))}
+    ended: dict[str, BaseException | None] = {}
+    runners = {name: Runner(f, backends, ResultsWriter(str(tmp_path / name), f.text),
+                            workers=workers, rank=k) for k, (name, f) in enumerate(files.items())}
+
+    def run(name: str) -> None:
+        try:
+            runners[name].run()
+            ended[name] = None
+        except BaseException as exc:    # noqa: B036 - the test thread reports it
+            ended[name] = exc
+
+    threads = {name: threading.Thread(target=run, args=(name,)) for name in files}
+    try:
+        threads['a'].start()
+        assert waiting.acquire(timeout=HANG) and waiting.acquire(timeout=HANG)   # a holds both
+        threads['b'].start()
+        canceled = RuntimeError('canceled')
+        runners['b'].stop(canceled)
+        threads['b'].join(HANG)
+        # b ended while a still held both workers: it waited for none of a's iterations
+        assert ended.get('b') is canceled and not release.is_set()
+        release.set()
+        threads['a'].join(HANG)
+        assert ended.get('a', 'not ended') is None
+    finally:
+        release.set()
+        for backend in backends:
+            backend.close()
+        for runner in runners.values():
+            runner.sink.close()
+    assert read(str(tmp_path / 'b')) == []
+    assert len(read(str(tmp_path / 'a'))) == 4

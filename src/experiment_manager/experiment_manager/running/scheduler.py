@@ -67,20 +67,21 @@ class Runner:
     does not leave the other workers idle. When an experiment finishes, the sink puts the rows
     in plan order, so the results do not depend on how many workers ran them or which. `abort`
     is set when the run fails, so that the other workers' calls stop. Runs given the same
-    `workers` (workers.py) go on side by side on the backends they share, the first begun
-    first.
+    `workers` (workers.py) go on side by side on the backends they share, the lowest `rank`
+    (default: the first to run) first.
     """
 
     def __init__(self, file: ExperimentFile, backends: Sequence[Backend], sink: Sink,
                  progress: Callable[[Progress], None] | None = None,
-                 abort: threading.Event | None = None, workers: Workers | None = None) -> None:
+                 abort: threading.Event | None = None, workers: Workers | None = None,
+                 rank: int | None = None) -> None:
         if not backends:
             raise ValueError('a run needs at least one backend')
         self.file, self.backends, self.sink = file, list(backends), sink
         self._progress = progress or (lambda p: None)
         self._abort = abort or threading.Event()
         self._workers = workers or Workers()
-        self._cond = self._workers.cond      # shared with the runs beside it
+        self._cond, self._joins_at = self._workers.cond, rank   # shared with the runs beside
         self._in_flight = 0
         self._rejoining = 0
         self._live = list(range(len(self.backends)))
@@ -109,7 +110,7 @@ class Runner:
     def run(self) -> Summary:
         """Run every experiment; returns the summary (also written to the sink). A worker
         missing at the start is left out; the run fails when all are."""
-        self._workers.join(self)
+        self._workers.join(self, self._joins_at)
         try:
             self._run()
         finally:
@@ -151,9 +152,16 @@ class Runner:
             for t in workers:
                 t.join()
 
+    def stop(self, exc: BaseException) -> None:
+        """End the run with `exc` (canceled), even while it waits for a worker: run() raises
+        it once the iterations in flight end."""
+        with self._cond:
+            self._errors.append(exc)
+            self._abort.set()
+            self._cond.notify_all()
+
     def wants(self, backend) -> bool:
-        """Whether this run has an iteration ready that `backend` may run (Workers, under
-        the condition)."""
+        """Whether this run has an iteration ready for `backend` (under the condition)."""
         return (bool(self._ready) and not self._errors and not self._abort.is_set()
                 and any(b is backend for k, b in enumerate(self.backends) if k in self._live))
 

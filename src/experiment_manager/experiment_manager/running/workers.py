@@ -3,16 +3,23 @@ side on one set of backends, so that a worker one run leaves idle (its last iter
 on another worker, or an adaptive batch not yet looked at) runs another's iteration.
 
 A run holds a worker for one iteration (or for its start) at a time. Of the runs with an
-iteration ready for a free worker, the one that joined first takes it: a later run only fills
-what the earlier ones leave idle, and the earlier ones are never queued behind it by more than
-the iteration it has in flight. Which worker runs which iteration changes no result (each
-iteration runs on a fresh scene with its own seed, and each run puts its rows in plan order).
+iteration ready for a free worker, the one begun first (the lowest rank: the manager's order of
+its goals) takes it: a later run only fills what the earlier ones leave idle, and the earlier
+ones are never queued behind it by more than the iteration it has in flight. Which worker runs
+which iteration changes no result (each iteration runs on a fresh scene with its own seed, and
+each run puts its rows in plan order).
 """
 
 from collections.abc import Callable
 import threading
 
 from .backend import Backend
+
+# Runs a manager runs at once. Each holds an executor thread of the manager for its whole run;
+# the others answer the workers' calls (MultiThreadedExecutor(num_threads=4) in
+# experiment_manager_node.main). Two keep every worker busy: the later fills what the earlier
+# leaves idle.
+RUNS_AT_ONCE = 2
 
 
 class Workers:
@@ -28,15 +35,23 @@ class Workers:
         self._taken = taken or (lambda backend, run: None)
         self._holder: dict[Backend, object] = {}   # backend -> the run holding it
         self._given: dict[Backend, tuple] = {}     # backend -> what it was last given
-        self._runs: list = []                      # the runs sharing them, in joining order
+        self._runs: list = []                      # the runs sharing them, by rank
+        self._ranks: dict[object, int] = {}        # run -> its rank
 
-    def join(self, run) -> None:
+    def join(self, run, rank: int | None = None) -> None:
+        """`run` shares the workers from now on, after the runs of a lower rank (`rank`:
+        after every run joined so far when None)."""
         with self.cond:
+            if rank is None:
+                rank = max(self._ranks.values(), default=0) + 1
+            self._ranks[run] = rank
             self._runs.append(run)
+            self._runs.sort(key=self._ranks.__getitem__)
 
     def leave(self, run) -> None:
         with self.cond:
             self._runs.remove(run)
+            del self._ranks[run]
             self.cond.notify_all()
 
     def free(self, backend: Backend, run) -> bool:
