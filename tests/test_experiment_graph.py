@@ -71,15 +71,32 @@ def graph_and_cores(path: str, tmp_path, label: str, workers: int
 
 
 @pytest.fixture(scope='module')
-def graph_run(tmp_path_factory, private_ros_domain):
+def graph_runs(tmp_path_factory, private_ros_domain
+               ) -> dict[str, tuple[str, str, subprocess.CompletedProcess]]:
+    """The small file and a drop test (DROPS) in one `run`, the drop test beside the small
+    file on its workers (filling what the small file leaves idle): per file id, its run
+    directory, its recording and `run`'s output with that file's lines only."""
     out, logs = tmp_path_factory.mktemp('out'), tmp_path_factory.mktemp('logs')
-    done = run_command(SMALL, '--output', str(out), '--namespace', NS, '--logs', str(logs),
-                       '--workers', str(WORKERS))
+    drops = out / 'drops.yaml'
+    drops.write_text(DROPS)
+    done = run_command(SMALL, str(drops), '--output', str(out), '--namespace', NS, '--logs',
+                       str(logs), '--workers', str(WORKERS))
     node_logs = '\n'.join(f'== {p}\n{open(p).read()[-3000:]}' for p in glob.glob(f'{logs}/*'))
     assert done.returncode == 0, done.stderr + node_logs
-    run_dir = re.search(r'^results:\s+(\S+)', done.stdout, re.M).group(1)
-    recording = re.search(r'^recording:\s+(\S+)', done.stdout, re.M).group(1)
-    return run_dir, recording, done
+    runs = {}
+    for block in re.split(r'^(?=results:)', done.stdout, flags=re.M)[1:]:
+        run_dir = re.search(r'^results:\s+(\S+)', block, re.M).group(1)
+        recording = re.search(r'^recording:\s+(\S+)', block, re.M).group(1)
+        runs[os.path.basename(run_dir).split('_')[0]] = (run_dir, recording, subprocess.
+                                                         CompletedProcess(done.args, 0, block,
+                                                                          done.stderr))
+    assert set(runs) == {'small', 'drops'}, done.stdout
+    return runs
+
+
+@pytest.fixture(scope='module')
+def graph_run(graph_runs):
+    return graph_runs['small']
 
 
 @pytest.fixture(scope='module')
@@ -319,13 +336,24 @@ experiments:
 """
 
 
-def test_a_drop_test_through_the_graph_gives_the_cores_aspects(tmp_path, private_ros_domain):
-    """A drop test on two workers: the world drops each part from the plate's height (which
-    reaches it in ContainerGeometry) and the rows, aspects and G-test are the cores'."""
-    path = tmp_path / 'drops.yaml'
-    path.write_text(DROPS)
-    _, run_dir, cores, expected = graph_and_cores(str(path), tmp_path, 'drops', 2)
+def test_a_drop_test_beside_another_run_gives_the_cores_aspects(graph_runs, tmp_path):
+    """A drop test on two workers, run beside the small file: the world drops each part from
+    the plate's height (which reaches it in ContainerGeometry) and the rows, aspects and G-test
+    are the cores'; its recording has its own iterations' scenes and frames only."""
+    run_dir, recording, _ = graph_runs['drops']
+    file = experiment_file.parse(DROPS)
+    cores = str(tmp_path / 'cores')
+    with LocalBackend() as backend, ResultsWriter(cores, file.text) as writer:
+        expected = json.loads(Runner(file, [backend], writer).run().json_text())
     assert rows(run_dir, 'iterations') == rows(cores, 'iterations')
+    with open(recording, 'rb') as f:
+        messages = [(channel.topic, msg) for _, channel, _, msg in make_reader(
+            f, decoder_factories=[DecoderFactory()]).iter_decoded_messages()]
+    seeds = {instance_seed(int(i['seed']), 0) for i in rows(run_dir, 'iterations')}
+    scenes = [m for topic, m in messages if topic.endswith('/scene')]
+    assert len(scenes) == 12 and {m.instances[0].seed for m in scenes} == seeds
+    assert len([m for topic, m in messages if topic == '/tf_static']) == 12
+    assert {m.experiment_id for topic, m in messages if topic == f'{NS}/progress'} == {'drop'}
     with open(os.path.join(run_dir, 'summary.json')) as f:
         got = json.load(f)['experiments']['drop']
     assert got == expected['experiments']['drop'] and got['drops'] + got['other'] == 12
@@ -460,6 +488,8 @@ def test_every_error_of_a_file_and_a_bad_option_are_named_as_given(tmp_path):
     assert re.search(r'experiments\[3\]\.max_vibrations: -3 must be within', done.stderr)
     done = run_command(SMALL, '--iterations', '-1', timeout=120)
     assert done.returncode == 2 and '--iterations -1 must be within [1, ' in done.stderr
+    done = run_command(SMALL, '--at-once', '3', timeout=120)
+    assert done.returncode == 2 and '--at-once 3 must be within [1, 2]' in done.stderr
 
 
 def test_the_reduced_copies_of_iterations_are_removed(tmp_path):
@@ -530,7 +560,7 @@ def _world_pid(namespace: str) -> int:
     return _pid(f'{namespace}/worker_0', 'lib/pick_sim_world/world')
 
 
-def test_a_second_goal_or_run_is_refused_and_a_killed_last_worker_ends_the_run(
+def test_a_third_goal_or_second_run_is_refused_and_a_killed_last_worker_ends_the_runs(
         tmp_path, client, private_ros_domain):
     ns = unique_namespace('exp_kill')
     path = tmp_path / 'long.yaml'
@@ -543,6 +573,13 @@ def test_a_second_goal_or_run_is_refused_and_a_killed_last_worker_ends_the_run(
 
         manager = LockedActionClient(client.node, RunExperiment, f'{ns}/run_experiment')
         assert client.wait_for_servers(manager)
+        # a second goal runs beside the first (RUNS_AT_ONCE), on what the first leaves idle
+        # (into the run's output: the only directory `run` lets its manager write)
+        beside = client.result(manager.send_goal_async(RunExperiment.Goal(
+            experiment_file=str(path), output_dir=str(out))))
+        assert beside.accepted
+        assert client.wait(lambda: len(glob.glob(f'{out}/long_*/recording.mcap')) == 2,
+                           60.0), 'the second goal did not begin its run'
         handle = client.result(manager.send_goal_async(RunExperiment.Goal(
             experiment_file=str(path), output_dir=str(tmp_path / 'other'))))
         busy = client.result(handle.get_result_async()).result
@@ -562,12 +599,15 @@ def test_a_second_goal_or_run_is_refused_and_a_killed_last_worker_ends_the_run(
     assert run.returncode == 1, stderr
     assert re.search(r'world \(pid \d+\) was killed by signal 9', stderr), stderr
     assert 'finished iterations are kept in' in stderr
-    run_dir = glob.glob(f'{out}/long_*')[0]
+    run_dir, beside_dir = sorted(glob.glob(f'{out}/long_*'))    # named by when they began
     assert [r['experiment'] for r in rows(run_dir, 'iterations')][:1] == ['sweep']
     with open(os.path.join(run_dir, 'recording.mcap'), 'rb') as f:
         summary = make_reader(f).get_summary()     # closed properly: it has a summary
     assert summary is not None and summary.statistics.message_count > 0
     assert {a.name for a in summary.attachment_indexes} >= {'experiment.yaml', 'iterations.csv'}
+    # the run beside it ended with the graph and closed its recording too
+    with open(os.path.join(beside_dir, 'recording.mcap'), 'rb') as f:
+        assert make_reader(f).get_summary() is not None
     assert not os.path.exists(tmp_path / 'other'), 'the busy goal wrote nothing'
     assert not os.path.exists(tmp_path / 'second'), 'the refused run wrote nothing'
 

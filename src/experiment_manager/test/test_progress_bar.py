@@ -3,7 +3,7 @@
 import io
 from types import SimpleNamespace
 
-from experiment_manager.commands.run import ProgressBar
+from experiment_manager.commands.progress_bar import ProgressBar
 
 
 class Terminal(io.StringIO):

@@ -1,22 +1,23 @@
 """`run`: bring up the graph on this machine and run experiment files through it.
 
     run [EXPERIMENT_FILE ...] [--output DIR | --resume RUN_DIR] [--iterations N] [--adaptive]
-        [--workers N] [--respawns N] [--namespace NS] [--logs DIR]
+        [--workers N] [--at-once N] [--respawns N] [--namespace NS] [--logs DIR]
     run --board FILE.kicad_pcb [--models DIR] [--boards-per-hour N] [--output DIR] ...
 
 Starts N workers (`world`, `validity` and `feeder_controller` under <NS>/worker_<k>, default: a
 worker per CPU) and `experiment_manager` under <NS> as separate processes (DDS between them, as
-on a cell), sends `run_experiment` for each file in turn, shows a progress bar, and prints where
-the results and the recording are. A worker node that dies is reported and started again (up to
---respawns times); the manager runs the iteration it lost again and takes the worker back, and
-the run fails only when no worker is left. Each node may read and write only where the goals
-need (mesh_dirs, experiment_dirs, output_dirs). Without a file it runs the built-in default
-(`share/experiment_manager/config/default_experiment.yaml`), or with --resume the file the run
-directory keeps. --iterations N caps every experiment at N iterations (a quick look at a long
-study; the run directory keeps the file that ran); --adaptive runs each experiment only until
-its decision is settled (sampling.py), at most its iterations. A board file (`board:` in place
-of `part:`), or --board in the built-in cell, runs as its parts' files, and ends with the
-board's one answer (commands/boards.py, docs/boards.md).
+on a cell), sends `run_experiment` for each file, the next while the one before runs (--at-once
+2: it fills the workers the one before leaves idle, and gets them only then), shows the progress
+of the earliest, and prints where each file's results and recording are. A worker node that dies
+is reported and started again (up to --respawns times); the manager runs the iteration it lost
+again and takes the worker back, and the run fails only when no worker is left. Each node may
+read and write only where the goals need (mesh_dirs, experiment_dirs, output_dirs). Without a
+file it runs the built-in default (`share/experiment_manager/config/default_experiment.yaml`),
+or with --resume the file the run directory keeps. --iterations N caps every experiment at N
+iterations (a quick look at a long study; the run directory keeps the file that ran); --adaptive
+runs each experiment only until its decision is settled (sampling.py), at most its iterations. A
+board file (`board:` in place of `part:`), or --board in the built-in cell, runs as its parts'
+files, and ends with the board's one answer (commands/boards.py, docs/boards.md).
 
 Exit codes: 0 done; 1 the run failed (the message says why; finished iterations are kept);
 2 bad input (the experiment file, an option); 130 interrupted (Ctrl-C: the run is canceled and
@@ -24,6 +25,7 @@ its files closed).
 """
 
 import argparse
+from dataclasses import dataclass
 import json
 import os
 import sys
@@ -40,12 +42,12 @@ from rclpy.exceptions import InvalidNamespaceException
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from rclpy.validate_namespace import validate_namespace
-from tqdm import tqdm
 
 from .. import experiment_file
 from ..analysis import summary as summary_model
 from ..analysis import wording
 from ..analysis.headlines import headlines
+from ..running.workers import RUNS_AT_ONCE
 from . import interrupt
 from .boards import (
     board_file,
@@ -57,6 +59,7 @@ from .boards import (
     options,
 )
 from .claim import claim, NamespaceInUse
+from .progress_bar import ProgressBar
 from .supervisor import Graph, report_dead, spin_until, start_graph
 
 MAX_WORKERS = 64
@@ -73,49 +76,6 @@ def default_workers() -> int:
 def default_file() -> str:
     return os.path.join(get_package_share_directory('experiment_manager'), 'config',
                         'default_experiment.yaml')
-
-
-class ProgressBar:
-    """The run's progress on `stream`: on a terminal, one tqdm line redrawn within the
-    terminal's width (`columns`, or the terminal's own as it is resized), the phase cut at its
-    end; otherwise (a log), a line per 5 % and per experiment."""
-
-    def __init__(self, stream=sys.stderr, columns: int | None = None) -> None:
-        self.stream, self.columns = stream, columns
-        self.tty = stream.isatty()
-        # an adaptive run's estimate is of the most it may take (running/estimate.py): said so
-        self.at_most = False
-        self._bar: tqdm | None = None
-        self._last = (None, -1)
-
-    @staticmethod
-    def _clock(seconds: float) -> str:
-        s = int(seconds)
-        return f'{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}'
-
-    def update(self, p) -> None:
-        eta = (('at most ' if self.at_most else '') + self._clock(p.eta)) if p.eta else '?'
-        status = f'{self._clock(p.elapsed)} elapsed, eta {eta}  {p.phase}'
-        if not self.tty:
-            fraction = p.iterations_done / p.iterations_total if p.iterations_total else 0.0
-            key = (p.experiment_id, int(fraction * 20))
-            if key != self._last:
-                self._last = key
-                self.stream.write(f'{p.iterations_done}/{p.iterations_total}  {status}\n')
-                self.stream.flush()
-            return
-        if self._bar is None:
-            self._bar = tqdm(total=p.iterations_total, file=self.stream, ncols=self.columns,
-                             dynamic_ncols=self.columns is None, ascii=' #', mininterval=0,
-                             bar_format='{n_fmt}/{total_fmt} [{bar:24}] {desc}')
-        self._bar.total, self._bar.n = p.iterations_total, p.iterations_done
-        self._bar.set_description_str(status, refresh=False)
-        self._bar.refresh()
-
-    def close(self) -> None:
-        if self._bar is not None:
-            self._bar.close()
-            self._bar = None
 
 
 def _parse(argv: list[str]) -> argparse.Namespace:
@@ -144,6 +104,9 @@ def _parse(argv: list[str]) -> argparse.Namespace:
                         help=f'worker processes to start (default {default_workers()}: a '
                         "worker per CPU, at most 8); a board's parts are cut on as many "
                         'processes, with --check too')
+    parser.add_argument('--at-once', type=int, metavar='N', default=RUNS_AT_ONCE,
+                        help=f'files run at once (default {RUNS_AT_ONCE}: the next fills the '
+                        'workers the one before leaves idle; 1: one after another)')
     parser.add_argument('--iterations', type=int, metavar='N',
                         help='cap every experiment at N iterations')
     parser.add_argument('--adaptive', action='store_true',
@@ -178,6 +141,9 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     if args.iterations is not None and not 1 <= args.iterations <= experiment_file.MAX_ITERATIONS:
         parser.error(f'--iterations {args.iterations} must be within '
                      f'[1, {experiment_file.MAX_ITERATIONS}]')
+    if not 1 <= args.at_once <= RUNS_AT_ONCE:
+        parser.error(f'--at-once {args.at_once} must be within [1, {RUNS_AT_ONCE}] (the most the '
+                     'manager runs at once)')
     if not 1 <= args.workers <= MAX_WORKERS:
         parser.error(f'--workers {args.workers} must be within [1, {MAX_WORKERS}]')
     try:
@@ -274,12 +240,8 @@ def _main(args: argparse.Namespace, temporary: list[str]) -> int:
                                   [g.output_dir for g, *_ in goals], args.respawns),
                       args.respawns)
         client = LockedActionClient(node, RunExperiment, 'run_experiment')
-        for goal, _, given, adaptive in goals:
-            bar.at_most = adaptive
-            code = _run(node, client, goal, given, graph, bar, args.boards)
-            if code:
-                return code
-        return _board_answers(args.boards)
+        code = _run(node, client, goals, graph, bar, args.boards, args.at_once)
+        return code or _board_answers(args.boards)
     except (FileNotFoundError, NamespaceInUse) as exc:   # before any goal was sent
         print(f'run: {exc}', file=sys.stderr)
         return 2
@@ -308,9 +270,20 @@ def _board_answers(boards: list[BoardRun]) -> int:
     return 0
 
 
-def _run(node: Node, client: LockedActionClient, goal, given: str, graph: Graph, bar,
-         boards: list[BoardRun]) -> int:
-    print(f'run: {given}', file=sys.stderr)
+@dataclass
+class Flying:
+    """A goal sent: the file as given, whether it runs adaptively, its handle and result."""
+    given: str
+    adaptive: bool
+    handle: object = None
+    result: object = None
+
+
+def _run(node: Node, client: LockedActionClient, goals: list, graph: Graph, bar,
+         boards: list[BoardRun], at_once: int) -> int:
+    """Run the goals, `at_once` at a time: the next is sent while the one before runs, and
+    fills the workers it leaves idle (the manager's RUNS_AT_ONCE). The bar shows the earliest
+    goal in flight. A goal that fails cancels the others and ends the run."""
     manager = graph.manager
     if not report_dead(node, client.server_is_ready, graph, START_TIMEOUT, bar) \
             or not client.server_is_ready():
@@ -323,24 +296,65 @@ def _run(node: Node, client: LockedActionClient, goal, given: str, graph: Graph,
         print('run: the experiment manager did not answer a probe of run_experiment within '
               f'{START_TIMEOUT:g} s', file=sys.stderr)
         return 1
-    send = client.send_goal_async(goal, feedback_callback=lambda f: bar.update(f.feedback.progress))
-    spin_until(node, send.done, [manager], START_TIMEOUT)
-    handle = send.result()
-    if handle is None or not handle.accepted:
-        print('run: the experiment manager did not accept the goal', file=sys.stderr)
-        return 1
-    result_future = handle.get_result_async()
+    pending, flying = list(goals), []
     try:
-        if not report_dead(node, result_future.done, graph, float('inf'), bar):
-            return 1
+        while pending or flying:
+            while pending and len(flying) < at_once:
+                goal, _, given, adaptive = pending.pop(0)
+                sent = Flying(given, adaptive)
+                if not _send(node, client, goal, sent, flying, bar, manager):
+                    return 1
+            if not report_dead(node, lambda: any(f.result.done() for f in flying), graph,
+                               float('inf'), bar):
+                return 1
+            for done in [f for f in flying if f.result.done()]:
+                flying.remove(done)
+                code = _finished(done, bar, boards)
+                if code:
+                    return code
+            bar.at_most = bool(flying) and flying[0].adaptive
     except KeyboardInterrupt:
-        handle.cancel_goal_async()
-        spin_until(node, result_future.done, [manager], STOP_TIMEOUT)
+        _cancel(node, flying, manager)
         raise
-    result = result_future.result().result
+    finally:
+        if flying:      # a goal failed, or the manager died: the others end with it
+            _cancel(node, flying, manager)
+    return 0
+
+
+def _send(node: Node, client: LockedActionClient, goal, sent: Flying, flying: list[Flying],
+          bar, manager) -> bool:
+    """Send a goal; False (said why) when the manager did not accept it."""
+    print(f'run: {sent.given}', file=sys.stderr)
+    send = client.send_goal_async(goal, feedback_callback=lambda f: flying and flying[0] is sent
+                                  and bar.update(f.feedback.progress))
+    spin_until(node, send.done, [manager], START_TIMEOUT)
+    sent.handle = send.result()
+    if sent.handle is None or not sent.handle.accepted:
+        print('run: the experiment manager did not accept the goal', file=sys.stderr)
+        return False
+    sent.result = sent.handle.get_result_async()
+    if not flying:
+        bar.at_most = sent.adaptive
+    flying.append(sent)
+    return True
+
+
+def _cancel(node: Node, flying: list[Flying], manager) -> None:
+    """Cancel the goals in flight and wait for each to close its files."""
+    for f in flying:
+        f.handle.cancel_goal_async()
+    for f in flying:
+        spin_until(node, f.result.done, [manager], STOP_TIMEOUT)
+    flying.clear()
+
+
+def _finished(done: Flying, bar, boards: list[BoardRun]) -> int:
+    """Print a goal's result; its exit code (0 when it succeeded)."""
+    result = done.result.result().result
     bar.close()
     if result.error_code:
-        print(f'run: failed: {result.error_msg}', file=sys.stderr)
+        print(f'run: {done.given} failed: {result.error_msg}', file=sys.stderr)
         return 2 if result.error_code == RunExperiment.Result.INVALID_ARGUMENT else 1
     print(f'results:   {result.results_path}')
     print(f'recording: {result.recording_path}')
@@ -349,7 +363,7 @@ def _run(node: Node, client: LockedActionClient, goal, given: str, graph: Graph,
         print(f'report:    {result.report_path}')
     summary = summary_model.validate(summary_model.migrate(json.loads(result.summary_json)))
     print('\n'.join(headlines(summary)))
-    decided(boards, given, options(summary),
+    decided(boards, done.given, options(summary),
             result.results_path)
     # the manager's decisions in one table, each with the stage that stops most parts and
     # its first reason (the report gives them all)

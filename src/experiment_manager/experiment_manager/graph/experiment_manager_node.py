@@ -7,9 +7,15 @@ workers, each a `world`, `validity` and `feeder_controller` under its own namesp
 workers (scheduler.py), and one whose worker dies or stops answering runs again on another;
 results are written as iterations finish (results.py); every topic of the workers, its own
 progress, the experiment file and the results go into one MCAP file per run (recording.py).
-One run at a time: a second goal is answered BUSY, not queued.
+Up to RUNS_AT_ONCE runs at a time, side by side on the same workers (running/workers.py): the
+first begun takes a free worker first, a later one fills what it leaves idle (a board's next
+part while the last iterations of the one before run); a goal beyond them is answered BUSY,
+not queued.
 """
 
+from collections.abc import Callable
+from dataclasses import dataclass
+import itertools
 import os
 import threading
 import time
@@ -31,11 +37,12 @@ from std_msgs.msg import Header
 from ..analysis.summary import Summary
 from ..analysis.verdicts import verdicts
 from ..running.scheduler import Progress
+from ..running.workers import RUNS_AT_ONCE, Workers
 from .graph_backend import GraphBackend, GraphError
 from .session import RunSession
 from .topic_recorder import TopicRecorder
 
-STOP_WAIT = 15.0        # s a shutdown waits for the run to close its files
+STOP_WAIT = 15.0        # s a shutdown waits for the runs to close their files
 DISCOVERY_SETTLE = 3.0  # s the worker list must stay the same before discovery ends
 BUILTIN_FILES = os.path.join(get_package_share_directory('experiment_manager'), 'config')
 # The range of each numeric parameter (s, bytes).
@@ -87,16 +94,19 @@ class ExperimentManagerNode(Node):
         self._group = ReentrantCallbackGroup()
         self._call_timeout, self._server_timeout = call_timeout, server_timeout
         self._stopping = threading.Event()
-        self._abort = threading.Event()     # set by a run that failed, for its other workers
-        self._lock = threading.Lock()
-        self._goal = None
+        self._runs = threading.Condition()
+        self._active: list[Active] = []          # the runs going on, in the order begun
+        self._pool = Workers(taken=self._taken)
         self._progress = self.create_publisher(ExperimentProgress, 'progress', 10)
         self._verdicts = self.create_publisher(RunVerdicts, 'verdicts', LATCHED)
         self._backends: dict[str, GraphBackend] = {}
         self._topics = TopicRecorder(f'{self.get_name()}_recorder', self.get_namespace(),
                                      self.context)
+        self._accepted: dict[bytes, int] = {}     # goal id -> its place in the order accepted
+        self._count = itertools.count()
         ActionServer(self, RunExperiment, 'run_experiment', execute_callback=self._run,
-                     cancel_callback=lambda _: CancelResponse.ACCEPT,
+                     handle_accepted_callback=self._accept,
+                     cancel_callback=self._cancel,
                      callback_group=self._group)
         names = ', '.join(w or 'this namespace' for w in self._workers)
         self.get_logger().info(f'workers: {names}; call_timeout {call_timeout:g} s')
@@ -105,10 +115,36 @@ class ExperimentManagerNode(Node):
         """destroy_node was called, or a signal already shut the context down under the run."""
         return self._stopping.is_set() or not self.context.ok()
 
-    def _cancel_requested(self) -> bool:
-        goal = self._goal
-        return (self._shutting_down() or self._abort.is_set()
-                or (goal is not None and goal.is_cancel_requested))
+    def _accept(self, goal_handle) -> None:
+        """A goal accepted: its place in the order (the first has the workers first), then
+        its execution (rclpy's default)."""
+        with self._runs:
+            self._accepted[bytes(goal_handle.goal_id.uuid)] = next(self._count)
+        goal_handle.execute()
+
+    def _cancel(self, goal_handle) -> CancelResponse:
+        """A cancel request: the run ends at once, even one waiting for a worker beside
+        another (its calls in flight stop at their next look, as they did)."""
+        for active in list(self._active):
+            if active.goal_id == bytes(goal_handle.goal_id.uuid) and active.session.runner:
+                active.session.runner.stop(GraphError(RunExperiment.Result.CANCELED,
+                                                      'run_experiment was canceled'))
+        return CancelResponse.ACCEPT
+
+    def _taken(self, backend: GraphBackend, runner) -> None:
+        """A run took a worker (Workers): the worker's topics go to that run's recording."""
+        for active in list(self._active):
+            if active.session.runner is runner:
+                self._topics.route(backend.worker, active.session.recorder)
+
+    def _worker_canceled(self, worker: str) -> bool:
+        """Whether the calls to `worker` are to stop: the node is shutting down, or the run
+        holding the worker was canceled or failed."""
+        if self._shutting_down():
+            return True
+        runner = self._pool.holder(self._backends[worker])
+        return any(a.stopped() for a in list(self._active) if a.session.runner is runner
+                   and runner is not None)
 
     def _discover(self) -> list[str]:
         """Namespaces under this node's that hold a whole worker (the world's reset_scene, the
@@ -124,13 +160,14 @@ class ExperimentManagerNode(Node):
                     found.append(ns[len(base):].strip('/'))
         return sorted(found)
 
-    def _workers_of_run(self) -> list[GraphBackend]:
-        """The backends of the workers to drive (found now when the parameter says '*')."""
+    def _workers_of_run(self, stopped: Callable[[], bool]) -> list[GraphBackend]:
+        """The backends of the workers to drive (found now when the parameter says '*'),
+        the search given up once `stopped()`."""
         workers = self._workers
         if workers == ['*']:
             deadline = time.monotonic() + self._server_timeout
             workers, since = [], time.monotonic()
-            while time.monotonic() < deadline and not self._cancel_requested():
+            while time.monotonic() < deadline and not stopped():
                 now = self._discover()
                 if now != workers:
                     workers, since = now, time.monotonic()
@@ -143,15 +180,16 @@ class ExperimentManagerNode(Node):
                     f'namespace under {self.get_namespace()} holds reset_scene, check_parts '
                     'and feed_cycle (are the world, validity and feeder_controller nodes '
                     'running?)'))
-        for worker in workers:
-            if worker not in self._backends:
-                self._backends[worker] = GraphBackend(
-                    self, worker, self._group, self._call_timeout, self._server_timeout,
-                    self._cancel_requested, self._rejoin_timeout)
-                self._topics.add(worker)
-        return [self._backends[w] for w in workers]
+        with self._runs:        # two runs beginning at once make one backend of a worker
+            for worker in workers:
+                if worker not in self._backends:
+                    self._backends[worker] = GraphBackend(
+                        self, worker, self._group, self._call_timeout, self._server_timeout,
+                        lambda w=worker: self._worker_canceled(w), self._rejoin_timeout)
+                    self._topics.add(worker)
+            return [self._backends[w] for w in workers]
 
-    def _publish_progress(self, p: Progress) -> None:
+    def _publish_progress(self, p: Progress, goal_handle, session: RunSession) -> None:
         msg = ExperimentProgress(header=Header(stamp=self.get_clock().now().to_msg()),
                                  experiment_id=p.experiment_id,
                                  experiment_type=p.experiment_type, phase=p.phase,
@@ -160,10 +198,10 @@ class ExperimentManagerNode(Node):
         if self._shutting_down():
             return   # the publishers may be gone
         self._progress.publish(msg)
-        if self._goal is not None:
-            self._goal.publish_feedback(RunExperiment.Feedback(progress=msg))
-        self._topics.write(self._progress, msg)
-        self._topics.flush()   # once per iteration: a killed manager's recording keeps the rest
+        goal_handle.publish_feedback(RunExperiment.Feedback(progress=msg))
+        self._topics.write(self._progress, msg, session.recorder)
+        # once per iteration: a killed manager's recording keeps the rest
+        self._topics.flush(session.recorder)
 
     def _publish_verdicts(self, session: RunSession, summary: Summary) -> list[Verdict]:
         """The run's decisions, published (latched) and recorded with the run."""
@@ -173,31 +211,38 @@ class ExperimentManagerNode(Node):
                                             reasons=v.reasons, stops_most=v.stops)
                                     for v in verdicts(summary)])
         self._verdicts.publish(msg)
-        self._topics.write(self._verdicts, msg)
+        self._topics.write(self._verdicts, msg, session.recorder)
         return msg.verdicts
 
     # ------------------------------------------------------------------------- the action
     def _run(self, goal_handle) -> RunExperiment.Result:
         """Map the goal to a run session, and what fails to an error code."""
         result = RunExperiment.Result()
-        if not self._lock.acquire(blocking=False):
-            result.error_code = RunExperiment.Result.BUSY
-            result.error_msg = ('another experiment is running; goals are not queued: send it '
-                                'again when the running one has finished')
-            goal_handle.abort()
-            return result
-        self._goal = goal_handle
         goal = goal_handle.request
         session = RunSession(self._experiment_dirs, self._output_dirs, self._chunk_size,
                              self._topics, self.get_fully_qualified_name(), self.get_logger())
+        abort = threading.Event()       # set by the run when it fails, for its other workers
+        with self._runs:
+            goal_id = bytes(goal_handle.goal_id.uuid)
+            active = Active(session, lambda: (self._shutting_down() or abort.is_set()
+                                              or goal_handle.is_cancel_requested),
+                            self._accepted.pop(goal_id), goal_id)
+            if len(self._active) >= RUNS_AT_ONCE:
+                result.error_code = RunExperiment.Result.BUSY
+                result.error_msg = (f'{len(self._active)} experiments are running, the most '
+                                    'the manager runs at once (goals are not queued): send it '
+                                    'again when one has finished')
+                goal_handle.abort()
+                return result
+            self._active.append(active)
         try:
             session.open(goal.experiment_file, goal.output_dir, goal.resume)
             result.results_path = session.run_dir
             result.recording_path = session.recorder.path
-            self._abort.clear()
-            backends = self._workers_of_run()
-            summary = session.run(backends, self._publish_progress, self._abort,
-                                  [b.worker or '.' for b in backends])
+            backends = self._workers_of_run(active.stopped)
+            summary = session.run(
+                backends, lambda p: self._publish_progress(p, goal_handle, session), abort,
+                [b.worker or '.' for b in backends], self._pool, active.rank)
             result.summary_json = summary.json_text()
             result.verdicts = self._publish_verdicts(session, summary)
             result.report_path = session.write_report()
@@ -210,8 +255,9 @@ class ExperimentManagerNode(Node):
             if session.writer is not None and result.error_code:
                 result.error_msg += (f' (finished iterations are kept in {session.run_dir};'
                                      ' resume the run there to finish it)')
-            self._goal = None
-            self._lock.release()
+            with self._runs:
+                self._active.remove(active)
+                self._runs.notify_all()
         return result
 
     def _end(self, goal_handle, result) -> None:
@@ -227,15 +273,24 @@ class ExperimentManagerNode(Node):
     def destroy_node(self) -> None:
         """On shutdown, stop a run at its next call and let it close its files."""
         self._stopping.set()
-        if self._lock.acquire(timeout=STOP_WAIT):   # held while a run is in flight
-            self._lock.release()
-        else:
-            self.get_logger().error('the run did not stop within '
-                                    f'{STOP_WAIT:g} s; its recording may be cut off')
+        with self._runs:
+            if not self._runs.wait_for(lambda: not self._active, STOP_WAIT):
+                self.get_logger().error(f'{len(self._active)} run(s) did not stop within '
+                                        f'{STOP_WAIT:g} s; their recordings may be cut off')
         for backend in self._backends.values():
             backend.destroy()
         self._topics.destroy()
         super().destroy_node()
+
+
+@dataclass(frozen=True, eq=False)
+class Active:
+    """A run going on: its session, whether it is to stop (canceled, failed, or the node
+    shutting down), its goal's place in the order accepted, and the goal's id."""
+    session: RunSession
+    stopped: Callable[[], bool]
+    rank: int       # the goal's place in the order accepted
+    goal_id: bytes
 
 
 def check_worker(worker: str) -> str:

@@ -20,6 +20,7 @@ from ..analysis.summary import Summary
 from ..experiment_file import ExperimentFile, load, resolved
 from ..running.backend import Backend
 from ..running.scheduler import Progress, Runner
+from ..running.workers import Workers
 from .recording import Recorder
 from .topic_recorder import TopicRecorder
 
@@ -53,6 +54,7 @@ class RunSession:
         self.file: ExperimentFile | None = None
         self.writer: ResultsWriter | None = None
         self.recorder: Recorder | None = None
+        self.runner: Runner | None = None
 
     def open(self, experiment_file: str, output_dir: str, resume: bool) -> None:
         """Check and load the file, make (or, to resume, take) the run directory, open the
@@ -82,11 +84,14 @@ class RunSession:
         return self.writer.directory
 
     def run(self, backends: Sequence[Backend], progress: Callable[[Progress], None],
-            abort: threading.Event, names: Sequence[str]) -> Summary:
-        """Run the file on the backends (workers, named `names` in the log); the summary."""
+            abort: threading.Event, names: Sequence[str], workers: Workers,
+            rank: int) -> Summary:
+        """Run the file on the backends (workers, named `names` in the log), shared through
+        `workers` with the runs beside it, after those of a lower `rank`; the summary."""
         self._logger.info(f'running {self.file.path} into {self.run_dir} on {len(backends)} '
                           f'worker(s): {", ".join(names)}')
-        runner = Runner(self.file, backends, self.writer, progress, abort)
+        runner = self.runner = Runner(self.file, backends, self.writer, progress, abort,
+                                      workers, rank)
         try:
             return runner.run()
         finally:
@@ -141,7 +146,7 @@ class RunSession:
         return recorder
 
     def _close_recording(self) -> None:
-        self._topics.stop()
+        self._topics.stop(self.recorder)
         try:
             for name in RESULT_FILES:
                 path = self.writer.path(name)
