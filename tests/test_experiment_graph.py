@@ -584,6 +584,14 @@ def test_a_third_goal_or_second_run_is_refused_and_a_killed_last_worker_ends_the
             experiment_file=str(path), output_dir=str(tmp_path / 'other'))))
         busy = client.result(handle.get_result_async()).result
         assert busy.error_code == RunExperiment.Result.BUSY and 'not queued' in busy.error_msg
+        # the second run waits for the one worker, which the first keeps while it has an
+        # iteration ready: canceled, it ends now, not when the first has finished
+        client.result(beside.cancel_goal_async())
+        canceled = client.result(beside.get_result_async()).result
+        assert canceled.error_code == RunExperiment.Result.CANCELED, canceled.error_msg
+        first_dir = sorted(glob.glob(f'{out}/long_*'))[0]     # named by when they began
+        assert not os.path.exists(os.path.join(first_dir, 'report.html')), \
+            'the first run had finished: the cancel waited for it'
         # a second `run` in the namespace starts no node beside the running ones
         second = run_command(str(path), '--output', str(tmp_path / 'second'), '--namespace', ns,
                              '--workers', '1', timeout=120)

@@ -14,7 +14,7 @@ not queued.
 """
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 import itertools
 import os
 import threading
@@ -124,12 +124,22 @@ class ExperimentManagerNode(Node):
 
     def _cancel(self, goal_handle) -> CancelResponse:
         """A cancel request: the run ends at once, even one waiting for a worker beside
-        another (its calls in flight stop at their next look, as they did)."""
-        for active in list(self._active):
-            if active.goal_id == bytes(goal_handle.goal_id.uuid) and active.session.runner:
-                active.session.runner.stop(GraphError(RunExperiment.Result.CANCELED,
-                                                      'run_experiment was canceled'))
+        another (its calls in flight stop at their next look, as they did); a run whose
+        runner is not made yet is stopped when it is (_made)."""
+        with self._runs:
+            for active in self._active:
+                if active.goal_id == bytes(goal_handle.goal_id.uuid):
+                    active.canceled.set()
+                    if active.session.runner is not None:
+                        self._made(active, active.session.runner)
         return CancelResponse.ACCEPT
+
+    def _made(self, active: 'Active', runner) -> None:
+        """A run's runner is made: stopped at once if its goal was canceled before."""
+        with self._runs:
+            if active.canceled.is_set():
+                runner.stop(GraphError(RunExperiment.Result.CANCELED,
+                                       'run_experiment was canceled'))
 
     def _taken(self, backend: GraphBackend, runner) -> None:
         """A run took a worker (Workers): the worker's topics go to that run's recording."""
@@ -242,7 +252,8 @@ class ExperimentManagerNode(Node):
             backends = self._workers_of_run(active.stopped)
             summary = session.run(
                 backends, lambda p: self._publish_progress(p, goal_handle, session), abort,
-                [b.worker or '.' for b in backends], self._pool, active.rank)
+                [b.worker or '.' for b in backends], self._pool, active.rank,
+                lambda runner: self._made(active, runner))
             result.summary_json = summary.json_text()
             result.verdicts = self._publish_verdicts(session, summary)
             result.report_path = session.write_report()
@@ -291,6 +302,7 @@ class Active:
     stopped: Callable[[], bool]
     rank: int       # the goal's place in the order accepted
     goal_id: bytes
+    canceled: threading.Event = field(default_factory=threading.Event)  # a cancel came
 
 
 def check_worker(worker: str) -> str:

@@ -84,14 +84,16 @@ class RunSession:
         return self.writer.directory
 
     def run(self, backends: Sequence[Backend], progress: Callable[[Progress], None],
-            abort: threading.Event, names: Sequence[str], workers: Workers,
-            rank: int) -> Summary:
+            abort: threading.Event, names: Sequence[str], workers: Workers, rank: int,
+            made: Callable[[Runner], None]) -> Summary:
         """Run the file on the backends (workers, named `names` in the log), shared through
-        `workers` with the runs beside it, after those of a lower `rank`; the summary."""
+        `workers` with the runs beside it, after those of a lower `rank`; the summary.
+        `made` is given the runner before it runs (to stop it, Runner.stop)."""
         self._logger.info(f'running {self.file.path} into {self.run_dir} on {len(backends)} '
                           f'worker(s): {", ".join(names)}')
         runner = self.runner = Runner(self.file, backends, self.writer, progress, abort,
                                       workers, rank)
+        made(runner)
         try:
             return runner.run()
         finally:
