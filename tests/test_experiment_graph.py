@@ -1,10 +1,11 @@
 """End to end: the `run` command brings up two workers (world, validity, feeder_controller) and
-experiment_manager as processes, runs a small file of every experiment type over DDS, and leaves
-results and a recording. The recording is decoded by an independent reader (mcap-ros2-support,
-from the schema text in the file) and matched against the results; the results are matched
-against the same file run on the cores in one process. Then: replay, a bad file, a worker
-killed mid-run (the other finishes the run with the same results), a second goal, and the last
-worker killed (the run fails, keeping what finished)."""
+experiment_manager as processes, runs a small file of every experiment type over DDS with a
+drop test beside it, and leaves each its results and recording. Each recording is decoded by
+an independent reader (mcap-ros2-support, from the schema text in the file) and matched against
+its results; the results are matched against the same file run on the cores in one process.
+Then: replay, a bad file, a worker killed mid-run (the other finishes the run with the same
+results), a second goal beside the first (canceled while it waits) and a third refused, and
+the last worker killed (the runs fail, keeping what finished)."""
 
 from collections.abc import Callable
 import glob
