@@ -312,12 +312,8 @@ def _run(node: Node, client: LockedActionClient, goals: list, graph: Graph, bar,
                 code = _finished(done, bar, boards)
                 if code:
                     return code
-            bar.at_most = bool(flying) and flying[0].adaptive
-    except KeyboardInterrupt:
-        _cancel(node, flying, manager)
-        raise
     finally:
-        if flying:      # a goal failed, or the manager died: the others end with it
+        if flying:      # a goal failed, the manager died or Ctrl-C: the others end with it
             _cancel(node, flying, manager)
     return 0
 
@@ -326,16 +322,18 @@ def _send(node: Node, client: LockedActionClient, goal, sent: Flying, flying: li
           bar, manager) -> bool:
     """Send a goal; False (said why) when the manager did not accept it."""
     print(f'run: {sent.given}', file=sys.stderr)
-    send = client.send_goal_async(goal, feedback_callback=lambda f: flying and flying[0] is sent
-                                  and bar.update(f.feedback.progress))
+
+    def feedback(f) -> None:
+        if flying and flying[0] is sent:      # the bar shows the earliest goal in flight
+            bar.at_most = sent.adaptive
+            bar.update(f.feedback.progress)
+    send = client.send_goal_async(goal, feedback_callback=feedback)
     spin_until(node, send.done, [manager], START_TIMEOUT)
     sent.handle = send.result()
     if sent.handle is None or not sent.handle.accepted:
         print('run: the experiment manager did not accept the goal', file=sys.stderr)
         return False
     sent.result = sent.handle.get_result_async()
-    if not flying:
-        bar.at_most = sent.adaptive
     flying.append(sent)
     return True
 

@@ -128,24 +128,32 @@ class ExperimentManagerNode(Node):
         runner is not made yet is stopped when it is (_made)."""
         with self._runs:
             for active in self._active:
-                if active.goal_id == bytes(goal_handle.goal_id.uuid):
+                if bytes(active.goal.goal_id.uuid) == bytes(goal_handle.goal_id.uuid):
                     active.canceled.set()
                     if active.session.runner is not None:
                         self._made(active, active.session.runner)
         return CancelResponse.ACCEPT
 
+    def _stopped(self, active: 'Active') -> bool:
+        """Whether a run's calls are to stop: it was canceled or failed, or the node is
+        shutting down."""
+        return self._shutting_down() or active.abort.is_set() or active.cancel_came
+
+    def _active_of(self, runner) -> 'Active | None':
+        return next((a for a in list(self._active) if a.session.runner is runner), None)
+
     def _made(self, active: 'Active', runner) -> None:
         """A run's runner is made: stopped at once if its goal was canceled before."""
         with self._runs:
-            if active.canceled.is_set():
+            if active.cancel_came:
                 runner.stop(GraphError(RunExperiment.Result.CANCELED,
                                        'run_experiment was canceled'))
 
     def _taken(self, backend: GraphBackend, runner) -> None:
         """A run took a worker (Workers): the worker's topics go to that run's recording."""
-        for active in list(self._active):
-            if active.session.runner is runner:
-                self._topics.route(backend.worker, active.session.recorder)
+        active = self._active_of(runner)
+        if active is not None:
+            self._topics.route(backend.worker, active.session.recorder)
 
     def _worker_canceled(self, worker: str) -> bool:
         """Whether the calls to `worker` are to stop: the node is shutting down, or the run
@@ -153,8 +161,8 @@ class ExperimentManagerNode(Node):
         if self._shutting_down():
             return True
         runner = self._pool.holder(self._backends[worker])
-        return any(a.stopped() for a in list(self._active) if a.session.runner is runner
-                   and runner is not None)
+        active = self._active_of(runner) if runner is not None else None
+        return active is not None and self._stopped(active)
 
     def _discover(self) -> list[str]:
         """Namespaces under this node's that hold a whole worker (the world's reset_scene, the
@@ -231,12 +239,9 @@ class ExperimentManagerNode(Node):
         goal = goal_handle.request
         session = RunSession(self._experiment_dirs, self._output_dirs, self._chunk_size,
                              self._topics, self.get_fully_qualified_name(), self.get_logger())
-        abort = threading.Event()       # set by the run when it fails, for its other workers
         with self._runs:
-            goal_id = bytes(goal_handle.goal_id.uuid)
-            active = Active(session, lambda: (self._shutting_down() or abort.is_set()
-                                              or goal_handle.is_cancel_requested),
-                            self._accepted.pop(goal_id), goal_id)
+            active = Active(session, self._accepted.pop(bytes(goal_handle.goal_id.uuid)),
+                            goal_handle)
             if len(self._active) >= RUNS_AT_ONCE:
                 result.error_code = RunExperiment.Result.BUSY
                 result.error_msg = (f'{len(self._active)} experiments are running, the most '
@@ -249,9 +254,10 @@ class ExperimentManagerNode(Node):
             session.open(goal.experiment_file, goal.output_dir, goal.resume)
             result.results_path = session.run_dir
             result.recording_path = session.recorder.path
-            backends = self._workers_of_run(active.stopped)
+            backends = self._workers_of_run(lambda: self._stopped(active))
             summary = session.run(
-                backends, lambda p: self._publish_progress(p, goal_handle, session), abort,
+                backends, lambda p: self._publish_progress(p, goal_handle, session),
+                active.abort,
                 [b.worker or '.' for b in backends], self._pool, active.rank,
                 lambda runner: self._made(active, runner))
             result.summary_json = summary.json_text()
@@ -296,13 +302,18 @@ class ExperimentManagerNode(Node):
 
 @dataclass(frozen=True, eq=False)
 class Active:
-    """A run going on: its session, whether it is to stop (canceled, failed, or the node
-    shutting down), its goal's place in the order accepted, and the goal's id."""
+    """A run going on: its session, its goal's place in the order accepted, its goal, whether
+    it failed (`abort`, set by its runner for its other workers) and whether a cancel came."""
     session: RunSession
-    stopped: Callable[[], bool]
     rank: int       # the goal's place in the order accepted
-    goal_id: bytes
-    canceled: threading.Event = field(default_factory=threading.Event)  # a cancel came
+    goal: object    # rclpy's ServerGoalHandle
+    abort: threading.Event = field(default_factory=threading.Event)
+    # set by the cancel callback, which runs before rclpy marks the goal canceled
+    canceled: threading.Event = field(default_factory=threading.Event)
+
+    @property
+    def cancel_came(self) -> bool:
+        return self.canceled.is_set() or self.goal.is_cancel_requested
 
 
 def check_worker(worker: str) -> str:
